@@ -1,0 +1,44 @@
+# SPDX-License-Identifier: MIT
+# The project's front door. `make run` and `make test` work on a fresh Debian bookworm machine.
+JOBS ?= $(shell nproc)
+
+.PHONY: all deps run test build-release build-ci bench format check-format clean help
+
+all: build-release
+
+help:
+	@echo "make run          install deps, build Release, run the main job (world demo)"
+	@echo "make test         install deps, build with -Werror, run the whole test suite"
+	@echo "make bench        build Release and run every benchmark (bench/run)"
+	@echo "make format       clang-format every source file"
+	@echo "make check-format fail if a source file is not clang-formatted"
+	@echo "make clean        remove build/"
+
+deps:
+	@scripts/install-deps
+
+build-release: deps
+	@cmake --preset release >/dev/null
+	@cmake --build --preset release -j $(JOBS)
+
+build-ci: deps
+	@cmake --preset ci >/dev/null
+	@cmake --build --preset ci -j $(JOBS)
+
+run: build-release
+	./build/release/kinematic/llsf-world-demo $(ARGS)
+
+test: build-ci
+	ctest --preset ci -j $(JOBS)
+
+bench: deps
+	bench/run
+
+format:
+	scripts/format
+
+check-format:
+	scripts/format --check
+
+clean:
+	rm -rf build
