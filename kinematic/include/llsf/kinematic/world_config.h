@@ -160,7 +160,9 @@ struct IrConfig {
 /// The two digital optical sensors at the holder arm tips, looking forward.
 struct OpticalConfig {
   double rate_hz = 30.0;
-  double range_m = 0.12;        ///< trigger distance (the thesis' corner problem needs this)
+  /// Trigger distance. The thesis' real sensors reached the corner walls beside R1/R2 (its
+  /// recycling-corner problem); 0.30 m reproduces that, a short range hides the walls.
+  double range_m = 0.30;
   double miss_probability = 0.0;///< chance that a triggered sensor reports false
 };
 
