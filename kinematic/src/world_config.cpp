@@ -1,0 +1,747 @@
+// SPDX-License-Identifier: MIT
+// The 2013 default world, WorldConfig::validate() and the YAML loader (docs/world-config.md).
+#include "llsf/kinematic/world_config.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <set>
+#include <utility>
+
+namespace llsf::kinematic {
+
+using core::ConfigError;
+using core::ConfigNode;
+
+// ---------------------------------------------------------------------------------------------
+// The 2013 field
+// ---------------------------------------------------------------------------------------------
+
+namespace {
+
+/// A rule-book device pose: position in metres, facing in degrees (RBX facts.clp orientation).
+struct DevicePose {
+  double x;
+  double y;
+  double ori_deg;
+};
+
+// In kDeviceNames order. The facings are given in degrees (270 = 3π/2, ...) so that the YAML
+// form `ori_deg: 270` of config/world-2013.yaml converts to the bit-identical heading.
+constexpr std::array<DevicePose, kDeviceCount> kPoses2013 = {{
+    {3.92, 1.68, 270},  // M1  3π/2
+    {3.92, 3.92, 0},    // M2  0
+    {2.80, 0.56, 90},   // M3  π/2
+    {2.80, 1.68, 90},   // M4  π/2
+    {2.80, 2.80, 180},  // M5  π
+    {2.80, 3.92, 90},   // M6  π/2
+    {2.80, 5.04, 270},  // M7  3π/2
+    {1.68, 1.68, 180},  // M8  π
+    {1.68, 3.92, 270},  // M9  3π/2
+    {1.68, 5.04, 0},    // M10 0
+    {5.40, 0.20, 135},  // R1  3π/4, bottom-right corner, facing the field centre
+    {0.20, 5.40, 315},  // R2  7π/4, top-left corner
+    {5.40, 5.40, 225},  // TST 5π/4, top-right corner
+    {5.34, 3.15, 180},  // D1  π, the delivery slot
+    {5.34, 2.80, 180},  // D2
+    {5.34, 2.45, 180},  // D3
+}};
+
+// Footprints. The sources give no device dimensions; these are assumptions.
+// Production machines: a signal tower plus RFID reader on a stand, taken as a 0.20 m deep,
+// 0.30 m wide box centred on the machine-space centre. The RFID zone centre lies 0.14 m ahead,
+// 0.04 m beyond the body front: where the centre of a puck touching the front comes to rest.
+constexpr double kMachineDepth = 0.20;
+constexpr double kMachineWidth = 0.30;
+constexpr double kMachineRfidOffset = 0.14;
+// Recycling units and the test station: the same tower, narrower (0.24 m) stand.
+constexpr double kCornerDepth = 0.20;
+constexpr double kCornerWidth = 0.24;
+constexpr double kCornerRfidOffset = 0.14;
+// Delivery gates: the pose is the delivery slot directly under the reader; the gate body
+// (0.16 m deep, 0.30 m wide as the RB gate width) stands behind the slot against the right
+// wall, so its centre is 0.12 m behind the slot.
+constexpr double kGateDepth = 0.16;
+constexpr double kGateWidth = 0.30;
+constexpr double kGateBodyOffset = -0.12;
+constexpr double kGateRfidOffset = 0.0;
+// The read zone: a puck tag is read within 0.05 m of the zone centre (RB: range <= 0.115 m).
+constexpr double kRfidRadius = 0.05;
+
+}  // namespace
+
+WorldConfig WorldConfig::default_2013() {
+  WorldConfig c;
+
+  // Devices at the rule-book poses with the assumed footprints.
+  for (int i = 0; i < kDeviceCount; ++i) {
+    DeviceConfig& d = c.devices[i];
+    const DevicePose& p = kPoses2013[i];
+    d.pose = Pose2D{p.x, p.y, core::normalize_angle(core::deg_to_rad(p.ori_deg))};
+    d.rfid_radius_m = kRfidRadius;
+    switch (device_kind(DeviceId(i))) {
+      case DeviceKind::kProduction:
+        d.body_depth_m = kMachineDepth;
+        d.body_width_m = kMachineWidth;
+        d.body_offset_m = 0.0;
+        d.rfid_offset_m = kMachineRfidOffset;
+        break;
+      case DeviceKind::kRecycling:
+      case DeviceKind::kTest:
+        d.body_depth_m = kCornerDepth;
+        d.body_width_m = kCornerWidth;
+        d.body_offset_m = 0.0;
+        d.rfid_offset_m = kCornerRfidOffset;
+        break;
+      case DeviceKind::kDelivery:
+        d.body_depth_m = kGateDepth;
+        d.body_width_m = kGateWidth;
+        d.body_offset_m = kGateBodyOffset;
+        d.rfid_offset_m = kGateRfidOffset;
+        break;
+    }
+  }
+
+  // The 20 S0 pucks in the input storage as drawn in the RB: two columns of ten, ids 1..10 at
+  // x = 0.12, ids 11..20 at x = 0.28, y = 2.35 .. 3.25. The y values are computed as integer
+  // centimetres / 100 so that they equal the decimal literals of config/world-2013.yaml.
+  for (int col = 0; col < 2; ++col) {
+    for (int k = 0; k < 10; ++k) {
+      const double x = col == 0 ? 0.12 : 0.28;
+      const double y = static_cast<double>(235 + 10 * k) / 100.0;
+      c.pucks.push_back(PuckPlacement{col * 10 + k + 1, Vec2(x, y)});
+    }
+  }
+
+  // Three robots in the insertion area, facing the field.
+  c.robots = {RobotStart{"robot1", Pose2D{0.20, 0.40, 0.0}},
+              RobotStart{"robot2", Pose2D{0.20, 1.00, 0.0}},
+              RobotStart{"robot3", Pose2D{0.20, 1.60, 0.0}}};
+  return c;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Validation
+// ---------------------------------------------------------------------------------------------
+
+namespace {
+
+constexpr double kRfidMaxRange = 0.115;  // RB: ISO 15693 reader, read range <= 115 mm
+constexpr double kEps = 1e-9;            // touching is not overlapping
+constexpr int kMaxBeams = 10000;
+
+/// Shortest round-trip form of a number ("-0.2", "1e-05").
+std::string num(double v) {
+  char buf[64];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
+}
+
+/// "(x.xx, y.yy)" for positions in messages.
+std::string at_xy(const Vec2& p) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "(%.2f, %.2f)", p.x(), p.y());
+  return buf;
+}
+
+[[noreturn]] void fail(const std::string& path, const std::string& reason) {
+  throw ConfigError(path + ": " + reason);
+}
+
+void require_finite(const std::string& path, double v) {
+  if (!std::isfinite(v)) fail(path, "must be a finite number (got " + num(v) + ")");
+}
+void require_positive(const std::string& path, double v) {
+  if (!(v > 0.0) || !std::isfinite(v)) fail(path, "must be > 0 (got " + num(v) + ")");
+}
+void require_non_negative(const std::string& path, double v) {
+  if (!(v >= 0.0) || !std::isfinite(v)) fail(path, "must be >= 0 (got " + num(v) + ")");
+}
+void require_in(const std::string& path, double v, double lo, double hi) {
+  if (!(v >= lo && v <= hi)) {
+    fail(path, "must be in [" + num(lo) + ", " + num(hi) + "] (got " + num(v) + ")");
+  }
+}
+
+/// True if the whole circle lies inside [0, width] x [0, height].
+bool circle_inside_field(const Vec2& c, double r, const FieldConfig& f) {
+  return c.x() - r >= -kEps && c.y() - r >= -kEps && c.x() + r <= f.width_m + kEps &&
+         c.y() + r <= f.height_m + kEps;
+}
+
+/// Exact circle-vs-oriented-box test: the distance from the centre to the box is below r.
+bool circle_overlaps_box(const Vec2& c, double r, const core::OrientedBox& box) {
+  const Vec2 l = box.pose.to_local(c);
+  const Vec2 nearest(std::clamp(l.x(), -box.half_extents.x(), box.half_extents.x()),
+                     std::clamp(l.y(), -box.half_extents.y(), box.half_extents.y()));
+  return (l - nearest).norm() < r - kEps;
+}
+
+bool circles_overlap(const Vec2& a, double ra, const Vec2& b, double rb) {
+  return (a - b).norm() < ra + rb - kEps;
+}
+
+std::string device_path(int i) { return "devices." + std::string(kDeviceNames[i]); }
+std::string indexed(const char* list, std::size_t i) {
+  return std::string(list) + "[" + std::to_string(i) + "]";
+}
+
+/// The field size with the keys it comes from (so a loader can point at them).
+std::string field_size(const FieldConfig& f) {
+  return "field.width_m x field.height_m = " + num(f.width_m) + " x " + num(f.height_m);
+}
+
+void validate_field(const FieldConfig& f) {
+  require_positive("field.width_m", f.width_m);
+  require_positive("field.height_m", f.height_m);
+  require_positive("field.wall_thickness_m", f.wall_thickness_m);
+}
+
+void validate_devices(const WorldConfig& c) {
+  const FieldConfig& f = c.field;
+  for (int i = 0; i < kDeviceCount; ++i) {
+    const DeviceConfig& d = c.devices[i];
+    const std::string p = device_path(i);
+    require_finite(p + ".x", d.pose.x);
+    require_finite(p + ".y", d.pose.y);
+    require_finite(p + ".ori", d.pose.theta);
+    require_positive(p + ".body_depth_m", d.body_depth_m);
+    require_positive(p + ".body_width_m", d.body_width_m);
+    require_finite(p + ".body_offset_m", d.body_offset_m);
+    require_finite(p + ".rfid_offset_m", d.rfid_offset_m);
+    if (!(d.rfid_radius_m > 0.0 && d.rfid_radius_m <= kRfidMaxRange)) {
+      fail(p + ".rfid_radius_m", "must be > 0 and <= " + num(kRfidMaxRange) +
+                                     " (the RFID reader range) (got " + num(d.rfid_radius_m) + ")");
+    }
+    if (!core::inside_rect(d.footprint(), Vec2(0.0, 0.0), Vec2(f.width_m, f.height_m))) {
+      fail(p, "footprint at " + at_xy(d.footprint().pose.position()) +
+                  " is not entirely inside the field (" + field_size(f) + ")");
+    }
+    const Vec2 rc = d.rfid_center();
+    if (!(rc.x() >= 0.0 && rc.y() >= 0.0 && rc.x() <= f.width_m && rc.y() <= f.height_m)) {
+      fail(p, "RFID zone centre " + at_xy(rc) + " is outside the field (" + field_size(f) + ")");
+    }
+  }
+  for (int i = 0; i < kDeviceCount; ++i) {
+    for (int j = i + 1; j < kDeviceCount; ++j) {
+      if (core::overlaps(c.devices[i].footprint(), c.devices[j].footprint())) {
+        fail(device_path(i), "footprint overlaps " + device_path(j));
+      }
+    }
+  }
+}
+
+/// The device whose footprint the circle overlaps, if any.
+std::optional<int> device_hit(const WorldConfig& c, const Vec2& center, double r) {
+  for (int i = 0; i < kDeviceCount; ++i) {
+    if (circle_overlaps_box(center, r, c.devices[i].footprint())) return i;
+  }
+  return std::nullopt;
+}
+
+void validate_pucks(const WorldConfig& c) {
+  const PuckModelConfig& m = c.puck;
+  require_positive("puck.radius_m", m.radius_m);
+  require_positive("puck.mass_kg", m.mass_kg);
+  require_non_negative("puck.floor_friction", m.floor_friction);
+  require_non_negative("puck.contact_friction", m.contact_friction);
+  require_in("puck.restitution", m.restitution, 0.0, 1.0);
+
+  const double r = m.radius_m;
+  std::map<int, std::size_t> seen_ids;
+  for (std::size_t i = 0; i < c.pucks.size(); ++i) {
+    const PuckPlacement& pk = c.pucks[i];
+    const std::string p = indexed("pucks", i);
+    if (pk.id <= 0) fail(p + ".id", "must be > 0 (got " + std::to_string(pk.id) + ")");
+    if (auto [it, fresh] = seen_ids.emplace(pk.id, i); !fresh) {
+      fail(p + ".id", "duplicate puck id " + std::to_string(pk.id) + " (also used by " +
+                          indexed("pucks", it->second) + ")");
+    }
+    require_finite(p + ".x", pk.position.x());
+    require_finite(p + ".y", pk.position.y());
+    const std::string what = "puck " + std::to_string(pk.id) + " at " + at_xy(pk.position);
+    if (!circle_inside_field(pk.position, r, c.field)) {
+      fail(p, what + " is outside the field (the whole circle of puck.radius_m = " + num(r) +
+                  " must lie inside " + field_size(c.field) + ")");
+    }
+    if (auto d = device_hit(c, pk.position, r)) {
+      fail(p, what + " overlaps the footprint of " + device_path(*d));
+    }
+    for (std::size_t j = 0; j < i; ++j) {
+      if (circles_overlap(pk.position, r, c.pucks[j].position, r)) {
+        fail(p, what + " overlaps puck " + std::to_string(c.pucks[j].id) + " (" +
+                    indexed("pucks", j) + ", puck.radius_m = " + num(r) + ")");
+      }
+    }
+  }
+}
+
+void validate_robots(const WorldConfig& c) {
+  const RobotModelConfig& m = c.robot;
+  require_positive("robot.radius_m", m.radius_m);
+  require_positive("robot.mass_kg", m.mass_kg);
+  require_positive("robot.max_speed_mps", m.max_speed_mps);
+  require_positive("robot.max_omega_rps", m.max_omega_rps);
+  require_positive("robot.max_accel_mps2", m.max_accel_mps2);
+  require_positive("robot.max_alpha_rps2", m.max_alpha_rps2);
+  require_non_negative("robot.contact_friction", m.contact_friction);
+
+  const HolderConfig& h = m.holder;
+  if (!(h.inner_width_m > 2.0 * c.puck.radius_m) || !std::isfinite(h.inner_width_m)) {
+    fail("robot.holder.inner_width_m",
+         "must be wider than the puck diameter 2 * puck.radius_m = " + num(2.0 * c.puck.radius_m) +
+             " (got " + num(h.inner_width_m) + ")");
+  }
+  require_positive("robot.holder.arm_length_m", h.arm_length_m);
+  require_positive("robot.holder.arm_thickness_m", h.arm_thickness_m);
+  require_non_negative("robot.holder.arm_friction", h.arm_friction);
+  require_non_negative("robot.holder.release_backing_speed_mps", h.release_backing_speed_mps);
+
+  const double r = m.radius_m;
+  std::map<std::string, std::size_t> seen_names;
+  for (std::size_t i = 0; i < c.robots.size(); ++i) {
+    const RobotStart& rs = c.robots[i];
+    const std::string p = indexed("robots", i);
+    if (rs.name.empty()) fail(p + ".name", "must not be empty");
+    if (auto [it, fresh] = seen_names.emplace(rs.name, i); !fresh) {
+      fail(p + ".name", "duplicate robot name '" + rs.name + "' (also used by " +
+                            indexed("robots", it->second) + ")");
+    }
+    require_finite(p + ".x", rs.pose.x);
+    require_finite(p + ".y", rs.pose.y);
+    require_finite(p + ".ori", rs.pose.theta);
+    const Vec2 pos = rs.pose.position();
+    const std::string what = "robot '" + rs.name + "' at " + at_xy(pos);
+    if (!circle_inside_field(pos, r, c.field)) {
+      fail(p, what + " is outside the field (the whole circle of robot.radius_m = " + num(r) +
+                  " must lie inside " + field_size(c.field) + ")");
+    }
+    if (auto d = device_hit(c, pos, r)) {
+      fail(p, what + " overlaps the footprint of " + device_path(*d));
+    }
+    for (std::size_t j = 0; j < i; ++j) {
+      if (circles_overlap(pos, r, c.robots[j].pose.position(), r)) {
+        fail(p, what + " overlaps robot '" + c.robots[j].name + "' (" + indexed("robots", j) +
+                    ", robot.radius_m = " + num(r) + ")");
+      }
+    }
+    for (std::size_t j = 0; j < c.pucks.size(); ++j) {
+      if (circles_overlap(pos, r, c.pucks[j].position, c.puck.radius_m)) {
+        fail(p, what + " overlaps puck " + std::to_string(c.pucks[j].id) + " (" +
+                    indexed("pucks", j) + ")");
+      }
+    }
+  }
+}
+
+void validate_sensors(const SensorsConfig& s) {
+  require_positive("sensors.odometry.rate_hz", s.odometry.rate_hz);
+  require_non_negative("sensors.odometry.trans_noise_per_m", s.odometry.trans_noise_per_m);
+  require_non_negative("sensors.odometry.rot_noise_per_rad", s.odometry.rot_noise_per_rad);
+  require_non_negative("sensors.odometry.accel_noise_per_mps", s.odometry.accel_noise_per_mps);
+  require_non_negative("sensors.odometry.accel_rot_noise_per_rps",
+                       s.odometry.accel_rot_noise_per_rps);
+
+  require_positive("sensors.gyro.rate_hz", s.gyro.rate_hz);
+  require_non_negative("sensors.gyro.noise_std_rps", s.gyro.noise_std_rps);
+  require_finite("sensors.gyro.bias_rps", s.gyro.bias_rps);
+
+  require_positive("sensors.ir.rate_hz", s.ir.rate_hz);
+  require_positive("sensors.ir.range_m", s.ir.range_m);
+  require_non_negative("sensors.ir.noise_std_m", s.ir.noise_std_m);
+  require_positive("sensors.ir.threshold_m", s.ir.threshold_m);
+  if (s.ir.threshold_m > s.ir.range_m) {
+    fail("sensors.ir.threshold_m", "must be <= sensors.ir.range_m " + num(s.ir.range_m) + " (got " +
+                                       num(s.ir.threshold_m) + ")");
+  }
+
+  require_positive("sensors.optical.rate_hz", s.optical.rate_hz);
+  require_positive("sensors.optical.range_m", s.optical.range_m);
+  require_in("sensors.optical.miss_probability", s.optical.miss_probability, 0.0, 1.0);
+
+  require_positive("sensors.ground_truth.rate_hz", s.ground_truth.rate_hz);
+
+  const LaserConfig& l = s.laser;
+  if (l.beams < 1 || l.beams > kMaxBeams) {
+    fail("sensors.laser.beams",
+         "must be in 1.." + std::to_string(kMaxBeams) + " (got " + std::to_string(l.beams) + ")");
+  }
+  require_positive("sensors.laser.rate_hz", l.rate_hz);
+  require_non_negative("sensors.laser.min_range_m", l.min_range_m);
+  require_positive("sensors.laser.max_range_m", l.max_range_m);
+  if (!(l.min_range_m < l.max_range_m)) {
+    fail("sensors.laser.min_range_m", "must be < sensors.laser.max_range_m " + num(l.max_range_m) +
+                                          " (got " + num(l.min_range_m) + ")");
+  }
+  require_non_negative("sensors.laser.noise_std_m", l.noise_std_m);
+  require_finite("sensors.laser.mount_x_m", l.mount_x_m);
+  require_finite("sensors.laser.mount_y_m", l.mount_y_m);
+}
+
+void validate_physics(const PhysicsConfig& p) {
+  if (p.step <= SimTime() || p.step > SimTime::from_ms(100)) {
+    fail("physics.step_ms", "must be > 0 and <= 100 (got " + num(p.step.seconds() * 1000.0) + ")");
+  }
+  if (p.velocity_iterations < 1) {
+    fail("physics.velocity_iterations",
+         "must be >= 1 (got " + std::to_string(p.velocity_iterations) + ")");
+  }
+  if (p.position_iterations < 1) {
+    fail("physics.position_iterations",
+         "must be >= 1 (got " + std::to_string(p.position_iterations) + ")");
+  }
+}
+
+}  // namespace
+
+void WorldConfig::validate() const {
+  // Models before placements: the placement checks use the sizes.
+  validate_field(field);
+  validate_devices(*this);
+  validate_pucks(*this);
+  validate_robots(*this);
+  validate_sensors(sensors);
+  validate_physics(physics);
+}
+
+// ---------------------------------------------------------------------------------------------
+// YAML loading
+// ---------------------------------------------------------------------------------------------
+
+namespace {
+
+/// Parent of a dotted path: "a.b[2].c" -> "a.b[2]" -> "a.b" -> "a" -> "".
+std::string parent_path(const std::string& path) {
+  const auto pos = path.find_last_of(".[");
+  return pos == std::string::npos ? std::string() : path.substr(0, pos);
+}
+
+bool is_name_char(char ch) {
+  return (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') ||
+         ch == '_';
+}
+
+/// Reads a document into a WorldConfig and remembers the node of every path it read, so that a
+/// validate() error ("devices.M4: ...") can be reported at the line the value came from.
+class Loader {
+ public:
+  explicit Loader(ConfigNode root) : root_(std::move(root)) {}
+
+  WorldConfig load(WorldConfig c) {
+    root_.require_map();
+    root_.check_keys(
+        {"field", "devices", "puck", "pucks", "robot", "robots", "sensors", "physics"});
+    read_field(c.field);
+    read_devices(c);
+    read_puck_model(c.puck);
+    read_pucks(c);
+    read_robot_model(c.robot);
+    read_robots(c);
+    read_sensors(c.sensors);
+    read_physics(c.physics);
+    try {
+      c.validate();
+    } catch (const ConfigError& e) {
+      throw ConfigError(locate(e.what()).location() + ": " + e.what());
+    }
+    return c;
+  }
+
+ private:
+  void remember(const ConfigNode& n) { seen_.insert_or_assign(n.path(), n); }
+
+  /// The map under `key` (possibly undefined or null), with its keys checked.
+  ConfigNode section(const ConfigNode& parent, std::string_view key,
+                     std::initializer_list<std::string_view> allowed) {
+    ConfigNode n = parent[key];
+    if (!n.defined()) return n;
+    n.require_map();
+    n.check_keys(allowed);
+    remember(n);
+    return n;
+  }
+  /// An element of a list that must be a map with the given keys.
+  ConfigNode element(const ConfigNode& e, std::initializer_list<std::string_view> allowed,
+                     const char* what) {
+    if (!e.is_map()) e.fail(std::string("expected a map ") + what);
+    e.check_keys(allowed);
+    remember(e);
+    return e;
+  }
+
+  void read(const ConfigNode& m, std::string_view key, double& out) {
+    if (ConfigNode n = m[key]; n.defined()) {
+      out = n.as_double();
+      remember(n);
+    }
+  }
+  void read(const ConfigNode& m, std::string_view key, int& out) {
+    if (ConfigNode n = m[key]; n.defined()) {
+      m.read(key, out);
+      remember(n);
+    }
+  }
+  void read(const ConfigNode& m, std::string_view key, bool& out) {
+    if (ConfigNode n = m[key]; n.defined()) {
+      out = n.as_bool();
+      remember(n);
+    }
+  }
+  /// `ori` (radians) or `ori_deg` (degrees), normalised to (-pi, pi].
+  void read_orientation(const ConfigNode& m, double& theta) {
+    const ConfigNode rad = m["ori"];
+    const ConfigNode deg = m["ori_deg"];
+    if (rad.defined() && deg.defined()) {
+      deg.fail("give either 'ori' (radians) or 'ori_deg' (degrees), not both");
+    }
+    if (rad.defined()) {
+      theta = core::normalize_angle(rad.as_double());
+      remember(rad);
+    } else if (deg.defined()) {
+      theta = core::normalize_angle(core::deg_to_rad(deg.as_double()));
+      remember(deg);
+    }
+  }
+
+  void read_field(FieldConfig& f) {
+    const ConfigNode n = section(root_, "field", {"width_m", "height_m", "wall_thickness_m"});
+    read(n, "width_m", f.width_m);
+    read(n, "height_m", f.height_m);
+    read(n, "wall_thickness_m", f.wall_thickness_m);
+  }
+
+  void read_devices(WorldConfig& c) {
+    const ConfigNode devs = root_["devices"];
+    if (!devs.defined()) return;
+    devs.require_map();
+    remember(devs);
+    if (devs.is_null()) return;
+    for (const std::string& name : devs.keys()) {
+      const ConfigNode d = devs[name];
+      const auto id = device_by_name(name);
+      if (!id) {
+        d.fail("unknown device '" + name + "' (expected one of M1..M10, R1, R2, TST, D1, D2, D3)");
+      }
+      d.require_map();
+      d.check_keys({"x", "y", "ori", "ori_deg", "body_depth_m", "body_width_m", "body_offset_m",
+                    "rfid_offset_m", "rfid_radius_m"});
+      remember(d);
+      DeviceConfig& dev = c.devices[id->value()];
+      read(d, "x", dev.pose.x);
+      read(d, "y", dev.pose.y);
+      read_orientation(d, dev.pose.theta);
+      read(d, "body_depth_m", dev.body_depth_m);
+      read(d, "body_width_m", dev.body_width_m);
+      read(d, "body_offset_m", dev.body_offset_m);
+      read(d, "rfid_offset_m", dev.rfid_offset_m);
+      read(d, "rfid_radius_m", dev.rfid_radius_m);
+    }
+  }
+
+  void read_puck_model(PuckModelConfig& m) {
+    const ConfigNode n =
+        section(root_, "puck",
+                {"radius_m", "mass_kg", "floor_friction", "contact_friction", "restitution"});
+    read(n, "radius_m", m.radius_m);
+    read(n, "mass_kg", m.mass_kg);
+    read(n, "floor_friction", m.floor_friction);
+    read(n, "contact_friction", m.contact_friction);
+    read(n, "restitution", m.restitution);
+  }
+
+  void read_pucks(WorldConfig& c) {
+    const ConfigNode list = root_["pucks"];
+    if (!list.defined()) return;
+    remember(list);
+    c.pucks.clear();  // the list replaces the base's; null or [] means no pucks
+    if (list.is_null()) return;
+    for (const ConfigNode& e : list.elements()) {
+      element(e, {"id", "x", "y"}, "{id, x, y}");
+      PuckPlacement p;
+      e.at("id");  // required keys: fail early with "missing required key"
+      e.at("x");
+      e.at("y");
+      read(e, "id", p.id);
+      read(e, "x", p.position.x());
+      read(e, "y", p.position.y());
+      c.pucks.push_back(p);
+    }
+  }
+
+  void read_robot_model(RobotModelConfig& m) {
+    const ConfigNode n =
+        section(root_, "robot",
+                {"radius_m", "mass_kg", "max_speed_mps", "max_omega_rps", "max_accel_mps2",
+                 "max_alpha_rps2", "contact_friction", "holder"});
+    read(n, "radius_m", m.radius_m);
+    read(n, "mass_kg", m.mass_kg);
+    read(n, "max_speed_mps", m.max_speed_mps);
+    read(n, "max_omega_rps", m.max_omega_rps);
+    read(n, "max_accel_mps2", m.max_accel_mps2);
+    read(n, "max_alpha_rps2", m.max_alpha_rps2);
+    read(n, "contact_friction", m.contact_friction);
+
+    HolderConfig& h = m.holder;
+    const ConfigNode hn = section(n, "holder",
+                                  {"mode", "inner_width_m", "arm_length_m", "arm_thickness_m",
+                                   "arm_friction", "release_backing_speed_mps"});
+    if (const ConfigNode mode = hn["mode"]; mode.defined()) {
+      const std::string s = mode.as_string();
+      if (s == "physical") {
+        h.mode = HolderMode::kPhysical;
+      } else if (s == "assisted") {
+        h.mode = HolderMode::kAssisted;
+      } else {
+        mode.fail("unknown holder mode '" + s + "' (expected one of: physical, assisted)");
+      }
+      remember(mode);
+    }
+    read(hn, "inner_width_m", h.inner_width_m);
+    read(hn, "arm_length_m", h.arm_length_m);
+    read(hn, "arm_thickness_m", h.arm_thickness_m);
+    read(hn, "arm_friction", h.arm_friction);
+    read(hn, "release_backing_speed_mps", h.release_backing_speed_mps);
+  }
+
+  void read_robots(WorldConfig& c) {
+    const ConfigNode list = root_["robots"];
+    if (!list.defined()) return;
+    remember(list);
+    c.robots.clear();  // the list replaces the base's; null or [] means no robots
+    if (list.is_null()) return;
+    for (const ConfigNode& e : list.elements()) {
+      element(e, {"name", "x", "y", "ori", "ori_deg"}, "{name, x, y, ori_deg}");
+      RobotStart r;
+      r.name = e.at("name").as_string();
+      remember(e.at("name"));
+      e.at("x");
+      e.at("y");
+      read(e, "x", r.pose.x);
+      read(e, "y", r.pose.y);
+      read_orientation(e, r.pose.theta);
+      c.robots.push_back(std::move(r));
+    }
+  }
+
+  void read_sensors(SensorsConfig& s) {
+    const ConfigNode n =
+        section(root_, "sensors", {"odometry", "gyro", "ir", "optical", "ground_truth", "laser"});
+
+    const ConfigNode odo = section(n, "odometry",
+                                   {"rate_hz", "trans_noise_per_m", "rot_noise_per_rad",
+                                    "accel_noise_per_mps", "accel_rot_noise_per_rps"});
+    read(odo, "rate_hz", s.odometry.rate_hz);
+    read(odo, "trans_noise_per_m", s.odometry.trans_noise_per_m);
+    read(odo, "rot_noise_per_rad", s.odometry.rot_noise_per_rad);
+    read(odo, "accel_noise_per_mps", s.odometry.accel_noise_per_mps);
+    read(odo, "accel_rot_noise_per_rps", s.odometry.accel_rot_noise_per_rps);
+
+    const ConfigNode gyro = section(n, "gyro", {"rate_hz", "noise_std_rps", "bias_rps"});
+    read(gyro, "rate_hz", s.gyro.rate_hz);
+    read(gyro, "noise_std_rps", s.gyro.noise_std_rps);
+    read(gyro, "bias_rps", s.gyro.bias_rps);
+
+    const ConfigNode ir = section(n, "ir", {"rate_hz", "range_m", "noise_std_m", "threshold_m"});
+    read(ir, "rate_hz", s.ir.rate_hz);
+    read(ir, "range_m", s.ir.range_m);
+    read(ir, "noise_std_m", s.ir.noise_std_m);
+    read(ir, "threshold_m", s.ir.threshold_m);
+
+    const ConfigNode opt = section(n, "optical", {"rate_hz", "range_m", "miss_probability"});
+    read(opt, "rate_hz", s.optical.rate_hz);
+    read(opt, "range_m", s.optical.range_m);
+    read(opt, "miss_probability", s.optical.miss_probability);
+
+    const ConfigNode gt = section(n, "ground_truth", {"rate_hz"});
+    read(gt, "rate_hz", s.ground_truth.rate_hz);
+
+    const ConfigNode las = section(n, "laser",
+                                   {"enabled", "beams", "rate_hz", "min_range_m", "max_range_m",
+                                    "noise_std_m", "mount_x_m", "mount_y_m"});
+    read(las, "enabled", s.laser.enabled);
+    read(las, "beams", s.laser.beams);
+    read(las, "rate_hz", s.laser.rate_hz);
+    read(las, "min_range_m", s.laser.min_range_m);
+    read(las, "max_range_m", s.laser.max_range_m);
+    read(las, "noise_std_m", s.laser.noise_std_m);
+    read(las, "mount_x_m", s.laser.mount_x_m);
+    read(las, "mount_y_m", s.laser.mount_y_m);
+  }
+
+  void read_physics(PhysicsConfig& p) {
+    const ConfigNode n =
+        section(root_, "physics", {"step_ms", "velocity_iterations", "position_iterations"});
+    if (const ConfigNode step = n["step_ms"]; step.defined()) {
+      const double ms = step.as_double();
+      // Checked here too: a huge value would overflow the nanosecond conversion.
+      if (!(ms > 0.0 && ms <= 100.0)) step.fail("must be > 0 and <= 100 (got " + num(ms) + ")");
+      p.step = SimTime::from_seconds(ms / 1000.0);
+      remember(step);
+    }
+    read(n, "velocity_iterations", p.velocity_iterations);
+    read(n, "position_iterations", p.position_iterations);
+  }
+
+  /// The node to report a validate() message at. The message starts with the field path; the
+  /// deepest node read at that path or an ancestor wins. If only an ancestor was read (e.g.
+  /// "devices.M4: footprint overlaps devices.M8" after moving M8), a path named later in the
+  /// message that was read exactly may be closer to the cause and wins if it is deeper. Only
+  /// path-like words (with a '.' or '[') count, so that "the field" does not match `field`.
+  /// Falls back to the document root.
+  const ConfigNode& locate(const std::string& message) const {
+    const std::string prefix = message.substr(0, message.find(": "));
+    const ConfigNode* best = nullptr;
+    std::size_t best_len = 0;
+    for (std::string p = prefix; !p.empty(); p = parent_path(p)) {
+      if (auto it = seen_.find(p); it != seen_.end()) {
+        if (p == prefix) return it->second;
+        best = &it->second;
+        best_len = p.size();
+        break;
+      }
+    }
+    const std::size_t rest = prefix.size();
+    for (const auto& [path, node] : seen_) {
+      if (path.size() <= best_len || path.find_first_of(".[") == std::string::npos) continue;
+      for (auto pos = message.find(path, rest); pos != std::string::npos;
+           pos = message.find(path, pos + 1)) {
+        const bool starts = pos == 0 || (!is_name_char(message[pos - 1]) &&
+                                         message[pos - 1] != '.' && message[pos - 1] != ']');
+        const std::size_t end = pos + path.size();
+        const bool ends = end == message.size() || !is_name_char(message[end]);
+        if (starts && ends) {
+          best = &node;
+          best_len = path.size();
+          break;
+        }
+      }
+    }
+    return best ? *best : root_;
+  }
+
+  ConfigNode root_;
+  std::map<std::string, ConfigNode> seen_;
+};
+
+}  // namespace
+
+WorldConfig load_world_config(const core::ConfigNode& node, WorldConfig base) {
+  if (!node.defined() || node.is_null()) {
+    // An empty document: the base unchanged (still checked, it may come from elsewhere).
+    try {
+      base.validate();
+    } catch (const ConfigError& e) {
+      throw ConfigError(node.location() + ": " + e.what());
+    }
+    return base;
+  }
+  return Loader(node).load(std::move(base));
+}
+
+WorldConfig load_world_config_file(const std::string& path) {
+  return load_world_config(core::ConfigNode::load_file(path));
+}
+
+}  // namespace llsf::kinematic
