@@ -52,13 +52,15 @@ double median_of(int repeats, const std::function<double()>& body) {
 int main(int argc, char** argv) {
   using llsf::bench::registry;
   if (argc > 1 && (std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0)) {
-    std::printf("usage: llsf-bench [--list] [NAME...]\n"
-                "Runs the named benchmarks (all when none is named); prints one JSON object\n"
-                "per result: {\"bench\", \"metric\", \"value\", \"unit\"}. Values are medians.\n");
+    std::printf(
+        "usage: llsf-bench [--list] [NAME...]\n"
+        "Runs the named benchmarks (all when none is named); prints one JSON object\n"
+        "per result: {\"bench\", \"metric\", \"value\", \"unit\"}. Values are medians.\n");
     return 0;
   }
   if (argc > 1 && std::strcmp(argv[1], "--list") == 0) {
-    for (const auto& [name, e] : registry()) std::printf("%-16s %s\n", name.c_str(), e.description.c_str());
+    for (const auto& [name, e] : registry())
+      std::printf("%-16s %s\n", name.c_str(), e.description.c_str());
     return 0;
   }
   std::vector<std::string> names;

@@ -26,8 +26,8 @@ struct Registration {
 }  // namespace llsf::bench
 
 /// Registers a benchmark function `void fn()` under `name` (static initialisation).
-#define LLSF_BENCH(name, description)                                                \
-  static void llsf_bench_##name();                                                   \
-  static ::llsf::bench::Registration llsf_bench_reg_##name(#name, description,       \
-                                                           &llsf_bench_##name);      \
+#define LLSF_BENCH(name, description)                                           \
+  static void llsf_bench_##name();                                              \
+  static ::llsf::bench::Registration llsf_bench_reg_##name(#name, description,  \
+                                                           &llsf_bench_##name); \
   static void llsf_bench_##name()

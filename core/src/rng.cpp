@@ -34,9 +34,7 @@ std::uint64_t RandomStream::next_u64() {
   return result;
 }
 
-double RandomStream::uniform01() {
-  return static_cast<double>(next_u64() >> 11) * 0x1.0p-53;
-}
+double RandomStream::uniform01() { return static_cast<double>(next_u64() >> 11) * 0x1.0p-53; }
 
 std::int64_t RandomStream::uniform_int(std::int64_t lo, std::int64_t hi) {
   LLSF_DEMAND(lo <= hi);

@@ -2,8 +2,8 @@
 // llsf-world-demo: the kinematic world on its own. Three robots drive scripted waypoints on the
 // 2013 field; robot1 pushes puck 16 from the input storage under M1's RFID reader. Prints the
 // world's events and the final state hash (equal seeds give equal hashes).
-#include <CLI/CLI.hpp>
 #include <fmt/core.h>
+#include <CLI/CLI.hpp>
 
 #include <cstdio>
 
@@ -16,9 +16,12 @@ using namespace llsf::kinematic;
 namespace {
 const char* collision_name(CollisionKind k) {
   switch (k) {
-    case CollisionKind::kRobotRobot: return "robot";
-    case CollisionKind::kRobotWall: return "wall";
-    case CollisionKind::kRobotDevice: return "device";
+    case CollisionKind::kRobotRobot:
+      return "robot";
+    case CollisionKind::kRobotWall:
+      return "wall";
+    case CollisionKind::kRobotDevice:
+      return "device";
   }
   return "?";
 }
@@ -46,8 +49,8 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   try {
-    WorldConfig cfg = config_path.empty() ? WorldConfig::default_2013()
-                                          : load_world_config_file(config_path);
+    WorldConfig cfg =
+        config_path.empty() ? WorldConfig::default_2013() : load_world_config_file(config_path);
     if (!holder.empty())
       cfg.robot.holder.mode = holder == "physical" ? HolderMode::kPhysical : HolderMode::kAssisted;
     DemoScene scene(cfg, seed, /*patrol_forever=*/false);

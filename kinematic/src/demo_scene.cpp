@@ -23,12 +23,12 @@ DemoMission demo_mission_route() {
   // Headings follow the direction of travel: an assisted holder lets its puck go when the
   // robot backs away, so a robot carrying a puck never drives backwards.
   m.route = {
-      wp(0.90, 0.40, 0.0),                   // leave the insertion area
+      wp(0.90, 0.40, 0.0),  // leave the insertion area
       wp(0.90, 2.40, kPi / 2),
-      wp(0.80, 2.85, kPi),                   // in front of the storage, facing it
-      wp(0.62, 2.85, kPi, 0.3, 0.005),       // line up with puck 16 at (0.28, 2.85)
-      wp(0.50, 2.85, kPi, 0.15, 0.005),      // the puck slides into the holder
-      wp(0.50, 2.85, -0.6, 0.5),             // turn towards the field with the puck
+      wp(0.80, 2.85, kPi),               // in front of the storage, facing it
+      wp(0.62, 2.85, kPi, 0.3, 0.005),   // line up with puck 16 at (0.28, 2.85)
+      wp(0.50, 2.85, kPi, 0.15, 0.005),  // the puck slides into the holder
+      wp(0.50, 2.85, -0.6, 0.5),         // turn towards the field with the puck
       wp(0.90, 2.60, -0.6, 0.6),
       wp(2.24, 2.24, -kPi / 2, 0.6),
       wp(2.24, 1.12, -kPi / 4, 0.6),
@@ -47,8 +47,8 @@ std::vector<Waypoint> demo_patrol_route(int which) {
     return {wp(1.12, 1.30, kPi / 2), wp(1.12, 4.48, 0.0), wp(3.36, 4.48, -kPi / 2),
             wp(3.36, 3.36, kPi), wp(1.12, 3.36, kPi / 2)};
   }
-  return {wp(1.12, 1.80, kPi / 2), wp(1.12, 2.24, 0.0), wp(3.36, 2.24, -kPi / 2),
-          wp(3.36, 1.12, kPi), wp(2.24, 1.12, kPi / 2), wp(2.24, 2.24, kPi)};
+  return {wp(1.12, 1.80, kPi / 2), wp(1.12, 2.24, 0.0),     wp(3.36, 2.24, -kPi / 2),
+          wp(3.36, 1.12, kPi),     wp(2.24, 1.12, kPi / 2), wp(2.24, 2.24, kPi)};
 }
 
 DemoScene::DemoScene(const WorldConfig& config, std::uint64_t seed, bool patrol_forever)
@@ -71,7 +71,8 @@ const WorldEvents& DemoScene::step() {
     if (now < starts_[i]) continue;
     if (drivers_[i].done() && loop_) {
       // Loop: patrols restart; robot1 patrols once its mission is over.
-      drivers_[i] = ScriptedDriver(i == 0 ? demo_patrol_route(1) : routes_[i], world_->config().robot);
+      drivers_[i] =
+          ScriptedDriver(i == 0 ? demo_patrol_route(1) : routes_[i], world_->config().robot);
     }
     world_->set_command(id, drivers_[i].update(world_->robot_pose(id)));
   }

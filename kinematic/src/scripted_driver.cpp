@@ -22,8 +22,8 @@ MotorCommand ScriptedDriver::update(const Pose2D& pose) {
     // Speed that still allows stopping at the waypoint (v^2 = 2 a d), with a small P term
     // for the last centimetres.
     const double a = 0.8 * model_.max_accel_mps2;
-    const double v = std::min({w.max_speed_mps, model_.max_speed_mps, std::sqrt(2.0 * a * dist),
-                               3.0 * dist});
+    const double v =
+        std::min({w.max_speed_mps, model_.max_speed_mps, std::sqrt(2.0 * a * dist), 3.0 * dist});
     const double al = 0.8 * model_.max_alpha_rps2;
     const double om = std::copysign(
         std::min({model_.max_omega_rps, std::sqrt(2.0 * al * std::abs(dth)), 4.0 * std::abs(dth)}),

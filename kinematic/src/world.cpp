@@ -38,7 +38,13 @@ constexpr std::uint16_t kCatHolder = 0x8;
 constexpr std::uint16_t kCatPuck = 0x10;
 
 // Fixture user data: what a fixture belongs to, packed as (kind << 24) | index.
-enum class Owner : std::uintptr_t { kWall = 1, kDevice = 2, kRobotBody = 3, kRobotHolder = 4, kPuck = 5 };
+enum class Owner : std::uintptr_t {
+  kWall = 1,
+  kDevice = 2,
+  kRobotBody = 3,
+  kRobotHolder = 4,
+  kPuck = 5
+};
 std::uintptr_t tag(Owner o, int index) {
   return (static_cast<std::uintptr_t>(o) << 24) | static_cast<std::uintptr_t>(index);
 }
@@ -78,8 +84,8 @@ struct World::Impl : public b2ContactListener {
   struct Robot {
     std::string name;
     b2Body* body = nullptr;
-    MotorCommand command;       // as given, robot frame
-    Vec2 wheel_v{0.0, 0.0};     // after clamping and ramping, robot frame
+    MotorCommand command;    // as given, robot frame
+    Vec2 wheel_v{0.0, 0.0};  // after clamping and ramping, robot frame
     double wheel_omega = 0.0;
     b2Joint* hold_joint = nullptr;  // assisted holder's grip
     int held_puck = -1;             // puck index while gripped
@@ -96,7 +102,7 @@ struct World::Impl : public b2ContactListener {
   struct Puck {
     PuckId id;
     b2Body* body = nullptr;
-    int zone = -1;       // device index or -1
+    int zone = -1;  // device index or -1
     bool removed = false;
   };
 
@@ -148,7 +154,8 @@ struct World::Impl : public b2ContactListener {
     const double w = cfg.field.width_m, h = cfg.field.height_m, t = cfg.field.wall_thickness_m;
     auto wall = [&](double cx, double cy, double hx, double hy) {
       b2PolygonShape s;
-      s.SetAsBox(static_cast<float>(hx - kSkin), static_cast<float>(hy - kSkin), to_b2({cx, cy}), 0.0f);
+      s.SetAsBox(static_cast<float>(hx - kSkin), static_cast<float>(hy - kSkin), to_b2({cx, cy}),
+                 0.0f);
       b2FixtureDef fd;
       fd.shape = &s;
       fd.friction = 0.3f;
@@ -240,13 +247,15 @@ struct World::Impl : public b2ContactListener {
   }
 
   void add_puck(PuckId id, const Vec2& pos) {
-    if (id.value() <= 0) throw core::ConfigError("puck id must be > 0 (got " + std::to_string(id.value()) + ")");
-    if (puck_index.count(id.value())) throw core::ConfigError("puck " + std::to_string(id.value()) + " already exists");
+    if (id.value() <= 0)
+      throw core::ConfigError("puck id must be > 0 (got " + std::to_string(id.value()) + ")");
+    if (puck_index.count(id.value()))
+      throw core::ConfigError("puck " + std::to_string(id.value()) + " already exists");
     const PuckModelConfig& m = cfg.puck;
     b2BodyDef def;
     def.type = b2_dynamicBody;
     def.position = to_b2(pos);
-    def.linearDamping = 0.5f;   // air/rolling losses on top of Coulomb floor friction
+    def.linearDamping = 0.5f;  // air/rolling losses on top of Coulomb floor friction
     def.angularDamping = 2.0f;
     Puck p;
     p.id = id;
@@ -267,7 +276,8 @@ struct World::Impl : public b2ContactListener {
     b2FrictionJointDef fj;
     fj.Initialize(ground, p.body, p.body->GetWorldCenter());
     fj.maxForce = static_cast<float>(m.floor_friction * m.mass_kg * kGravity);
-    fj.maxTorque = static_cast<float>(m.floor_friction * m.mass_kg * kGravity * m.radius_m * 2.0 / 3.0);
+    fj.maxTorque =
+        static_cast<float>(m.floor_friction * m.mass_kg * kGravity * m.radius_m * 2.0 / 3.0);
     world.CreateJoint(&fj);
     p.zone = -1;
     pucks.push_back(p);
@@ -310,15 +320,21 @@ struct World::Impl : public b2ContactListener {
     e.time = now;
     e.robot = RobotId(index_of(a));
     switch (owner_of(b)) {
-      case Owner::kWall: e.kind = CollisionKind::kRobotWall; break;
-      case Owner::kDevice: e.kind = CollisionKind::kRobotDevice; e.device = DeviceId(index_of(b)); break;
+      case Owner::kWall:
+        e.kind = CollisionKind::kRobotWall;
+        break;
+      case Owner::kDevice:
+        e.kind = CollisionKind::kRobotDevice;
+        e.device = DeviceId(index_of(b));
+        break;
       case Owner::kRobotBody:
       case Owner::kRobotHolder:
         e.kind = CollisionKind::kRobotRobot;
         e.other_robot = RobotId(index_of(b));
         if (e.other_robot < e.robot) std::swap(e.robot, e.other_robot);
         break;
-      default: return;  // pucks are pushed, not collided with
+      default:
+        return;  // pucks are pushed, not collided with
     }
     for (const CollisionEvent& o : events.collisions) {
       if (o.kind == e.kind && o.robot == e.robot && o.other_robot == e.other_robot &&
@@ -341,7 +357,8 @@ struct World::Impl : public b2ContactListener {
       Vec2 target(r.command.vx_mps, r.command.vy_mps);
       const double speed = target.norm();
       if (speed > m.max_speed_mps) target *= m.max_speed_mps / speed;
-      const double omega_target = std::clamp(r.command.omega_rps, -m.max_omega_rps, m.max_omega_rps);
+      const double omega_target =
+          std::clamp(r.command.omega_rps, -m.max_omega_rps, m.max_omega_rps);
       const Vec2 prev_v = r.wheel_v;
       const double prev_omega = r.wheel_omega;
       r.wheel_v = ramp(r.wheel_v, target, m.max_accel_mps2 * h);
@@ -475,15 +492,17 @@ struct World::Impl : public b2ContactListener {
       const OdometryConfig& oc = sc.odometry;
       const double st = std::sqrt(oc.trans_noise_per_m * oc.trans_noise_per_m * r.odom_dist +
                                   oc.accel_noise_per_mps * oc.accel_noise_per_mps * r.odom_dv);
-      const double sr = std::sqrt(oc.rot_noise_per_rad * oc.rot_noise_per_rad * r.odom_rot +
-                                  oc.accel_rot_noise_per_rps * oc.accel_rot_noise_per_rps * r.odom_domega);
+      const double sr =
+          std::sqrt(oc.rot_noise_per_rad * oc.rot_noise_per_rad * r.odom_rot +
+                    oc.accel_rot_noise_per_rps * oc.accel_rot_noise_per_rps * r.odom_domega);
       if (st > 0.0) {
         const Vec2 e(r.odom_rng.normal(0.0, st), r.odom_rng.normal(0.0, st));
         const Vec2 ew = core::rotate(e, r.odom_pose.theta);
         r.odom_pose.x += ew.x();
         r.odom_pose.y += ew.y();
       }
-      if (sr > 0.0) r.odom_pose.theta = core::normalize_angle(r.odom_pose.theta + r.odom_rng.normal(0.0, sr));
+      if (sr > 0.0)
+        r.odom_pose.theta = core::normalize_angle(r.odom_pose.theta + r.odom_rng.normal(0.0, sr));
       r.odom_dist = r.odom_rot = r.odom_dv = r.odom_domega = 0.0;
       s.odometry.stamp = now;
       ++s.odometry.seq;
@@ -494,7 +513,8 @@ struct World::Impl : public b2ContactListener {
     }
     if (r.gyro_s.due(now)) {
       const GyroConfig& gc = sc.gyro;
-      const double rate = r.body->GetAngularVelocity() + gc.bias_rps + r.gyro_rng.normal(0.0, gc.noise_std_rps);
+      const double rate =
+          r.body->GetAngularVelocity() + gc.bias_rps + r.gyro_rng.normal(0.0, gc.noise_std_rps);
       r.gyro_yaw = core::normalize_angle(r.gyro_yaw + rate * (now - r.gyro_last).seconds());
       r.gyro_last = now;
       s.gyro.stamp = now;
@@ -642,7 +662,8 @@ std::vector<PuckId> World::pucks_in_zone(DeviceId device) const {
 }
 void World::add_puck(PuckId puck, const Vec2& position) {
   const auto& f = impl_->cfg.field;
-  if (!(position.x() > 0 && position.y() > 0 && position.x() < f.width_m && position.y() < f.height_m))
+  if (!(position.x() > 0 && position.y() > 0 && position.x() < f.width_m &&
+        position.y() < f.height_m))
     throw core::ConfigError("add_puck: position outside the field");
   if (has_puck(puck) || impl_->puck_index.count(puck.value()))
     throw core::ConfigError("add_puck: puck " + std::to_string(puck.value()) + " already exists");

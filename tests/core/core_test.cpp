@@ -192,8 +192,8 @@ TEST_CASE("config nodes report file, line and path") {
                        doctest::Contains("unknown key 'speed'"), ConfigError);
   CHECK_THROWS_WITH_AS(root.at("nothing"), doctest::Contains("missing required key 'nothing'"),
                        ConfigError);
-  CHECK_THROWS_WITH_AS(ConfigNode::parse("a: [1, 2\n", "bad.yaml"),
-                       doctest::Contains("bad.yaml:"), ConfigError);
+  CHECK_THROWS_WITH_AS(ConfigNode::parse("a: [1, 2\n", "bad.yaml"), doctest::Contains("bad.yaml:"),
+                       ConfigError);
   CHECK_THROWS_WITH_AS(ConfigNode::load_file("/nonexistent/x.yaml"),
                        doctest::Contains("cannot open"), ConfigError);
   CHECK(root["robot"].keys() == std::vector<std::string>{"radius_m", "name", "speed"});

@@ -30,6 +30,6 @@ TEST_CASE("device geometry follows the facing") {
   CHECK(fp.pose.x == doctest::Approx(1.0));
   CHECK(fp.pose.y == doctest::Approx(0.9));
   CHECK(d.rfid_center().y() == doctest::Approx(1.14));
-  CHECK(fp.contains({1.14, 0.9}));   // width runs along x when facing +y
+  CHECK(fp.contains({1.14, 0.9}));  // width runs along x when facing +y
   CHECK_FALSE(fp.contains({1.0, 1.05}));
 }

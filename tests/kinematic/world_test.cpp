@@ -52,13 +52,13 @@ TEST_CASE("commanded velocities are reached within the limits") {
     w.step();
     const MotorCommand v = w.robot_wheel_velocity(r);
     const double speed = std::hypot(v.vx_mps, v.vy_mps);
-    CHECK(speed - prev_speed <= 1.0 * dt + 1e-9);       // 1 m/s^2
+    CHECK(speed - prev_speed <= 1.0 * dt + 1e-9);        // 1 m/s^2
     CHECK(v.omega_rps - prev_omega <= 4.0 * dt + 1e-9);  // 4 rad/s^2
     prev_speed = speed;
     prev_omega = v.omega_rps;
   }
   CHECK(prev_speed == doctest::Approx(0.5).epsilon(0.01));  // after 0.5 s at 1 m/s^2
-  w.set_command(r, {0.0, 3.0, -5.0});  // sideways, other way round
+  w.set_command(r, {0.0, 3.0, -5.0});                       // sideways, other way round
   run(w, 2.0);
   const MotorCommand v = w.robot_wheel_velocity(r);
   CHECK(v.vx_mps == doctest::Approx(0.0));
@@ -137,7 +137,8 @@ TEST_CASE("a robot pushes a puck from the storage into M1's RFID zone and away a
   CHECK_FALSE(scene.world().puck_zone(kDemoPuck));
   // Every other puck is still in the input storage.
   for (PuckId p : scene.world().pucks())
-    if (p != kDemoPuck) CHECK(scene.world().config().field.input_storage.contains(scene.world().puck_position(p)));
+    if (p != kDemoPuck)
+      CHECK(scene.world().config().field.input_storage.contains(scene.world().puck_position(p)));
 }
 
 TEST_CASE("RFID zones report pucks added, moved and removed by the referee") {
@@ -223,14 +224,15 @@ TEST_CASE("odometry drifts, more with acceleration, and counts while pushing a w
     smooth += drive(100 + s, false) / n;
     bursty += drive(100 + s, true) / n;
   }
-  CHECK(smooth > 0.002);        // odometry is not ground truth
+  CHECK(smooth > 0.002);         // odometry is not ground truth
   CHECK(bursty > 1.5 * smooth);  // and its error grows with acceleration
   MESSAGE("mean odometry error smooth ", smooth, " m, in bursts ", bursty, " m");
 
   World w(empty_field({{"r", {1.0, 4.6, kPi}}}), core::Rng(3));
   w.set_command(RobotId(0), {0.5, 0.0, 0.0});
   run(w, 6.0);  // the holder's arm tips reach the wall after ~1.5 s, then it pushes
-  CHECK(w.robot_pose(RobotId(0)).x < w.config().robot.radius_m + w.config().robot.holder.arm_length_m + 0.01);
+  CHECK(w.robot_pose(RobotId(0)).x <
+        w.config().robot.radius_m + w.config().robot.holder.arm_length_m + 0.01);
   CHECK(w.sensors(RobotId(0)).odometry.pose.x < -1.0);  // the wheels kept turning
 }
 
@@ -295,8 +297,8 @@ TEST_CASE("the optical sensors fire near the R1 corner walls") {
     c.sensors.optical.range_m = range;
     // Arm tips 5 cm in front of the plate, shifted `offset` towards the right wall.
     const double tip = c.robot.radius_m + c.robot.holder.arm_length_m;
-    const Vec2 p = r1.pose.position() + (0.5 * r1.body_depth_m + 0.05 + tip) * facing +
-                   offset * lateral;
+    const Vec2 p =
+        r1.pose.position() + (0.5 * r1.body_depth_m + 0.05 + tip) * facing + offset * lateral;
     c.robots = {{"r", {p.x(), p.y(), core::normalize_angle(r1.pose.theta + kPi)}}};
     World w(c, core::Rng(1));
     run(w, 0.1);

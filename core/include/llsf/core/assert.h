@@ -21,13 +21,14 @@ namespace detail {
 }  // namespace llsf::core
 
 /// Always-on check of an invariant; throws llsf::core::AssertionError naming file and line.
-#define LLSF_DEMAND(cond)                                                             \
-  ((cond) ? static_cast<void>(0)                                                      \
+#define LLSF_DEMAND(cond)        \
+  ((cond) ? static_cast<void>(0) \
           : ::llsf::core::detail::demand_failed(#cond, __FILE__, __LINE__, std::string()))
 
 /// LLSF_DEMAND with an explanatory message (any expression convertible to std::string).
 #define LLSF_DEMAND_MSG(cond, msg) \
-  ((cond) ? static_cast<void>(0) : ::llsf::core::detail::demand_failed(#cond, __FILE__, __LINE__, (msg)))
+  ((cond) ? static_cast<void>(0)   \
+          : ::llsf::core::detail::demand_failed(#cond, __FILE__, __LINE__, (msg)))
 
 #if !defined(NDEBUG) || defined(LLSF_ENABLE_ASSERTS)
 /// Debug-only check (on without NDEBUG or with LLSF_ENABLE_ASSERTS); free in Release builds.

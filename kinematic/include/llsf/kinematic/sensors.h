@@ -16,7 +16,7 @@ struct OdometryReading {
   core::SimTime stamp;
   std::int64_t seq = 0;  ///< increments with every new reading; 0 = none yet
   core::Pose2D pose;
-  double vx_mps = 0.0;   ///< commanded wheel velocity, robot frame
+  double vx_mps = 0.0;  ///< commanded wheel velocity, robot frame
   double vy_mps = 0.0;
   double omega_rps = 0.0;
 };
@@ -33,7 +33,7 @@ struct GyroReading {
 struct IrReading {
   core::SimTime stamp;
   std::int64_t seq = 0;
-  double distance_m = 0.0;   ///< from the body front to the puck; the range when nothing is there
+  double distance_m = 0.0;  ///< from the body front to the puck; the range when nothing is there
   bool puck_detected = false;
 };
 

@@ -32,8 +32,8 @@ using core::Vec2;
 inline constexpr int kDeviceCount = 16;
 /// Device names in DeviceId order (DeviceId(i) is kDeviceNames[i]).
 inline constexpr std::array<std::string_view, kDeviceCount> kDeviceNames = {
-    "M1", "M2", "M3", "M4", "M5", "M6", "M7", "M8", "M9", "M10",
-    "R1", "R2", "TST", "D1", "D2", "D3"};
+    "M1", "M2",  "M3", "M4", "M5",  "M6", "M7", "M8",
+    "M9", "M10", "R1", "R2", "TST", "D1", "D2", "D3"};
 
 enum class DeviceKind { kProduction, kRecycling, kTest, kDelivery };
 
@@ -55,9 +55,9 @@ struct Rect {
 
 /// The arena: size, walls and the marked areas of the left and right strips.
 struct FieldConfig {
-  double width_m = 5.6;           ///< x extent; origin is the bottom-left corner
-  double height_m = 5.6;          ///< y extent
-  double wall_thickness_m = 0.05; ///< boards stand outside [0, width] x [0, height]
+  double width_m = 5.6;                          ///< x extent; origin is the bottom-left corner
+  double height_m = 5.6;                         ///< y extent
+  double wall_thickness_m = 0.05;                ///< boards stand outside [0, width] x [0, height]
   Rect insertion_area{{0.0, 0.0}, {0.4, 2.3}};   ///< robots start here (RB drawing)
   Rect input_storage{{0.0, 2.3}, {0.4, 3.3}};    ///< the 20 S0 pucks at game start
   Rect late_order_area{{0.0, 3.3}, {0.4, 3.9}};  ///< above the storage
@@ -84,10 +84,10 @@ struct DeviceConfig {
 
 /// The puck model (an ice-hockey puck with an RFID tag on top).
 struct PuckModelConfig {
-  double radius_m = 0.0375;         ///< RB: diameter 7.5 cm
-  double mass_kg = 0.16;            ///< a standard ice-hockey puck (assumption)
-  double floor_friction = 0.25;     ///< Coulomb coefficient puck/floor: sliding decel = mu * g
-  double contact_friction = 0.2;    ///< puck against robots, devices, walls and other pucks
+  double radius_m = 0.0375;       ///< RB: diameter 7.5 cm
+  double mass_kg = 0.16;          ///< a standard ice-hockey puck (assumption)
+  double floor_friction = 0.25;   ///< Coulomb coefficient puck/floor: sliding decel = mu * g
+  double contact_friction = 0.2;  ///< puck against robots, devices, walls and other pucks
   double restitution = 0.1;
 };
 
@@ -106,22 +106,22 @@ enum class HolderMode {
 /// The passive holder: two arms left and right of the puck pocket at the robot's front.
 struct HolderConfig {
   HolderMode mode = HolderMode::kAssisted;
-  double inner_width_m = 0.09;     ///< gap between the arms (puck diameter 0.075 m)
-  double arm_length_m = 0.065;     ///< arms reach this far beyond the body's front (RB: <= 0.15)
+  double inner_width_m = 0.09;  ///< gap between the arms (puck diameter 0.075 m)
+  double arm_length_m = 0.065;  ///< arms reach this far beyond the body's front (RB: <= 0.15)
   double arm_thickness_m = 0.01;
-  double arm_friction = 0.05;      ///< puck against the arms (smooth plastic, assumption)
+  double arm_friction = 0.05;  ///< puck against the arms (smooth plastic, assumption)
   /// Assisted mode lets the puck go once the commanded backward speed exceeds this.
   double release_backing_speed_mps = 0.02;
 };
 
 /// The Robotino model shared by every robot.
 struct RobotModelConfig {
-  double radius_m = 0.185;               ///< thesis: diameter 37 cm
-  double mass_kg = 20.0;                 ///< heavy, so that pucks do not stop it
-  double max_speed_mps = 1.0;            ///< translational speed limit (2013 robots)
-  double max_omega_rps = 2.0;            ///< rotational speed limit
-  double max_accel_mps2 = 1.0;           ///< translational acceleration limit
-  double max_alpha_rps2 = 4.0;           ///< rotational acceleration limit (assumption)
+  double radius_m = 0.185;      ///< thesis: diameter 37 cm
+  double mass_kg = 20.0;        ///< heavy, so that pucks do not stop it
+  double max_speed_mps = 1.0;   ///< translational speed limit (2013 robots)
+  double max_omega_rps = 2.0;   ///< rotational speed limit
+  double max_accel_mps2 = 1.0;  ///< translational acceleration limit
+  double max_alpha_rps2 = 4.0;  ///< rotational acceleration limit (assumption)
   double contact_friction = 0.3;
   HolderConfig holder;
 };
@@ -136,10 +136,12 @@ struct RobotStart {
 /// pushes against an obstacle) with an error that grows with distance, rotation and acceleration.
 struct OdometryConfig {
   double rate_hz = 50.0;
-  double trans_noise_per_m = 0.01;      ///< std of the translation error per metre driven
-  double rot_noise_per_rad = 0.01;      ///< std of the heading error per radian turned
-  double accel_noise_per_mps = 0.02;    ///< std of the translation error per m/s of velocity change
-  double accel_rot_noise_per_rps = 0.01;///< std of the heading error per rad/s of omega change
+  // Each std is the one reached after 1 unit; the error grows with the square root of the
+  // distance / rotation / accumulated velocity change (a random walk, independent of rate_hz).
+  double trans_noise_per_m = 0.01;        ///< translation error std after 1 m driven
+  double rot_noise_per_rad = 0.01;        ///< heading error std after 1 rad turned
+  double accel_noise_per_mps = 0.02;      ///< translation error std after 1 m/s of velocity change
+  double accel_rot_noise_per_rps = 0.01;  ///< heading error std after 1 rad/s of omega change
 };
 
 /// Gyroscope: true yaw rate with Gaussian noise and a constant bias, and its integral.
@@ -152,9 +154,9 @@ struct GyroConfig {
 /// Infrared distance sensor looking into the puck pocket from the robot's front.
 struct IrConfig {
   double rate_hz = 30.0;
-  double range_m = 0.10;        ///< readings beyond this report range_m
+  double range_m = 0.10;  ///< readings beyond this report range_m
   double noise_std_m = 0.002;
-  double threshold_m = 0.02;    ///< puck detected when the reading is below this
+  double threshold_m = 0.02;  ///< puck detected when the reading is below this
 };
 
 /// The two digital optical sensors at the holder arm tips, looking forward.
@@ -163,7 +165,7 @@ struct OpticalConfig {
   /// Trigger distance. The thesis' real sensors reached the corner walls beside R1/R2 (its
   /// recycling-corner problem); 0.30 m reproduces that, a short range hides the walls.
   double range_m = 0.30;
-  double miss_probability = 0.0;///< chance that a triggered sensor reports false
+  double miss_probability = 0.0;  ///< chance that a triggered sensor reports false
 };
 
 /// Ground-truth pose, for the `ground_truth` localization level.
@@ -175,11 +177,11 @@ struct GroundTruthConfig {
 struct LaserConfig {
   bool enabled = true;
   int beams = 360;
-  double rate_hz = 5.0;         ///< thesis: 5 Hz in simulation
+  double rate_hz = 5.0;  ///< thesis: 5 Hz in simulation
   double min_range_m = 0.02;
   double max_range_m = 5.6;
   double noise_std_m = 0.01;
-  double mount_x_m = 0.0;       ///< sensor position in the robot frame
+  double mount_x_m = 0.0;  ///< sensor position in the robot frame
   double mount_y_m = 0.0;
 };
 
