@@ -76,7 +76,6 @@ int main(int argc, char** argv) {
                          ? world.config().robots[e.other_robot.value()].name
                          : std::string());
       }
-      if (scene.done() && world.time() >= end) break;
     }
     fmt::print("simulated {:.2f} s in {} steps; {} RFID events, {} collisions\n",
                world.time().seconds(), world.time() / world.config().physics.step, rfid_events,
