@@ -1,0 +1,252 @@
+// SPDX-License-Identifier: MIT
+// HubConfig::validate() and the YAML loader (docs/comm.md).
+#include "llsf/comm/hub_config.h"
+
+#include <cmath>
+#include <cstdio>
+#include <set>
+
+#include "llsf/comm/frame.h"
+#include "llsf/core/error.h"
+
+namespace llsf::comm {
+
+using core::ConfigError;
+using core::ConfigNode;
+
+const char* loss_model_name(LossModel m) {
+  switch (m) {
+    case LossModel::kNone:
+      return "none";
+    case LossModel::kGlobal:
+      return "global";
+    case LossModel::kPerLink:
+      return "per_link";
+    case LossModel::kBurst:
+      return "burst";
+  }
+  return "?";
+}
+
+namespace {
+
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+[[noreturn]] void fail(const std::string& path, const std::string& reason) {
+  throw ConfigError(path + ": " + reason);
+}
+
+void require_probability(const std::string& path, double p) {
+  if (!(p >= 0.0 && p <= 1.0)) fail(path, "must be in [0, 1] (got " + num(p) + ")");
+}
+
+void require_non_negative(const std::string& path, SimTime t) {
+  if (t.ns() < 0) fail(path, "must be >= 0 (got " + num(t.seconds() * 1e3) + " ms)");
+}
+
+/// In the burst model a link with long-run loss p and mean burst length L enters the bad state
+/// with probability p / (1 - p) / L per copy, which must not exceed 1.
+void require_burst_feasible(const std::string& path, double p, double mean_burst) {
+  if (p > mean_burst / (mean_burst + 1.0)) {
+    fail(path, "a long-run loss of " + num(p) + " is impossible with mean_burst_length " +
+                   num(mean_burst) +
+                   " (at most L / (L + 1) = " + num(mean_burst / (mean_burst + 1.0)) + ")");
+  }
+}
+
+std::string indexed(const char* list, std::size_t i) {
+  return std::string(list) + "[" + std::to_string(i) + "]";
+}
+
+}  // namespace
+
+void HubConfig::validate() const {
+  require_probability("loss.probability", loss_probability);
+  if (!(mean_burst_length >= 1.0) || !std::isfinite(mean_burst_length)) {
+    fail("loss.mean_burst_length", "must be >= 1 (got " + num(mean_burst_length) + ")");
+  }
+  if (loss_model == LossModel::kBurst) {
+    require_burst_feasible("loss.probability", loss_probability, mean_burst_length);
+  }
+  require_non_negative("delay.fixed_ms", delay.fixed);
+  require_non_negative("delay.jitter_ms", delay.jitter);
+  if (max_frame_bytes < kHeaderSize || max_frame_bytes > 65507) {
+    fail("max_frame_bytes", "must be in [8, 65507] (got " + std::to_string(max_frame_bytes) + ")");
+  }
+  for (std::size_t i = 0; i < links.size(); ++i) {
+    const LinkConfig& l = links[i];
+    const std::string p = indexed("links", i);
+    if (l.from.empty()) fail(p + ".from", "must name a peer");
+    if (l.to.empty()) fail(p + ".to", "must name a peer");
+    if (l.from == l.to) fail(p + ".to", "must differ from 'from' (" + l.from + ")");
+    if (l.loss_probability) {
+      if (loss_model != LossModel::kPerLink && loss_model != LossModel::kBurst) {
+        fail(p + ".loss_probability", std::string("is only used with loss.model per_link or "
+                                                  "burst (model is ") +
+                                          loss_model_name(loss_model) + ")");
+      }
+      require_probability(p + ".loss_probability", *l.loss_probability);
+      if (loss_model == LossModel::kBurst) {
+        require_burst_feasible(p + ".loss_probability", *l.loss_probability, mean_burst_length);
+      }
+    }
+    if (l.delay_fixed) require_non_negative(p + ".fixed_ms", *l.delay_fixed);
+    if (l.delay_jitter) require_non_negative(p + ".jitter_ms", *l.delay_jitter);
+  }
+  for (std::size_t i = 0; i < outages.size(); ++i) {
+    const OutageConfig& o = outages[i];
+    const std::string p = indexed("outages", i);
+    if (o.peer.empty()) fail(p + ".peer", "must name a peer");
+    if (o.other == o.peer) fail(p + ".other", "must differ from 'peer' (" + o.peer + ")");
+    if (o.from.ns() < 0) fail(p + ".from_s", "must be >= 0");
+    if (!(o.until > o.from)) fail(p + ".until_s", "must be after from_s");
+  }
+}
+
+void HubConfig::validate_peer_names(const std::vector<std::string>& peer_names) const {
+  const std::set<std::string> known(peer_names.begin(), peer_names.end());
+  const auto check = [&](const std::string& path, const std::string& name) {
+    if (!name.empty() && !known.count(name)) fail(path, "no peer is called '" + name + "'");
+  };
+  for (std::size_t i = 0; i < links.size(); ++i) {
+    check(indexed("links", i) + ".from", links[i].from);
+    check(indexed("links", i) + ".to", links[i].to);
+  }
+  for (std::size_t i = 0; i < outages.size(); ++i) {
+    check(indexed("outages", i) + ".peer", outages[i].peer);
+    check(indexed("outages", i) + ".other", outages[i].other);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// YAML
+// ---------------------------------------------------------------------------------------------
+
+namespace {
+
+void read_ms(const ConfigNode& n, std::string_view key, SimTime& out) {
+  if (!n[key].defined()) return;
+  const double ms = n[key].as_double();
+  if (!std::isfinite(ms)) n[key].fail("expected a finite number of milliseconds");
+  out = SimTime::from_seconds(ms * 1e-3);
+}
+
+void read_s(const ConfigNode& n, std::string_view key, SimTime& out) {
+  if (!n[key].defined()) return;
+  const double s = n[key].as_double();
+  if (!std::isfinite(s)) n[key].fail("expected a finite number of seconds");
+  out = SimTime::from_seconds(s);
+}
+
+LossModel parse_loss_model(const ConfigNode& n) {
+  const std::string s = n.as_string();
+  if (s == "none") return LossModel::kNone;
+  if (s == "global") return LossModel::kGlobal;
+  if (s == "per_link") return LossModel::kPerLink;
+  if (s == "burst") return LossModel::kBurst;
+  n.fail("unknown loss model '" + s + "' (expected none, global, per_link or burst)");
+}
+
+/// The node at the start of a validate() message "a.b[2].c: reason" (or its deepest present
+/// ancestor).
+ConfigNode locate(const ConfigNode& root, const std::string& message) {
+  const std::string path = message.substr(0, message.find(": "));
+  ConfigNode n = root;
+  std::size_t i = 0;
+  while (i < path.size()) {
+    const std::size_t j = path.find_first_of(".[", i);
+    const std::string key = path.substr(i, j == std::string::npos ? std::string::npos : j - i);
+    if (!key.empty()) {
+      const ConfigNode child = n[key];
+      if (!child.defined()) return n;
+      n = child;
+    }
+    if (j == std::string::npos) break;
+    if (path[j] == '[') {
+      const std::size_t close = path.find(']', j);
+      if (close == std::string::npos || !n.is_sequence()) return n;
+      const int index = std::stoi(path.substr(j + 1, close - j - 1));
+      if (index >= n.size()) return n;
+      n = n.at(index);
+      i = close + 1;
+      if (i < path.size() && path[i] == '.') ++i;
+    } else {
+      i = j + 1;
+    }
+  }
+  return n;
+}
+
+}  // namespace
+
+HubConfig load_hub_config(const ConfigNode& node, HubConfig base) {
+  HubConfig c = std::move(base);
+  node.require_map();
+  if (node.is_null()) return c;
+  node.check_keys({"loss", "delay", "links", "outages", "max_frame_bytes", "forward_unregistered"});
+
+  if (const ConfigNode loss = node["loss"]; loss.defined()) {
+    loss.require_map();
+    loss.check_keys({"model", "probability", "mean_burst_length"});
+    if (loss["model"].defined()) c.loss_model = parse_loss_model(loss["model"]);
+    loss.read("probability", c.loss_probability);
+    loss.read("mean_burst_length", c.mean_burst_length);
+  }
+  if (const ConfigNode delay = node["delay"]; delay.defined()) {
+    delay.require_map();
+    delay.check_keys({"fixed_ms", "jitter_ms"});
+    read_ms(delay, "fixed_ms", c.delay.fixed);
+    read_ms(delay, "jitter_ms", c.delay.jitter);
+  }
+  node.read("max_frame_bytes", c.max_frame_bytes);
+  node.read("forward_unregistered", c.forward_unregistered);
+
+  if (const ConfigNode links = node["links"]; links.defined()) {
+    c.links.clear();
+    for (const ConfigNode& l : links.elements()) {
+      l.require_map();
+      l.check_keys({"from", "to", "symmetric", "loss_probability", "fixed_ms", "jitter_ms"});
+      LinkConfig lc;
+      lc.from = l.at("from").as_string();
+      lc.to = l.at("to").as_string();
+      l.read("symmetric", lc.symmetric);
+      if (l["loss_probability"].defined()) lc.loss_probability = l["loss_probability"].as_double();
+      if (l["fixed_ms"].defined()) read_ms(l, "fixed_ms", lc.delay_fixed.emplace());
+      if (l["jitter_ms"].defined()) read_ms(l, "jitter_ms", lc.delay_jitter.emplace());
+      // Ranges are checked by validate(), whose errors are located below.
+      c.links.push_back(lc);
+    }
+  }
+  if (const ConfigNode outages = node["outages"]; outages.defined()) {
+    c.outages.clear();
+    for (const ConfigNode& o : outages.elements()) {
+      o.require_map();
+      o.check_keys({"peer", "other", "from_s", "until_s"});
+      OutageConfig oc;
+      oc.peer = o.at("peer").as_string();
+      o.read("other", oc.other);
+      o.at("from_s");  // both are required
+      o.at("until_s");
+      read_s(o, "from_s", oc.from);
+      read_s(o, "until_s", oc.until);
+      c.outages.push_back(oc);
+    }
+  }
+  try {
+    c.validate();
+  } catch (const ConfigError& e) {
+    // validate() names fields by their YAML paths; point at the deepest node that exists.
+    throw ConfigError(locate(node, e.what()).location() + ": " + e.what());
+  }
+  return c;
+}
+
+HubConfig load_hub_config_file(const std::string& path) {
+  return load_hub_config(ConfigNode::load_file(path));
+}
+
+}  // namespace llsf::comm

@@ -1,0 +1,126 @@
+// SPDX-License-Identifier: MIT
+// StreamServer: accepts controller connections on loopback and speaks the 2013 stream framing.
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <deque>
+#include <map>
+#include <stdexcept>
+
+#include "llsf/comm/stream.h"
+#include "stream_connection.h"
+
+namespace llsf::comm {
+
+namespace asio = boost::asio;
+using asio::ip::tcp;
+using detail::StreamConnection;
+
+struct StreamServer::Impl {
+  asio::io_context io;  // first: destroyed last
+  tcp::acceptor acceptor{io};
+  const MessageRegistry* registry;
+  std::int64_t max_payload;
+  std::map<int, std::shared_ptr<StreamConnection>> open;  ///< by client id
+  std::deque<StreamCounters> counters;                    ///< by client id; stable addresses
+  std::vector<StreamEvent> events;
+
+  Impl(const MessageRegistry& reg, const StreamServerOptions& o)
+      : registry(&reg), max_payload(o.max_payload) {
+    boost::system::error_code ec;
+    const auto address = asio::ip::make_address(o.address, ec);
+    if (ec) throw std::runtime_error("StreamServer: bad address '" + o.address + "'");
+    if (o.port < 0 || o.port > 65535) throw std::runtime_error("StreamServer: bad port");
+    const tcp::endpoint ep(address, static_cast<unsigned short>(o.port));
+    acceptor.open(ep.protocol(), ec);
+    if (!ec) acceptor.set_option(tcp::acceptor::reuse_address(true), ec);
+    if (!ec) acceptor.bind(ep, ec);
+    if (!ec) acceptor.listen(asio::socket_base::max_listen_connections, ec);
+    if (ec) {
+      throw std::runtime_error("StreamServer: cannot listen on " + o.address + ":" +
+                               std::to_string(o.port) + ": " + ec.message());
+    }
+    accept();
+  }
+
+  void accept() {
+    acceptor.async_accept([this](const boost::system::error_code& ec, tcp::socket socket) {
+      if (ec == asio::error::operation_aborted) return;
+      if (!ec) {
+        const int id = static_cast<int>(counters.size());
+        counters.emplace_back();
+        auto conn = std::make_shared<StreamConnection>(
+            std::move(socket), *registry, max_payload, ClientId(id), &counters.back(),
+            [this](StreamEvent&& e) {
+              if (e.kind == StreamEvent::Kind::kDisconnected) open.erase(e.client.value());
+              events.push_back(std::move(e));
+            });
+        open.emplace(id, conn);
+        StreamEvent e;
+        e.kind = StreamEvent::Kind::kConnected;
+        e.client = ClientId(id);
+        events.push_back(std::move(e));
+        conn->start();
+      }
+      accept();
+    });
+  }
+};
+
+StreamServer::StreamServer(const MessageRegistry& registry, StreamServerOptions options)
+    : impl_(std::make_unique<Impl>(registry, options)) {}
+
+StreamServer::~StreamServer() {
+  boost::system::error_code ec;
+  impl_->acceptor.close(ec);
+  // Closing emits events into impl_; take a copy of the list first.
+  const auto open = impl_->open;
+  for (const auto& [id, conn] : open) conn->close();
+}
+
+int StreamServer::port() const {
+  boost::system::error_code ec;
+  const auto ep = impl_->acceptor.local_endpoint(ec);
+  return ec ? -1 : ep.port();
+}
+
+void StreamServer::poll() {
+  impl_->io.restart();
+  impl_->io.poll();
+}
+
+void StreamServer::run_for(std::chrono::milliseconds duration) {
+  impl_->io.restart();
+  impl_->io.run_for(duration);
+}
+
+std::vector<StreamEvent> StreamServer::take_events() {
+  std::vector<StreamEvent> out;
+  out.swap(impl_->events);
+  return out;
+}
+
+bool StreamServer::send(ClientId client, const google::protobuf::Message& message) {
+  const auto it = impl_->open.find(client.value());
+  return it != impl_->open.end() && it->second->send(message);
+}
+
+int StreamServer::broadcast(const google::protobuf::Message& message) {
+  int n = 0;
+  for (const auto& [id, conn] : impl_->open) n += conn->send(message) ? 1 : 0;
+  return n;
+}
+
+void StreamServer::disconnect(ClientId client) {
+  const auto it = impl_->open.find(client.value());
+  if (it == impl_->open.end()) return;
+  const auto conn = it->second;  // keep alive while it erases itself from the map
+  conn->close();
+}
+
+int StreamServer::client_count() const { return static_cast<int>(impl_->open.size()); }
+
+const StreamCounters& StreamServer::counters(ClientId client) const {
+  return impl_->counters.at(static_cast<std::size_t>(client.value()));
+}
+
+}  // namespace llsf::comm

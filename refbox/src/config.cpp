@@ -1,0 +1,244 @@
+// SPDX-License-Identifier: MIT
+// RefboxConfig::validate() and the YAML loader (docs/refbox.md).
+#include "llsf/refbox/config.h"
+
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <set>
+
+#include "llsf/core/error.h"
+
+namespace llsf::refbox {
+
+using core::ConfigError;
+using core::ConfigNode;
+
+namespace {
+
+/// Reports a bad field: `field` is relative to the refbox map ("production_s", "pucks[3]").
+using FailFn = std::function<void(const std::string& field, const std::string& reason)>;
+
+std::string seconds_text(SimTime t) {
+  const std::int64_t ms = t.ns() / 1000000;
+  char buf[48];
+  if (ms % 1000 == 0) {
+    std::snprintf(buf, sizeof buf, "%lld s", static_cast<long long>(ms / 1000));
+  } else {
+    std::snprintf(buf, sizeof buf, "%.3f s", static_cast<double>(ms) / 1000.0);
+  }
+  return buf;
+}
+
+void check_config(const RefboxConfig& c, const FailFn& fail) {
+  if (!is_known_rules_variant(c.rules)) {
+    fail("rules", "unknown rules variant '" + c.rules + "' (known: " +
+                      std::string(kRulesRefbox061) + ", " + std::string(kRulesRulebook2013) + ")");
+  }
+  auto check_duration = [&](const char* field, SimTime d, SimTime max) {
+    if (d <= SimTime() || d > max) {
+      fail(field, "must be > 0 and <= " + seconds_text(max) + " (got " + seconds_text(d) + ")");
+    }
+  };
+  check_duration("setup_s", c.setup_duration, SimTime::from_sec(300));
+  check_duration("exploration_s", c.exploration_duration, SimTime::from_sec(180));
+  check_duration("production_s", c.production_duration, SimTime::from_sec(kPlanProductionS));
+  std::set<int> seen;
+  for (std::size_t i = 0; i < c.pucks.size(); ++i) {
+    const std::string f = "pucks[" + std::to_string(i) + "]";
+    if (c.pucks[i] <= 0) fail(f, "puck ids must be > 0 (got " + std::to_string(c.pucks[i]) + ")");
+    if (!seen.insert(c.pucks[i]).second) {
+      fail(f, "duplicate puck id " + std::to_string(c.pucks[i]));
+    }
+  }
+  for (int i = 0; i < kDeviceCount; ++i) {
+    const core::Pose2D& p = c.device_poses[i];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.theta)) {
+      fail("device_poses." + std::string(kDeviceNames[i]), "must be finite");
+    }
+  }
+  if (c.params) {
+    try {
+      validate_game_params(*c.params, "params");
+    } catch (const ConfigError& e) {
+      const std::string what = e.what();
+      const auto colon = what.find(": ");
+      fail(what.substr(0, colon), what.substr(colon + 2));
+    }
+  }
+}
+
+// --- YAML -------------------------------------------------------------------------------------
+
+SimTime read_seconds(const ConfigNode& n, const char* key, SimTime def) {
+  const ConfigNode v = n[key];
+  if (!v.defined()) return def;
+  const double s = v.as_double();
+  if (!std::isfinite(s)) v.fail("must be a finite number of seconds");
+  return SimTime::from_seconds(s);
+}
+
+int read_int(const ConfigNode& v) {
+  const std::int64_t x = v.as_int();
+  if (x < -1000000000 || x > 1000000000) v.fail("out of range");
+  return static_cast<int>(x);
+}
+
+DeviceId read_device(const ConfigNode& v) {
+  const std::string name = v.as_string();
+  const auto d = device_by_name(name);
+  if (!d) v.fail("unknown device '" + name + "'");
+  return *d;
+}
+
+Lights read_light_code(const ConfigNode& v) {
+  const std::string s = v.as_string();
+  Lights l;
+  for (char ch : s) {
+    LightState* lamp = ch == 'R' ? &l.red : ch == 'Y' ? &l.yellow : ch == 'G' ? &l.green : nullptr;
+    if (lamp == nullptr) v.fail("light code letters are R, Y, G (got '" + s + "')");
+    if (*lamp == LightState::kOn) v.fail("lamp repeated in '" + s + "'");
+    *lamp = LightState::kOn;
+  }
+  return l;
+}
+
+GameParams read_params(const ConfigNode& n) {
+  n.require_map();
+  n.check_keys({"machine_types", "proc_time_s", "light_codes", "order_quantities",
+                "late_order_start_s", "down_times", "gate_schedule"});
+  GameParams p;
+  const ConfigNode types = n.at("machine_types");
+  types.require_map();
+  for (const std::string& k : types.keys()) {
+    const auto d = device_by_name(k);
+    if (!d || !is_production_machine(*d)) types[k].fail("keys must be M1..M10");
+  }
+  for (int i = 0; i < kProductionMachineCount; ++i) {
+    const ConfigNode v = types.at(kDeviceNames[i]);
+    const auto t = machine_type_from_string(v.as_string());
+    if (!t || static_cast<int>(*t) > 4) v.fail("must be one of T1..T5");
+    p.machine_types[i] = *t;
+  }
+  const ConfigNode proc = n.at("proc_time_s");
+  proc.check_keys({"T1", "T2", "T3", "T4", "T5"});
+  const ConfigNode codes = n.at("light_codes");
+  codes.check_keys({"T1", "T2", "T3", "T4", "T5"});
+  for (int t = 0; t < 5; ++t) {
+    const std::string key{'T', static_cast<char>('1' + t)};
+    p.proc_time_s[t] = read_int(proc.at(key));
+    p.light_codes[t] = read_light_code(codes.at(key));
+  }
+  const ConfigNode q = n.at("order_quantities");
+  if (!q.is_sequence() || q.size() != kRegularOrderCount) q.fail("expected a list of 9 integers");
+  for (int i = 0; i < kRegularOrderCount; ++i) p.order_quantities[i] = read_int(q.at(i));
+  const ConfigNode late = n.at("late_order_start_s");
+  if (!late.is_sequence() || late.size() != kLateOrderCount) {
+    late.fail("expected a list of 2 integers");
+  }
+  for (int i = 0; i < kLateOrderCount; ++i) p.late_order_start_s[i] = read_int(late.at(i));
+  for (const ConfigNode& e : n.at("down_times").elements()) {
+    e.require_map();
+    e.check_keys({"machine", "start_s", "end_s"});
+    p.down_times.push_back(
+        DownTime{read_device(e.at("machine")), read_int(e.at("start_s")), read_int(e.at("end_s"))});
+  }
+  for (const ConfigNode& e : n.at("gate_schedule").elements()) {
+    e.require_map();
+    e.check_keys({"gate", "start_s", "end_s"});
+    p.gate_schedule.push_back(
+        GatePeriod{read_device(e.at("gate")), read_int(e.at("start_s")), read_int(e.at("end_s"))});
+  }
+  return p;
+}
+
+/// The node a relative field path ("params.down_times[2].end_s") points at, as deep as it exists.
+ConfigNode resolve(const ConfigNode& root, const std::string& field) {
+  ConfigNode n = root;
+  std::size_t pos = 0;
+  while (pos < field.size()) {
+    std::size_t end = field.find_first_of(".[", pos);
+    if (end == std::string::npos) end = field.size();
+    ConfigNode next;
+    if (end > pos) {
+      if (!n.is_map()) break;
+      next = n[field.substr(pos, end - pos)];
+    } else if (field[pos] == '[') {
+      const std::size_t close = field.find(']', pos);
+      if (close == std::string::npos || !n.is_sequence()) break;
+      const int idx = std::stoi(field.substr(pos + 1, close - pos - 1));
+      if (idx >= n.size()) break;
+      next = n.at(idx);
+      end = close + 1;
+    }
+    if (!next.defined()) break;
+    n = next;
+    pos = end;
+    if (pos < field.size() && field[pos] == '.') ++pos;
+  }
+  return n;
+}
+
+}  // namespace
+
+void RefboxConfig::validate() const {
+  check_config(*this, [](const std::string& field, const std::string& reason) {
+    throw ConfigError("refbox." + field + ": " + reason);
+  });
+}
+
+std::array<core::Pose2D, kDeviceCount> RefboxConfig::default_device_poses() {
+  constexpr double pi = core::kPi;
+  return {core::Pose2D{3.92, 1.68, 1.5 * pi},
+          {3.92, 3.92, 0.0},
+          {2.80, 0.56, 0.5 * pi},
+          {2.80, 1.68, 0.5 * pi},
+          {2.80, 2.80, pi},
+          {2.80, 3.92, 0.5 * pi},
+          {2.80, 5.04, 1.5 * pi},
+          {1.68, 1.68, pi},
+          {1.68, 3.92, 1.5 * pi},
+          {1.68, 5.04, 0.0},
+          {5.40, 0.20, 0.75 * pi},
+          {0.20, 5.40, 1.75 * pi},
+          {5.40, 5.40, 1.25 * pi},
+          {5.34, 3.15, pi},
+          {5.34, 2.80, pi},
+          {5.34, 2.45, pi}};
+}
+
+RefboxConfig load_refbox_config(const ConfigNode& node) {
+  RefboxConfig c;
+  node.require_map();
+  if (!node.is_map()) {
+    c.validate();
+    return c;
+  }
+  node.check_keys({"rules", "team", "skip_setup", "setup_s", "exploration_s", "production_s",
+                   "pucks", "learn_unknown_pucks", "params"});
+  node.read("rules", c.rules);
+  node.read("team", c.team);
+  node.read("skip_setup", c.skip_setup);
+  c.setup_duration = read_seconds(node, "setup_s", c.setup_duration);
+  c.exploration_duration = read_seconds(node, "exploration_s", c.exploration_duration);
+  c.production_duration = read_seconds(node, "production_s", c.production_duration);
+  if (node["pucks"].defined()) {
+    c.pucks.clear();
+    for (const ConfigNode& e : node["pucks"].elements()) c.pucks.push_back(read_int(e));
+  }
+  node.read("learn_unknown_pucks", c.learn_unknown_pucks);
+  if (node["params"].defined() && !node["params"].is_null()) c.params = read_params(node["params"]);
+  check_config(c, [&](const std::string& field, const std::string& reason) {
+    const ConfigNode n = resolve(node, field);
+    const bool exact = n.path().size() >= field.size() &&
+                       n.path().compare(n.path().size() - field.size(), field.size(), field) == 0;
+    n.fail(exact ? reason : field + ": " + reason);
+  });
+  return c;
+}
+
+RefboxConfig load_refbox_config_file(const std::string& path) {
+  return load_refbox_config(ConfigNode::load_file(path));
+}
+
+}  // namespace llsf::refbox
