@@ -297,8 +297,7 @@ int Hub::step(SimTime now) {
                  SimTime::from_ns(q.due_ns), std::span<const std::uint8_t>(fr.bytes)});
     handed_out_.push_back(q.frame);
     const SimTime latency = SimTime::from_ns(now.ns() - q.sent_ns);
-    for (TrafficCounters* c :
-         {&link(q.from, q.to).counters, &type_slot(q.type)}) {
+    for (TrafficCounters* c : {&link(q.from, q.to).counters, &type_slot(q.type)}) {
       ++c->delivered;
       c->bytes_delivered += bytes;
       c->delay.add(latency);
@@ -324,8 +323,8 @@ std::optional<SimTime> Hub::next_due() const {
 void Hub::mark_undeliverable(const Delivery& d) {
   const auto bytes = static_cast<std::int64_t>(d.frame.size());
   const auto cause = static_cast<std::size_t>(DropCause::kTransport);
-  for (TrafficCounters* c : {&link(d.from.value(), d.to.value()).counters,
-                             &type_slot(d.type_index)}) {
+  for (TrafficCounters* c :
+       {&link(d.from.value(), d.to.value()).counters, &type_slot(d.type_index)}) {
     --c->delivered;
     c->bytes_delivered -= bytes;
     ++c->dropped[cause];

@@ -43,7 +43,12 @@ int main(int argc, char** argv) {
         llsf::comm::load_socket_config(llsf::core::ConfigNode::load_file(sockets_file));
     std::vector<std::string> names;
     for (const auto& p : sock_cfg.udp_peers) names.push_back(p.name);
-    hub_cfg.validate_peer_names(names);
+    try {
+      hub_cfg.validate_peer_names(names);
+    } catch (const llsf::core::ConfigError& e) {
+      throw llsf::core::ConfigError(hub_file + ": " + e.what() + " (peers come from " +
+                                    sockets_file + ")");
+    }
 
     llsf::comm::MessageRegistry registry;
     llsf::comm::add_agent_messages(registry);
@@ -52,8 +57,7 @@ int main(int argc, char** argv) {
     for (const auto& p : sock_cfg.udp_peers) {
       const auto id = hub.add_peer(p);
       std::printf("peer %-12s channel %-8s hub listens on %s:%d, sends to port %s\n",
-                  p.name.c_str(), p.channel.c_str(), sock_cfg.address.c_str(),
-                  hub.listen_port(id),
+                  p.name.c_str(), p.channel.c_str(), sock_cfg.address.c_str(), hub.listen_port(id),
                   p.recv_port ? std::to_string(p.recv_port).c_str() : "(learnt)");
     }
     std::fflush(stdout);

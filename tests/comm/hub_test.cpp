@@ -375,6 +375,27 @@ TEST_CASE("an outage under a loss model does not change the other links' draws")
   CHECK(differ > 100);
 }
 
+TEST_CASE("changing one link's loss probability changes only that link's outcomes") {
+  HubConfig c = loss(LossModel::kPerLink, 0.3);
+  Team a(c, 8);
+  c.links.push_back(LinkConfig{"robot1", "robot3", false, 0.9});
+  Team b(c, 8);
+  a.hub.set_trace(true);
+  b.hub.set_trace(true);
+  send_many(a, 2000);
+  send_many(b, 2000);
+  REQUIRE(a.hub.trace().size() == b.hub.trace().size());
+  int changed = 0;
+  for (std::size_t i = 0; i < a.hub.trace().size(); ++i) {
+    const TraceEntry& x = a.hub.trace()[i];
+    const TraceEntry& y = b.hub.trace()[i];
+    if (x == y) continue;
+    ++changed;
+    CHECK(y.to == b.r3);
+  }
+  CHECK(changed > 500);  // about 2000 x (0.9 - 0.3)
+}
+
 TEST_CASE("same seed = same drop and delay sequence; another seed differs") {
   HubConfig c = loss(LossModel::kBurst, 0.25, SimTime::from_ms(3));
   c.delay.jitter = SimTime::from_ms(7);
@@ -467,7 +488,8 @@ TEST_CASE("forward_unregistered relays frames of unknown types unparsed") {
   c.forward_unregistered = true;
   Team t(c);
   // A frame of (2000, 1) (a refbox BeaconSignal, say) that this registry does not know.
-  const std::vector<std::uint8_t> beacon{0x07, 0xd0, 0x00, 0x01, 0x00, 0x00, 0x00, 0x02, 0x20, 0x01};
+  const std::vector<std::uint8_t> beacon{0x07, 0xd0, 0x00, 0x01, 0x00,
+                                         0x00, 0x00, 0x02, 0x20, 0x01};
   CHECK(t.hub.broadcast_frame(t.refbox, beacon, SimTime::from_ms(0)) == FrameError::kNone);
   // Framing is still checked.
   CHECK(t.hub.broadcast_frame(t.refbox, std::span(beacon.data(), 9), SimTime::from_ms(0)) ==

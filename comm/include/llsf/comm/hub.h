@@ -10,9 +10,11 @@
 // Determinism: loss draws come from the stream "<stream>/loss" and delay draws from
 // "<stream>/delay" of the Rng, in a fixed order: per message, [global: one loss draw], then for
 // each receiver in ascending peer id [per_link/burst: one loss draw] [jitter > 0: one delay draw].
-// Draws are made for every copy, including copies an outage drops, so that an outage, a
-// per-link delay or a loss setting never shifts the random numbers of other links and other
-// messages. Same seed + same sends = same drops, delays and deliveries.
+// Draws are made for every copy, including copies an outage drops, and do not depend on the
+// probabilities' values: an outage never shifts a draw, changing a (per-link) loss probability
+// only changes the outcomes of the links it sets, and delay settings never change which copies
+// are lost (and loss settings never change the delays). Same seed + same sends = same drops,
+// delays and deliveries.
 #pragma once
 
 #include <google/protobuf/message.h>
@@ -212,8 +214,8 @@ class Hub {
   TrafficCounters& type_slot(int type);
   std::vector<TrafficCounters> type_counters_;  ///< per registry index (grows with it)
   TrafficCounters unregistered_counters_;
-  std::vector<Pending> pending_;                ///< min-heap on (due, seq)
-  std::deque<Frame> frames_;                    ///< stable addresses for Delivery::frame
+  std::vector<Pending> pending_;  ///< min-heap on (due, seq)
+  std::deque<Frame> frames_;      ///< stable addresses for Delivery::frame
   std::vector<int> free_frames_;
   std::vector<int> handed_out_;  ///< frames of the last step's deliveries (one entry per copy)
   std::vector<TraceEntry> trace_;
