@@ -7,6 +7,7 @@
 
 #include "harness.h"
 #include "llsf/core/rng.h"
+#include "llsf/planner/navigator.h"
 #include "llsf/planner/planner.h"
 
 #if __has_include("llsf/kinematic/world_config.h")
@@ -77,7 +78,51 @@ double quantile(std::vector<double> v, double q) {
   return v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5)];
 }
 
+// Three navigators on ideal kinematics (the pose integrates the command), each driving a loop
+// of places and seeing the others as discs; returns CPU us per Navigator::update.
+double us_per_nav_update() {
+  Planner p(field_2013(), PlannerConfig{});
+  const core::Rng rng(7);
+  std::vector<Navigator> navs;
+  std::vector<Pose2D> poses{{0.6, 0.4, 0.0}, {0.6, 1.0, 0.0}, {0.6, 1.6, 0.0}};
+  const std::vector<std::vector<const char*>> routes{{"M1", "D2", "M8_left", "INS_2"},
+                                                     {"M4_look", "R1", "M9", "WAIT_INS"},
+                                                     {"M10_look", "TST", "M5_right", "LATE_ORDER"}};
+  for (int i = 0; i < 3; ++i) {
+    navs.emplace_back(p, ControllerConfig{}, rng.stream("planner/robot" + std::to_string(i)));
+  }
+  std::vector<int> leg(3, 0);
+  std::vector<DiscObstacle> others;
+  const double dt = 0.01;
+  const int steps = 30000;  // 300 s
+  core::SimTime now;
+  const double t0 = bench::cpu_seconds();
+  for (int k = 0; k < steps; ++k) {
+    for (int i = 0; i < 3; ++i) {
+      if (navs[i].status().outcome != NavOutcome::kRunning) {
+        navs[i].go_to_place(routes[i][leg[i]++ % 4]);
+      }
+      others.clear();
+      for (int j = 0; j < 3; ++j) {
+        if (j != i) others.push_back({j, poses[j].position(), 0.26});
+      }
+      const VelocityCommand c = navs[i].update(now, poses[i], others);
+      const Vec2 v = core::rotate(Vec2(c.vx_mps, c.vy_mps), poses[i].theta);
+      poses[i].x += v.x() * dt;
+      poses[i].y += v.y() * dt;
+      poses[i].theta = core::normalize_angle(poses[i].theta + c.omega_rps * dt);
+    }
+    now += core::SimTime::from_ms(10);
+  }
+  return (bench::cpu_seconds() - t0) * 1e6 / (3.0 * steps);
+}
+
 }  // namespace
+
+LLSF_BENCH(nav_update, "Navigator::update, 3 robots driving place loops (ideal kinematics)") {
+  us_per_nav_update();  // warm-up
+  bench::report("nav_update", "us_per_update", bench::median_of(kRepeats, us_per_nav_update), "us");
+}
 
 LLSF_BENCH(plan_query, "one planner query on the 2013 field (300 place-to-place queries)") {
   game_queries();  // warm-up: page in OMPL, allocator

@@ -4,44 +4,53 @@
 //               meets another robot's disc; held there: waiting;
 //   waiting  -- stopped; path clear again: driving; after wait_before_replan_s plus a seeded
 //               jitter: plan around the other robots (driving) or, if that fails, back off;
-//   backing off -- move backoff_distance_m away from the blocker, wait a seeded random delay,
-//               then plan around again.
+//   backing off -- give way: move to a spot off the line through the blocker, wait a seeded
+//               random delay (exponential back-off), then plan around again.
 // Time held back by robots adds up; past blocked_timeout_s the outcome is `blocked`. Free to
 // drive but no progress for stuck_timeout_s: `stuck`.
 #include "llsf/planner/navigator.h"
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <optional>
 
 namespace llsf::planner {
 
 namespace {
+
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kHeld = 0.05;  // m to the stop point and m/s: held back by a robot
+// m to the stop point and m/s: held back by a robot.
+constexpr double kHeld = 0.05;
+// Predicted discs per moving robot in the blocking check.
+constexpr int kPredictionSteps = 5;
+// m beyond the stop buffer: the way is open again.
 constexpr double kClearAgain = 0.3;
-constexpr double kSettled = 0.02;  // m/s: stopped enough to take a new direction
+// m/s: stopped enough to take a new direction.
+constexpr double kSettled = 0.02;
+// m/s: another robot faster than this is predicted along its velocity.
 constexpr double kMovingSpeed = 0.1;
+// s: time constant of the other robots' velocity estimates.
 constexpr double kVelocityFilter_s = 0.2;
-constexpr double kRefugeExtra =
-    0.1;  // m beyond what the blocker needs to pass a refuge  // time constant of the velocity
-          // estimate  // m/s: another robot faster than this is predicted       // m beyond the
-          // stop buffer: the way is open again
-constexpr double kHeadingProgress = 0.1;  // rad of heading error reduced counts as progress
+// m: a refuge lies this much further across than the blocker needs to pass.
+constexpr double kRefugeExtra = 0.1;
+// rad of heading error reduced counts as progress.
+constexpr double kHeadingProgress = 0.1;
+// m: forward mode comes in straight along the goal heading for this last stretch.
+constexpr double kApproach = 0.4;
 // Brake for another robot as if only half the distance were there: it may be coming the other
 // way just as fast.
 constexpr double kStopShare = 0.5;
-}  // namespace
 
-namespace {
 // True if no point of [a, b] comes closer to `c` than `r` (less a hair, for a start on it).
-bool detail_segment_keeps_off(const Vec2& a, const Vec2& b, const Vec2& c, double r) {
+bool segment_keeps_off(const Vec2& a, const Vec2& b, const Vec2& c, double r) {
   const Vec2 d = b - a;
   const double len2 = d.squaredNorm();
   const double t = len2 > 0.0 ? std::clamp((c - a).dot(d) / len2, 0.0, 1.0) : 0.0;
   return (a + t * d - c).norm() >= r - 1e-6;
 }
+
 }  // namespace
 
 const char* to_string(NavOutcome outcome) {
@@ -80,7 +89,6 @@ void Navigator::go_to(const Pose2D& goal, bool forward) {
   need_plan_ = true;
   braking_ = false;
   blocker_ = -1;
-  blocked_for_s_ = 0.0;
   no_progress_s_ = 0.0;
 }
 
@@ -108,6 +116,18 @@ bool Navigator::plan_from(const Pose2D& pose, std::span<const DiscObstacle> othe
   PlanRequest req;
   req.start = pose;
   req.goal = goal_;
+  // Forward (carrying a puck): come in straight along the goal heading for the last
+  // kApproach metres, as the holder needs, if that stretch is free.
+  bool approach = false;
+  if (forward_) {
+    const Vec2 g = goal_.position();
+    const Vec2 pre = g - kApproach * core::unit(goal_.theta);
+    if (planner_->is_segment_free(pre, g) &&
+        (pose.position() - g).norm() > kApproach + config_.position_tolerance_m) {
+      req.goal = Pose2D{pre.x(), pre.y(), goal_.theta};
+      approach = true;
+    }
+  }
   if (around_others) {
     // Plan around where the others are and, for those that move, where they are going within
     // prediction_horizon_s (discs along their estimated velocity).
@@ -129,6 +149,7 @@ bool Navigator::plan_from(const Pose2D& pose, std::span<const DiscObstacle> othe
   PlanResult r = planner_->plan(req);
   switch (r.status) {
     case PlanStatus::kFound:
+      if (approach) r.path.points.push_back(goal_.position());
       follower_.set_path(std::move(r.path), forward_);
       ++stats_.plans;
       best_remaining_ = follower_.remaining_m();
@@ -153,42 +174,65 @@ double Navigator::blocking_arc(const Pose2D& pose, std::span<const DiscObstacle>
                                int& who) const {
   // The first arc length (from the robot's projection, within the lookahead) where the path
   // comes closer to another robot than the two discs allow -- or than the robot is now, if
-  // it is already too close (moving away is always allowed).
+  // it is already too close (moving away is always allowed). A moving robot also blocks where
+  // it will be within prediction_horizon_s (a robot crossing the path is seen before it is on
+  // it); those predicted discs count only if the path enters them ahead, not if the robot is
+  // in one already (someone coming up from behind is not a reason to stop).
   who = -1;
   if (!follower_.has_path()) return kInf;
   const double own = planner_->config().inflated_radius_m();
-  const auto& pts = follower_.path().points;
-  const auto& cum = follower_.vertex_arc();
   const double s0 = follower_.progress_m();
-  const double s_end = s0 + config_.obstacle_lookahead_m;
   double best = kInf;
   for (const DiscObstacle& o : others) {
     const double sep = own + o.radius_m + config_.robot_margin_m;
     const double now = (pose.position() - o.position).norm();
     const double thr = std::min(sep, now - 0.005);
-    if (thr <= 0.0) continue;
-    for (std::size_t i = 1; i < pts.size(); ++i) {
-      if (cum[i] <= s0) continue;
-      if (cum[i - 1] >= std::min(s_end, best)) break;
-      const double from = std::max(s0, cum[i - 1]);
-      const Vec2 a = follower_.point_at(from);
-      const double len = cum[i] - from;
-      if (len <= 1e-12) continue;
-      const Vec2 dir = (pts[i] - a) / len;
-      double hit = kInf;
-      if ((a - o.position).norm() < thr) {
-        hit = from;
-      } else if (const auto t = core::ray_circle(a, dir, o.position, thr); t && *t <= len) {
-        hit = from + *t;
-      }
-      if (hit < best && hit <= s_end) {
+    if (thr > 0.0) {
+      const double hit = path_entry(o.position, thr, s0, true);
+      if (hit < best) {
         best = hit;
         who = o.id;
       }
-      if (hit < kInf) break;
+    }
+    const Vec2 v = velocity_of(o.id);
+    if (v.norm() < kMovingSpeed) continue;
+    for (int k = 1; k <= kPredictionSteps; ++k) {
+      const Vec2 c = o.position + v * (config_.prediction_horizon_s * k / kPredictionSteps);
+      const double hit = path_entry(c, sep, s0, false);
+      if (hit < best) {
+        best = hit;
+        who = o.id;
+      }
     }
   }
   return best;
+}
+
+double Navigator::path_entry(const Vec2& c, double r, double s0, bool inside_blocks) const {
+  // The first arc length >= s0 within the lookahead where the path enters the disc (c, r);
+  // starting inside counts as s0 if `inside_blocks`, else that disc is ignored.
+  const auto& pts = follower_.path().points;
+  const auto& cum = follower_.vertex_arc();
+  const double s_end = s0 + config_.obstacle_lookahead_m;
+  bool first = true;
+  for (std::size_t i = 1; i < pts.size(); ++i) {
+    if (cum[i] <= s0) continue;
+    if (cum[i - 1] >= s_end) break;
+    const double from = std::max(s0, cum[i - 1]);
+    const Vec2 a = follower_.point_at(from);
+    const double len = cum[i] - from;
+    if (len <= 1e-12) continue;
+    if ((a - c).norm() < r) {
+      if (first && !inside_blocks) return kInf;
+      return from <= s_end ? from : kInf;
+    }
+    first = false;
+    const Vec2 dir = (pts[i] - a) / len;
+    if (const auto t = core::ray_circle(a, dir, c, r); t && *t <= len) {
+      return from + *t <= s_end ? from + *t : kInf;
+    }
+  }
+  return kInf;
 }
 
 VelocityCommand Navigator::update(core::SimTime now, const Pose2D& pose,
@@ -208,12 +252,11 @@ VelocityCommand Navigator::update(core::SimTime now, const Pose2D& pose,
   // Held back by robots for too long in total: give up.
   auto held = [&](double step) -> bool {
     stats_.blocked_s += step;
-    blocked_for_s_ += step;
     if (stats_.blocked_s > config_.blocked_timeout_s) {
-      finish(NavOutcome::kBlocked,
-             "held back by robot " + std::to_string(blocker_) + " for " +
-                 std::to_string(stats_.blocked_s) + " s",
-             blocker_);
+      char buf[96];
+      std::snprintf(buf, sizeof buf, "held back by robot %d for %.1f s", blocker_,
+                    stats_.blocked_s);
+      finish(NavOutcome::kBlocked, buf, blocker_);
       return true;
     }
     return false;
@@ -228,7 +271,6 @@ VelocityCommand Navigator::update(core::SimTime now, const Pose2D& pose,
       const double s_block = blocking_arc(pose, others, who);
       if (s_block - follower_.progress_m() > config_.stop_buffer_m + kClearAgain) {
         phase_ = NavPhase::kDriving;
-        blocked_for_s_ = 0.0;
         no_progress_s_ = 0.0;
         return drive(now, pose, others, dt);
       }
@@ -238,7 +280,6 @@ VelocityCommand Navigator::update(core::SimTime now, const Pose2D& pose,
         if (plan_from(pose, others, true)) {
           ++stats_.replans;
           phase_ = NavPhase::kDriving;
-          blocked_for_s_ = 0.0;
           return drive(now, pose, others, dt);
         }
         if (status_.outcome != NavOutcome::kRunning) return follower_.brake(pose, dt);
@@ -260,7 +301,6 @@ VelocityCommand Navigator::update(core::SimTime now, const Pose2D& pose,
       if (plan_from(pose, others, true)) {
         ++stats_.replans;
         phase_ = NavPhase::kDriving;
-        blocked_for_s_ = 0.0;
         return drive(now, pose, others, dt);
       }
       if (status_.outcome != NavOutcome::kRunning) return follower_.brake(pose, dt);
@@ -310,7 +350,6 @@ VelocityCommand Navigator::drive(core::SimTime now, const Pose2D& pose,
     // Held back by another robot: wait, then plan around it.
     phase_ = NavPhase::kWaiting;
     blocker_ = who;
-    blocked_for_s_ = 0.0;
     wait_until_ = now + core::SimTime::from_seconds(config_.wait_before_replan_s +
                                                     rng_.uniform(0.0, config_.replan_jitter_s));
     return cmd;
@@ -328,7 +367,11 @@ VelocityCommand Navigator::drive(core::SimTime now, const Pose2D& pose,
     } else {
       no_progress_s_ += dt;
       if (no_progress_s_ > config_.stuck_timeout_s) {
-        finish(NavOutcome::kStuck, "no progress for " + std::to_string(no_progress_s_) + " s");
+        char buf[96];
+        const Vec2 p = pose.position();
+        std::snprintf(buf, sizeof buf, "no progress for %.1f s at (%.3f, %.3f)", no_progress_s_,
+                      p.x(), p.y());
+        finish(NavOutcome::kStuck, buf);
       }
     }
   }
@@ -339,10 +382,11 @@ VelocityCommand Navigator::start_backoff(core::SimTime now, const Pose2D& pose,
                                          std::span<const DiscObstacle> others, double dt) {
   ++stats_.backoffs;
   phase_ = NavPhase::kBackingOff;
-  // Exponential back-off: the range of the random delay doubles with every back-off of this
-  // navigation (up to 4x), so that two robots that keep giving way to each other at the same
-  // moments soon stop doing so.
-  const double spread = std::min(std::pow(2.0, stats_.backoffs - 1), 4.0);
+  // Exponential back-off, capped: the range of the random delay doubles after the first
+  // back-off of this navigation (1x, then 2x), so that two robots that keep giving way to each
+  // other at the same moments soon stop doing so. (A higher cap made them wait so long that
+  // more navigations ended blocked in the swap tests.)
+  const double spread = std::min(std::pow(2.0, stats_.backoffs - 1), 2.0);
   const double lo = config_.backoff_min_s;
   wait_until_ = now + core::SimTime::from_seconds(
                           rng_.uniform(lo, lo + spread * (config_.backoff_max_s - lo)));
@@ -374,9 +418,8 @@ VelocityCommand Navigator::start_backoff(core::SimTime now, const Pose2D& pose,
       bool ok = planner_->is_segment_free(p, target);
       for (const DiscObstacle& o : others) {
         const double sep = own + o.radius_m + config_.robot_margin_m;
-        ok =
-            ok && (target - o.position).norm() >= sep &&
-            detail_segment_keeps_off(p, target, o.position, std::min(sep, (p - o.position).norm()));
+        ok = ok && (target - o.position).norm() >= sep &&
+             segment_keeps_off(p, target, o.position, std::min(sep, (p - o.position).norm()));
       }
       return ok;
     };

@@ -157,12 +157,13 @@ VelocityCommand PathFollower::update(const Pose2D& pose, double dt, double stop_
   // kFinalTurn metres -- within the rotation limits and the budget that turning while driving
   // leaves: omega * v <= turn_accel_fraction * a_max.
   double e = heading_error_;
-  if (forward_ && dir.norm() > 1e-9) {
-    if (cum_.back() - s_ > kFinalTurn)
-      e = core::angle_diff(std::atan2(dir.y(), dir.x()), pose.theta);
-    // Never backwards (an assisted holder lets its puck go): turn on the spot first, then
-    // drive with the forward share of the direction only.
-    const double off = std::abs(core::angle_diff(std::atan2(dir.y(), dir.x()), pose.theta));
+  if (forward_ && dir.norm() > 1e-9 && cum_.back() - s_ > kFinalTurn) {
+    // Face along the path; never backwards (an assisted holder lets its puck go): turn on
+    // the spot first, then drive with the forward share of the direction only. In the last
+    // kFinalTurn metres the robot turns to the goal heading and output() only cuts any
+    // backward part of the command.
+    e = core::angle_diff(std::atan2(dir.y(), dir.x()), pose.theta);
+    const double off = std::abs(e);
     v = off > kForwardCone ? 0.0 : v * std::cos(off);
   }
   const double al = config_.accel_fraction * config_.max_alpha_rps2;

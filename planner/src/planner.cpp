@@ -233,12 +233,15 @@ struct Planner::Impl {
   }
 
   /// The free point nearest to `p` within `max_m` (1 cm rings, 32 directions), if any.
+  /// A start free of static obstacles (inside a disc only) moves out along a statically free
+  /// segment.
   std::optional<Vec2> escape(const Vec2& p, double max_m) const {
     const int rings = static_cast<int>(std::floor(max_m / 0.01 + 1e-9));
+    const bool static_free = map.point_free(p);
     for (int k = 1; k <= rings; ++k) {
       for (int j = 0; j < 32; ++j) {
         const Vec2 c = p + 0.01 * k * core::unit(2.0 * core::kPi * j / 32.0);
-        if (query.free(c)) return c;
+        if (query.free(c) && (!static_free || map.segment_free(p, c))) return c;
       }
     }
     return std::nullopt;
@@ -317,6 +320,14 @@ struct Planner::Impl {
       result.message = "goal is not a finite pose";
       return result;
     }
+    if (goal.x() < 0.0 || goal.y() < 0.0 || goal.x() > map.width() || goal.y() > map.height()) {
+      char buf[96];
+      std::snprintf(buf, sizeof buf, " lies outside the field [0, %.2f] x [0, %.2f]", map.width(),
+                    map.height());
+      result.status = PlanStatus::kInvalidGoal;
+      result.message = "goal " + xy(goal) + buf;
+      return result;
+    }
     if (!map.point_free(goal)) {
       const Clearance c = clearance(goal);
       char buf[160];
@@ -350,8 +361,9 @@ struct Planner::Impl {
       const auto out = escape(start, config.start_escape_m);
       if (!out) {
         result.status = PlanStatus::kInvalidStart;
-        result.message = "start " + xy(start) + " has no free point within " +
-                         std::to_string(config.start_escape_m) + " m";
+        char buf[64];
+        std::snprintf(buf, sizeof buf, " has no free point within %.2f m", config.start_escape_m);
+        result.message = "start " + xy(start) + buf;
         return result;
       }
       prefix.push_back(start);

@@ -151,6 +151,7 @@ TEST_CASE("a robot holding the goal: blocked, naming it, after the timeout") {
   const NavStatus& st = scene.nav(0).status();
   CHECK(st.outcome == NavOutcome::kBlocked);
   CHECK(st.blocked_by == 1);
+  CHECK(st.message.rfind("held back by robot 1 for ", 0) == 0);
   CHECK(t < 30.0);
   CHECK(scene.nav(0).stats().blocked_s > 6.0);
   CHECK(scene.robot_contacts() == 0);
@@ -181,6 +182,7 @@ TEST_CASE("pushing against an obstacle the map does not know: stuck") {
   }
   CHECK(touched);
   CHECK(nav.status().outcome == NavOutcome::kStuck);
+  CHECK(nav.status().message.rfind("no progress for 2.0", 0) == 0);
   CHECK(world.time().seconds() < 10.0);
 }
 
@@ -284,4 +286,46 @@ TEST_CASE("carrying a puck: forward mode keeps it in the holder and lands it in 
   // Holonomic driving with the heading turned on the way backs up at the start: the holder
   // lets the puck go.
   CHECK_FALSE(run(false).has_value());
+}
+
+TEST_CASE("forward mode reaches places from any side, coming in straight at the end") {
+  NavScene scene(test_world({kIns3}), 4);
+  for (const char* name : {"M3_left", "D1", "M9", "R2", "INS_2", "M7_right", "LATE_ORDER", "R1"}) {
+    INFO(name);
+    scene.nav(0).go_to_place(name, /*forward=*/true);
+    scene.run(60.0);
+    REQUIRE(scene.nav(0).status().outcome == NavOutcome::kArrived);
+    // The last stretch is straight along the goal heading.
+    const Path& path = scene.nav(0).path();
+    const Vec2 last = path.points.back() - path.points[path.points.size() - 2];
+    CHECK(last.norm() >= 0.39);
+    CHECK(std::abs(core::angle_diff(std::atan2(last.y(), last.x()), path.goal_theta)) < 1e-6);
+  }
+  CHECK(scene.static_contacts() == 0);
+}
+
+TEST_CASE("a robot following another down a lane slows down behind it, then arrives") {
+  // Both drive east along the lane between the machine rows at y = 1.68 and 2.8; robot 2
+  // starts 1 m behind at full speed, robot 1 drives at 0.4 m/s: robot 2 closes up.
+  ControllerConfig slow;
+  slow.max_speed_mps = 0.4;
+  kinematic::WorldConfig w = test_world({{1.6, 2.25, 0.0}, {0.6, 2.25, 0.0}});
+  NavScene scene(w, 9, PlannerConfig{}, ControllerConfig{});
+  // Robot 1 drives slowly: a navigator of its own with the slow config.
+  Navigator lead(scene.planner(), slow, core::RandomStream(3));
+  lead.go_to({4.6, 2.25, 0.0});
+  scene.nav(1).go_to({4.0, 2.25, 0.0});
+  for (int k = 0; k < 4000 && scene.nav(1).status().outcome == NavOutcome::kRunning; ++k) {
+    const core::SimTime now = scene.world().time();
+    const core::RobotId r0(0);
+    scene.world().set_command(
+        r0, test::to_motor(lead.update(now, scene.world().robot_pose(r0), scene.others(0))));
+    const core::RobotId r1(1);
+    scene.world().set_command(r1, test::to_motor(scene.nav(1).update(
+                                      now, scene.world().robot_pose(r1), scene.others(1))));
+    const auto& ev = scene.world().step();
+    for (const auto& c : ev.collisions) CHECK(c.kind != kinematic::CollisionKind::kRobotRobot);
+  }
+  CHECK(scene.nav(1).status().outcome == NavOutcome::kArrived);
+  CHECK(scene.nav(1).stats().replans == 0);  // it followed, it did not go round
 }

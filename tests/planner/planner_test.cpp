@@ -210,8 +210,9 @@ TEST_CASE("a goal inside an obstacle is rejected with a clear error") {
   res = p.plan({start, {0.1, 4.5, 0.0}, {}, 0.0, 1});
   CHECK(res.status == PlanStatus::kInvalidGoal);
   CHECK(res.message.find("wall x=0") != std::string::npos);
-  res = p.plan({start, {7.0, 1.0, 0.0}, {}, 0.0, 1});  // outside the field
+  res = p.plan({start, {7.0, 1.0, 0.0}, {}, 0.0, 1});
   CHECK(res.status == PlanStatus::kInvalidGoal);
+  CHECK(res.message == "goal (7.000, 1.000) lies outside the field [0, 5.60] x [0, 5.60]");
 }
 
 TEST_CASE("an unreachable goal gives no path") {
@@ -338,4 +339,15 @@ TEST_CASE("the YAML loader reads both sections and reports bad values at their l
   CHECK_THROWS_WITH_AS(
       load_navigation_config(core::ConfigNode::parse("planner:\n  safety_margn_m: 1\n", "n.yaml")),
       doctest::Contains("safety_margn_m"), core::ConfigError);
+  CHECK_THROWS_WITH_AS(load_navigation_config(core::ConfigNode::parse(
+                           "planner:\n  places:\n    extra: 5\n", "n.yaml")),
+                       doctest::Contains("n.yaml:3:12: planner.places.extra: expected a list"),
+                       core::ConfigError);
+  CHECK_THROWS_WITH_AS(load_navigation_config(
+                           core::ConfigNode::parse("planner:\n  max_iterations: many\n", "n.yaml")),
+                       doctest::Contains("n.yaml:2:19"), core::ConfigError);
+  CHECK_THROWS_WITH_AS(load_navigation_config(core::ConfigNode::parse(
+                           "controller:\n  backoff_min_s: 2\n  backoff_max_s: 1\n", "n.yaml")),
+                       "n.yaml:3:18: controller.backoff_max_s: must be >= backoff_min_s (got 1)",
+                       core::ConfigError);
 }

@@ -84,8 +84,9 @@ struct ControllerConfig {
   double turn_accel_fraction = 0.25;
   double position_tolerance_m = 0.02;
   double angle_tolerance_rad = 0.03;
-  /// How far a path corner may be cut when driving round it; sets the corner speed.
-  double corner_deviation_m = 0.02;
+  /// How far the robot may swing out at a path corner; sets the corner speed. The 0.26 m
+  /// disc covers the holder arms with only millimetres to spare: keep this small.
+  double corner_deviation_m = 0.01;
   /// Other robots closer to the path than the two discs plus this margin block it.
   double robot_margin_m = 0.0;
   /// The path is checked for other robots this far ahead.
@@ -97,20 +98,21 @@ struct ControllerConfig {
   double replan_jitter_s = 1.0;
   /// Extra clearance kept from other robots when planning around them.
   double replan_margin_m = 0.06;
-  /// When planning around a moving robot, also avoid where it will be within this time at its
-  /// estimated velocity.
+  /// A moving robot also blocks, and is planned around, where it will be within this time at
+  /// its estimated velocity.
   double prediction_horizon_s = 1.5;
   /// No way around: give way -- move at most this far to a spot off the line through the
   /// blocker (far enough across it for the blocker to pass, else as far as possible) -- and
   /// wait a seeded random delay.
   double backoff_distance_m = 1.2;
-  /// The delay is uniform in [min, min + k (max - min)], k = 1, 2, 4, 4, ... for the 1st,
-  /// 2nd, 3rd, ... back-off of one navigation (exponential back-off).
+  /// The delay is uniform in [min, min + k (max - min)], k = 1, 2, 2, ... for the 1st, 2nd,
+  /// 3rd, ... back-off of one navigation (capped exponential back-off).
   double backoff_min_s = 0.5;
   double backoff_max_s = 3.0;
   /// Total time held back by other robots after which the goal is given up as `blocked`.
   double blocked_timeout_s = 30.0;
-  /// No progress for this long while free to drive: `stuck`.
+  /// No progress (progress_m less path to go, or 0.1 rad less heading error) for this long
+  /// while free to drive: `stuck`.
   double stuck_timeout_s = 4.0;
   double progress_m = 0.03;
 

@@ -63,7 +63,8 @@ class Navigator {
   void abort();
 
   /// One control step at simulated time `now` for the robot at `pose`, with the other robots
-  /// as discs. Returns the velocity command (zero once the navigation has ended).
+  /// (not this one) as discs; call it every physics step or at any steady rate. Returns the
+  /// velocity command; once the navigation has ended it brakes to a stop, then returns zero.
   VelocityCommand update(core::SimTime now, const Pose2D& pose,
                          std::span<const DiscObstacle> others);
 
@@ -78,6 +79,7 @@ class Navigator {
   void finish(NavOutcome outcome, std::string message, int blocked_by = -1);
   bool plan_from(const Pose2D& pose, std::span<const DiscObstacle> others, bool around_others);
   double blocking_arc(const Pose2D& pose, std::span<const DiscObstacle> others, int& who) const;
+  double path_entry(const Vec2& c, double r, double s0, bool inside_blocks) const;
   VelocityCommand drive(core::SimTime now, const Pose2D& pose, std::span<const DiscObstacle> others,
                         double dt);
   VelocityCommand start_backoff(core::SimTime now, const Pose2D& pose,
@@ -107,7 +109,6 @@ class Navigator {
   // Waiting / backing off.
   core::SimTime wait_until_;
   int blocker_ = -1;
-  double blocked_for_s_ = 0.0;  // continuous time held back in this wait
   // Other robots: estimated velocities, and the discs planned around (kept to reuse memory).
   std::vector<Track> tracks_;
   std::vector<DiscObstacle> predicted_;
