@@ -2,6 +2,7 @@
 // RefboxConfig::validate() and the YAML loader (docs/refbox.md).
 #include "llsf/refbox/config.h"
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -43,6 +44,7 @@ void check_config(const RefboxConfig& c, const FailFn& fail) {
   check_duration("setup_s", c.setup_duration, SimTime::from_sec(300));
   check_duration("exploration_s", c.exploration_duration, SimTime::from_sec(180));
   check_duration("production_s", c.production_duration, SimTime::from_sec(kPlanProductionS));
+  check_duration("overtime_s", c.overtime_duration, SimTime::from_sec(kOvertimeS));
   std::set<int> seen;
   for (std::size_t i = 0; i < c.pucks.size(); ++i) {
     const std::string f = "pucks[" + std::to_string(i) + "]";
@@ -59,7 +61,8 @@ void check_config(const RefboxConfig& c, const FailFn& fail) {
   }
   if (c.params) {
     try {
-      validate_game_params(*c.params, "params");
+      validate_game_params(*c.params, "params",
+                           c.synchronised() ? kPlanSynchronisedS : kPlanProductionS);
     } catch (const ConfigError& e) {
       const std::string what = e.what();
       const auto colon = what.find(": ");
@@ -215,7 +218,7 @@ RefboxConfig load_refbox_config(const ConfigNode& node) {
     return c;
   }
   node.check_keys({"rules", "team", "skip_setup", "setup_s", "exploration_s", "production_s",
-                   "pucks", "learn_unknown_pucks", "params"});
+                   "pucks", "learn_unknown_pucks", "params", "mode", "overtime_s"});
   node.read("rules", c.rules);
   node.read("team", c.team);
   node.read("skip_setup", c.skip_setup);
@@ -227,6 +230,15 @@ RefboxConfig load_refbox_config(const ConfigNode& node) {
     for (const ConfigNode& e : node["pucks"].elements()) c.pucks.push_back(read_int(e));
   }
   node.read("learn_unknown_pucks", c.learn_unknown_pucks);
+  if (node["mode"].defined()) {
+    const ConfigNode v = node["mode"];
+    std::string name = v.as_string();
+    for (char& ch : name) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+    const auto m = refbox_mode_from_string(name);
+    if (!m) v.fail("must be standalone, master or slave (got '" + v.as_string() + "')");
+    c.mode = *m;
+  }
+  c.overtime_duration = read_seconds(node, "overtime_s", c.overtime_duration);
   if (node["params"].defined() && !node["params"].is_null()) c.params = read_params(node["params"]);
   check_config(c, [&](const std::string& field, const std::string& reason) {
     const ConfigNode n = resolve(node, field);

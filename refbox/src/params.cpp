@@ -6,6 +6,7 @@
 #include <set>
 #include <utility>
 
+#include "llsf/core/assert.h"
 #include "llsf/core/error.h"
 #include "llsf/refbox/rules_variant.h"
 
@@ -85,6 +86,11 @@ std::string light_code_string(const Lights& code) {
 }
 
 GameParams draw_game_params(RandomStream& rng, const RulesVariant& rules) {
+  return draw_game_params(rng, rules, kPlanProductionS);
+}
+
+GameParams draw_game_params(RandomStream& rng, const RulesVariant& rules, int gate_schedule_end_s) {
+  LLSF_DEMAND(gate_schedule_end_s >= kPlanProductionS);
   GameParams p;
 
   // Machine types: MACHINE-DISTRIBUTION shuffled and dealt to M1..M10.
@@ -134,10 +140,11 @@ GameParams draw_game_params(RandomStream& rng, const RulesVariant& rules) {
   }
 
   // Delivery-gate schedule: 60..180 s periods on a gate other than the previous one; a period
-  // ending within 60 s of the end is stretched to the end.
+  // ending within 60 s of the end (900 s, or 1200 s in synchronised mode) is stretched to it.
+  const int gate_end = gate_schedule_end_s;
   int t = 0;
   int prev = -1;
-  while (t < kPlanProductionS) {
+  while (t < gate_end) {
     const int len = draw(rng, 60, 180);
     int gate;
     if (prev < 0) {
@@ -147,7 +154,7 @@ GameParams draw_game_params(RandomStream& rng, const RulesVariant& rules) {
       if (gate >= prev) ++gate;
     }
     int end = t + len;
-    if (end > kPlanProductionS - 60) end = kPlanProductionS;
+    if (end > gate_end - 60) end = gate_end;
     p.gate_schedule.push_back(GatePeriod{DeviceId(kD1 + gate), t, end});
     prev = gate;
     t = end;
@@ -156,6 +163,10 @@ GameParams draw_game_params(RandomStream& rng, const RulesVariant& rules) {
 }
 
 void validate_game_params(const GameParams& p, const std::string& path) {
+  validate_game_params(p, path, kPlanProductionS);
+}
+
+void validate_game_params(const GameParams& p, const std::string& path, int gate_schedule_end_s) {
   // Machine types: four T1, three T2, one each of T3..T5.
   std::array<int, 5> count{};
   for (int i = 0; i < kProductionMachineCount; ++i) {
@@ -235,9 +246,9 @@ void validate_game_params(const GameParams& p, const std::string& path) {
     if (g.end_s <= g.start_s) fail(f + ".end_s", "must be > start_s");
     t = g.end_s;
   }
-  if (t < kPlanProductionS) {
+  if (t < gate_schedule_end_s) {
     fail(path + ".gate_schedule", "must cover production up to " +
-                                      std::to_string(kPlanProductionS) + " s (ends at " +
+                                      std::to_string(gate_schedule_end_s) + " s (ends at " +
                                       std::to_string(t) + ")");
   }
 }

@@ -3,9 +3,11 @@
 #include "llsf/refbox/refbox.h"
 
 #include <algorithm>
+#include <cmath>
 #include <utility>
 
 #include "llsf/core/assert.h"
+#include "llsf/core/error.h"
 
 namespace llsf::refbox {
 
@@ -34,12 +36,23 @@ int phase_slot(GamePhase p) {
       return 3;
     case GamePhase::kPostGame:
       return 4;
+    case GamePhase::kOpenChallenge:
+      return 5;
+    case GamePhase::kNavigationChallenge:
+      return 6;
+    case GamePhase::kWhackAMoleChallenge:
+      return 7;
   }
   return 0;
 }
-constexpr std::array<GamePhase, 5> kPhases = {GamePhase::kPreGame, GamePhase::kSetup,
-                                              GamePhase::kExploration, GamePhase::kProduction,
-                                              GamePhase::kPostGame};
+constexpr std::array<GamePhase, 8> kPhases = {GamePhase::kPreGame,
+                                              GamePhase::kSetup,
+                                              GamePhase::kExploration,
+                                              GamePhase::kProduction,
+                                              GamePhase::kPostGame,
+                                              GamePhase::kOpenChallenge,
+                                              GamePhase::kNavigationChallenge,
+                                              GamePhase::kWhackAMoleChallenge};
 
 /// Points when a production machine completes its set (RBX 0.6.1 = RB).
 int completion_points(MachineType t) {
@@ -152,13 +165,17 @@ const StepOutput& Refbox::step(SimTime now, const StepInput& in) {
     if (state_ == GameState::kInit) set_state(GameState::kWaitStart);
   }
 
-  // 1. Game time and phase ends.
+  // 1. Game time and phase ends; in synchronised mode the other field's state may end the
+  //    wait at the regular production end (overtime or POST_GAME).
   advance_time(dt);
+  if (in.peer_game_state) handle_peer(*in.peer_game_state);
   // 2. Controller commands.
   for (const Command& c : in.commands) apply(c);
-  // 3. Beacons and machine reports.
+  // 3. Beacons and machine reports, then the overhead-camera poses (whack-a-mole).
   for (const Beacon& b : in.beacons) handle_beacon(b);
   for (const MachineReport& r : in.reports) handle_report(r);
+  update_vision(in.robot_poses);
+  update_whack_a_mole(in.robot_poses);
   // 4. RFID zones.
   for (const RfidEvent& e : in.rfid) handle_rfid(e);
   // 5. Scheduled production rules.
@@ -185,20 +202,25 @@ SimTime Refbox::phase_duration(GamePhase p) const {
     case GamePhase::kExploration:
       return config_.exploration_duration;
     case GamePhase::kProduction:
-      return config_.production_duration;
+      return overtime_ ? config_.production_duration + config_.overtime_duration
+                       : config_.production_duration;
+    case GamePhase::kNavigationChallenge:
+      return rules_.navigation_challenge_duration;
+    case GamePhase::kWhackAMoleChallenge:
+      return rules_.whack_a_mole_duration;
     default:
-      return SimTime();
+      return SimTime();  // PRE_GAME, POST_GAME, OPEN_CHALLENGE: game time stands still
   }
 }
 
+bool Refbox::awaiting_overtime_decision() const {
+  return config_.synchronised() && phase_ == GamePhase::kProduction && !overtime_ &&
+         game_time_ >= config_.production_duration;
+}
+
 void Refbox::advance_time(SimTime dt) {
-  if (state_ != GameState::kRunning) {
-    return;
-  }
-  if (phase_ != GamePhase::kSetup && phase_ != GamePhase::kExploration &&
-      phase_ != GamePhase::kProduction) {
-    return;
-  }
+  // Game time runs only while RUNNING in a timed phase (spec §4).
+  if (state_ != GameState::kRunning || !timed(phase_)) return;
   game_time_ += dt;
   if (phase_ == GamePhase::kSetup && !setup_warned_ &&
       game_time_.ns() * 10 >= config_.setup_duration.ns() * 9) {
@@ -208,19 +230,55 @@ void Refbox::advance_time(SimTime dt) {
   // A phase that ends hands the remaining time to the next one (exact for any step size).
   while (state_ == GameState::kRunning && phase_duration(phase_) > SimTime() &&
          game_time_ >= phase_duration(phase_)) {
-    const SimTime carry = game_time_ - phase_duration(phase_);
-    const GamePhase next = phase_ == GamePhase::kSetup         ? GamePhase::kExploration
-                           : phase_ == GamePhase::kExploration ? GamePhase::kProduction
-                                                               : GamePhase::kPostGame;
-    if (phase_ == GamePhase::kProduction) {
-      // The game ends; POST_GAME shows the final production time.
-      enter_phase(next);
-      game_time_ = config_.production_duration;
+    const SimTime end = phase_duration(phase_);
+    const SimTime carry = game_time_ - end;
+    if (awaiting_overtime_decision()) {
+      // Synchronised play-off (spec §10): each field pauses at the regular end and waits for
+      // the other one (handle_peer()).
+      game_time_ = end;
+      set_state(GameState::kPaused);
+      attention("Waiting for the synchronised game to end", 15.0);
       break;
     }
+    if (phase_ == GamePhase::kProduction || is_challenge(phase_)) {
+      // The game or the timed challenge ends; POST_GAME shows the final game time.
+      enter_phase(GamePhase::kPostGame);
+      game_time_ = end;
+      break;
+    }
+    const GamePhase next =
+        phase_ == GamePhase::kSetup ? GamePhase::kExploration : GamePhase::kProduction;
     enter_phase(next);
     game_time_ = carry;
   }
+}
+
+void Refbox::handle_peer(const PeerGameState& p) {
+  if (!awaiting_overtime_decision()) return;
+  const SimTime regular = config_.production_duration;
+  // The other field has finished its regular time when it stands paused at (or beyond) the
+  // regular end, or is already in POST_GAME; one that already plays overtime decided for both.
+  bool start_overtime = false;
+  if ((p.phase == GamePhase::kProduction && p.state == GameState::kPaused &&
+       p.game_time >= regular) ||
+      (p.phase == GamePhase::kPostGame && p.game_time >= regular)) {
+    start_overtime = p.points == points() && points() > 0;
+  } else if (p.phase == GamePhase::kProduction && p.state == GameState::kRunning &&
+             p.game_time > regular) {
+    start_overtime = true;
+  } else {
+    return;  // the other game is still running its regular time
+  }
+  if (start_overtime) {
+    overtime_ = true;
+    attention("Entering overtime (" + std::to_string(config_.overtime_duration.ns() / 1000000000) +
+                  " s): equal points " + std::to_string(points()),
+              15.0);
+    set_state(GameState::kRunning);
+    return;
+  }
+  enter_phase(GamePhase::kPostGame);
+  game_time_ = regular;
 }
 
 void Refbox::set_state(GameState s) {
@@ -234,6 +292,8 @@ void Refbox::enter_phase(GamePhase p) {
   phase_ = p;
   game_time_ = SimTime();
   out_.phase_changed = true;
+  mole_.reset();  // only WHACK_A_MOLE lights a mole, drawn when it runs
+  last_mole_ = DeviceId();
   attention("Switching to " + std::string(to_string(p)), 5.0);
   switch (p) {
     case GamePhase::kSetup:
@@ -252,7 +312,17 @@ void Refbox::enter_phase(GamePhase p) {
 }
 
 void Refbox::parameterise() {
-  params_ = config_.params ? *config_.params : draw_game_params(rng_, rules_);
+  if (synced_params_) {
+    params_ = *synced_params_;
+  } else if (config_.params) {
+    params_ = *config_.params;
+  } else {
+    if (config_.mode == RefBoxMode::kSlave) {
+      attention("Slave refbox has no plan from its master: playing its own", 30.0);
+    }
+    params_ = draw_game_params(rng_, rules_,
+                               config_.synchronised() ? kPlanSynchronisedS : kPlanProductionS);
+  }
   const GameParams& p = *params_;
   for (int i = 0; i < kProductionMachineCount; ++i) machines_[i].type = p.machine_types[i];
   for (int t = 0; t < 5; ++t) signals_[t] = {static_cast<MachineType>(t), p.light_codes[t]};
@@ -281,7 +351,26 @@ void Refbox::parameterise() {
   down_phase_.assign(p.down_times.size(), 0);
 }
 
+SyncResult Refbox::sync_from(const GameParams& master_params) {
+  if (config_.mode != RefBoxMode::kSlave) return {SyncResult::Status::kNotSlave, {}};
+  if (params_) return {SyncResult::Status::kAlreadyParameterised, {}};
+  try {
+    validate_game_params(master_params, "sync",
+                         config_.synchronised() ? kPlanSynchronisedS : kPlanProductionS);
+  } catch (const core::ConfigError& e) {
+    return {SyncResult::Status::kInvalid, e.what()};
+  }
+  synced_params_ = master_params;
+  return {SyncResult::Status::kApplied, {}};
+}
+
+const GameParams& Refbox::sync_params() {
+  if (!params_) parameterise();
+  return *params_;
+}
+
 void Refbox::init_production() {
+  overtime_ = false;
   for (Machine& m : machines_) {
     m.state = MachineState::kIdle;
     m.state_before_down = MachineState::kIdle;
@@ -312,6 +401,18 @@ void Refbox::apply(const Command& c) {
   std::visit(
       Overloaded{
           [&](const command::SetGameState& s) {
+            if (s.state == GameState::kRunning && awaiting_overtime_decision()) {
+              attention("Waiting for the synchronised game to end", 5.0);
+              return;
+            }
+            if (s.state == GameState::kPaused && phase_ == GamePhase::kWhackAMoleChallenge &&
+                state_ == GameState::kRunning && mole_) {
+              // The referee pauses when a robot reached the mole (spec §7): +1; the next mole
+              // lights up when the game resumes.
+              award(1, AwardReason::kMoleReachedReferee, *mole_, OrderId(), PuckId());
+              last_mole_ = *mole_;
+              mole_.reset();
+            }
             if (s.state == GameState::kRunning && phase_ == GamePhase::kPreGame) {
               enter_phase(team_.empty() || config_.skip_setup ? GamePhase::kExploration
                                                               : GamePhase::kSetup);
@@ -864,6 +965,44 @@ void Refbox::set_machine_state(Machine& m, MachineState s, PuckId puck) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Technical challenges: vision poses and whack-a-mole (spec §4, §7)
+// ---------------------------------------------------------------------------------------------
+
+void Refbox::update_vision(std::span<const RobotPose> poses) {
+  for (const RobotPose& rp : poses) {
+    for (Robot& r : robots_) {
+      if (r.number == rp.number && (team_.empty() || r.team == team_)) r.vision_pose = rp.pose;
+    }
+  }
+}
+
+void Refbox::update_whack_a_mole(std::span<const RobotPose> poses) {
+  if (phase_ != GamePhase::kWhackAMoleChallenge || state_ != GameState::kRunning) return;
+  if (!mole_) next_mole();
+  // A robot whose camera pose lies in the box around the mole reaches it: +1, next mole (one
+  // per step; the next mole is another machine, at least 1.12 m away).
+  const core::Pose2D& mp = config_.device_poses[mole_->value()];
+  const double half = rules_.whack_a_mole_box_m / 2.0;
+  for (const RobotPose& rp : poses) {
+    if (std::abs(rp.pose.x - mp.x) <= half && std::abs(rp.pose.y - mp.y) <= half) {
+      award(1, AwardReason::kMoleReached, *mole_, OrderId(), PuckId());
+      last_mole_ = *mole_;
+      next_mole();
+      break;
+    }
+  }
+}
+
+void Refbox::next_mole() {
+  // Uniform among M1..M10 except the previous mole (assumption, docs/refbox.md).
+  const bool have_last = is_production_machine(last_mole_);
+  int k = static_cast<int>(
+      rng_.uniform_int(0, have_last ? kProductionMachineCount - 2 : kProductionMachineCount - 1));
+  if (have_last && k >= last_mole_.value()) ++k;
+  mole_ = DeviceId(k);
+}
+
+// ---------------------------------------------------------------------------------------------
 // Robots
 // ---------------------------------------------------------------------------------------------
 
@@ -900,7 +1039,9 @@ void Refbox::attention(std::string text, double seconds) {
 void Refbox::award(int points, AwardReason reason, DeviceId device, OrderId order, PuckId puck) {
   GamePhase phase = phase_;
   if (reason == AwardReason::kPenaltyMinor || reason == AwardReason::kPenaltyMajor) {
-    if (phase != GamePhase::kExploration) phase = GamePhase::kProduction;
+    if (phase != GamePhase::kExploration && phase != GamePhase::kWhackAMoleChallenge) {
+      phase = GamePhase::kProduction;
+    }
   }
   const PointsAward a{game_time_, phase, points, reason, device, order, puck};
   awards_.push_back(a);
@@ -911,8 +1052,12 @@ void Refbox::award(int points, AwardReason reason, DeviceId device, OrderId orde
 int Refbox::phase_points(GamePhase phase) const { return phase_sums_[phase_slot(phase)]; }
 
 int Refbox::points() const {
+  // Spec §7: the scored phases are EXPLORATION, PRODUCTION and WHACK_A_MOLE_CHALLENGE.
   int total = 0;
-  for (int s : phase_sums_) total += std::max(0, s);
+  for (GamePhase p :
+       {GamePhase::kExploration, GamePhase::kProduction, GamePhase::kWhackAMoleChallenge}) {
+    total += std::max(0, phase_sums_[phase_slot(p)]);
+  }
   return total;
 }
 
@@ -991,6 +1136,11 @@ Lights Refbox::lights_of(const Machine& m) const {
       return params_->light_codes[type_index(m.type)];
     case GamePhase::kPostGame:
       return {kBlink, kOff, kOff};
+    case GamePhase::kOpenChallenge:
+    case GamePhase::kNavigationChallenge:
+      return kAllOff;
+    case GamePhase::kWhackAMoleChallenge:
+      return mole_ && m.id == *mole_ ? kAllOn : kAllOff;
     case GamePhase::kProduction:
       break;
   }
@@ -1059,6 +1209,8 @@ GameReport Refbox::report() const {
   r.seed = seed_;
   r.final_state = state_;
   r.final_phase = phase_;
+  r.mode = config_.mode;
+  r.overtime = overtime_;
   r.params = params_;
   r.awards = awards_;
   for (GamePhase p : kPhases) {
@@ -1103,6 +1255,9 @@ std::uint64_t Refbox::state_hash() const {
     mix(a.game_time.ns());
     mix(a.points);
   }
+  // Only mixed when set, so that hashes of games without them stay as they were.
+  if (mole_) mix(1000 + mole_->value());
+  if (overtime_) mix(2000);
   return h;
 }
 

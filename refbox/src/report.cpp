@@ -85,7 +85,9 @@ std::string to_json(const GameReport& r) {
   o += "{\n  \"rules\": " + quote(r.rules) + ",\n  \"team\": " + quote(r.team) +
        ",\n  \"seed\": " + std::to_string(r.seed) +
        ",\n  \"final_state\": " + quote(to_string(r.final_state)) +
-       ",\n  \"final_phase\": " + quote(to_string(r.final_phase)) + ",\n  \"params\": ";
+       ",\n  \"final_phase\": " + quote(to_string(r.final_phase)) +
+       ",\n  \"mode\": " + quote(to_string(r.mode)) +
+       ",\n  \"overtime\": " + (r.overtime ? "true" : "false") + ",\n  \"params\": ";
   if (r.params) {
     params_json(o, *r.params);
   } else {
@@ -162,6 +164,10 @@ std::string_view to_string(AwardReason r) {
       return "PENALTY_MINOR";
     case AwardReason::kPenaltyMajor:
       return "PENALTY_MAJOR";
+    case AwardReason::kMoleReached:
+      return "MOLE_REACHED";
+    case AwardReason::kMoleReachedReferee:
+      return "MOLE_REACHED_REFEREE";
   }
   return "?";
 }

@@ -45,8 +45,33 @@ std::string_view to_string(GamePhase p) {
       return "PRODUCTION";
     case GamePhase::kPostGame:
       return "POST_GAME";
+    case GamePhase::kOpenChallenge:
+      return "OPEN_CHALLENGE";
+    case GamePhase::kNavigationChallenge:
+      return "NAVIGATION_CHALLENGE";
+    case GamePhase::kWhackAMoleChallenge:
+      return "WHACK_A_MOLE_CHALLENGE";
   }
   return "?";
+}
+
+std::string_view to_string(RefBoxMode m) {
+  switch (m) {
+    case RefBoxMode::kStandalone:
+      return "STANDALONE";
+    case RefBoxMode::kMaster:
+      return "MASTER";
+    case RefBoxMode::kSlave:
+      return "SLAVE";
+  }
+  return "?";
+}
+
+std::optional<RefBoxMode> refbox_mode_from_string(std::string_view s) {
+  for (RefBoxMode m : {RefBoxMode::kStandalone, RefBoxMode::kMaster, RefBoxMode::kSlave}) {
+    if (to_string(m) == s) return m;
+  }
+  return std::nullopt;
 }
 
 std::string_view to_string(PuckState s) {

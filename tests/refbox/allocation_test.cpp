@@ -73,3 +73,38 @@ TEST_CASE("Refbox::step allocates only in steps that announce something") {
   CHECK(quiet_steps_allocating == 0);
   CHECK(busy_allocations > 0);  // the counter works
 }
+
+TEST_CASE("Refbox::step does not allocate during a whack-a-mole challenge") {
+  RefboxConfig cfg;
+  cfg.team = "Carologistics";
+  Refbox rb(cfg, core::Rng(12));
+  std::vector<Command> cmds;
+  cmds.emplace_back(std::in_place_type<command::SetGamePhase>,
+                    command::SetGamePhase{GamePhase::kWhackAMoleChallenge});
+  cmds.emplace_back(std::in_place_type<command::SetGameState>,
+                    command::SetGameState{GameState::kRunning});
+  StepInput in;
+  in.commands = cmds;
+  SimTime now;
+  rb.step(now, in);
+  std::vector<RobotPose> poses(2);
+  int steps = 0, quiet_steps_allocating = 0;
+  while (rb.phase() == GamePhase::kWhackAMoleChallenge) {
+    now += SimTime::from_ms(10);
+    // Robot 1 reaches the mole every 2 s; robot 2 stands somewhere else.
+    poses[0] = {1, {0.1, 0.1, 0.0}};
+    if (steps % 200 == 199 && rb.mole()) poses[0].pose = cfg.device_poses[rb.mole()->value()];
+    poses[1] = {2, {0.8, 0.8, 0.0}};
+    in = StepInput{};
+    in.robot_poses = poses;
+    g_allocations = 0;
+    g_counting = true;
+    const StepOutput& out = rb.step(now, in);
+    g_counting = false;
+    ++steps;
+    if (out.attention.empty() && g_allocations > 0) ++quiet_steps_allocating;
+  }
+  CHECK(steps == 30000);
+  CHECK(rb.points() == 149);  // every 200th step; the 150th falls on the step that ends it
+  CHECK(quiet_steps_allocating == 0);
+}

@@ -31,6 +31,13 @@ inline GameParams test_params() {
   return p;
 }
 
+/// test_params() with the gate schedule extended to 1200 s (D1 900-1200) for synchronised games.
+inline GameParams test_params_synchronised() {
+  GameParams p = test_params();
+  p.gate_schedule.push_back({DeviceId(kD1), 900, 1200});
+  return p;
+}
+
 inline RefboxConfig test_config(std::string_view rules = kRulesRefbox061) {
   RefboxConfig c;
   c.rules = std::string(rules);
@@ -63,6 +70,12 @@ class Game {
   }
   void beacon(Beacon b) { beacons_.push_back(std::move(b)); }
   void report(MachineReport r) { reports_.push_back(std::move(r)); }
+  /// Queues an overhead-camera pose of robot `number` for the next step.
+  void vision(int number, double x, double y) { poses_.push_back({number, {x, y, 0.0}}); }
+  /// Passes the other field's GameState with the next step (synchronised mode).
+  void peer(GamePhase phase, GameState state, double game_time_s, int points) {
+    peer_ = PeerGameState{phase, state, SimTime::from_seconds(game_time_s), points};
+  }
 
   /// One step of `dt` with everything queued.
   const StepOutput& step(SimTime dt = kStep) {
@@ -73,7 +86,11 @@ class Game {
     in.beacons = beacons_;
     in.reports = reports_;
     in.insertion_slot_occupied = slot_occupied;
+    in.robot_poses = poses_;
+    in.peer_game_state = peer_;
     const StepOutput& out = rb.step(now, in);
+    poses_.clear();
+    peer_.reset();
     rfid_.clear();
     cmds_.clear();
     beacons_.clear();
@@ -129,6 +146,8 @@ class Game {
   std::vector<Command> cmds_;
   std::vector<Beacon> beacons_;
   std::vector<MachineReport> reports_;
+  std::vector<RobotPose> poses_;
+  std::optional<PeerGameState> peer_;
 };
 
 }  // namespace llsf::refbox::test

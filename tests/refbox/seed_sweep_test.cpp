@@ -127,6 +127,9 @@ bool allowed_value(const PointsAward& a, const RulesVariant& v) {
     case AwardReason::kPenaltyMinor:
     case AwardReason::kPenaltyMajor:
       return a.points < 0;
+    case AwardReason::kMoleReached:
+    case AwardReason::kMoleReachedReferee:
+      return a.points == 1;
   }
   return false;
 }

@@ -33,11 +33,21 @@ struct RefboxConfig {
   bool learn_unknown_pucks = true;
   /// An explicit parameterisation; without it the game draws one from rng.stream("refbox").
   std::optional<GameParams> params;
+  /// STANDALONE, or MASTER / SLAVE of a synchronised two-field play-off game (spec §10). Any
+  /// mode but STANDALONE is synchronised play: production pauses at its regular end and waits
+  /// for the other field (StepInput::peer_game_state) to decide on overtime, and a drawn gate
+  /// schedule covers kPlanSynchronisedS (1200 s). A SLAVE takes the master's plan (params or
+  /// Refbox::sync_from()).
+  RefBoxMode mode = RefBoxMode::kStandalone;
+  /// Overtime of a synchronised game with equal non-zero points (spec §10: 300 s).
+  SimTime overtime_duration = SimTime::from_sec(kOvertimeS);
   /// Device poses (for ExplorationMachine and MachineInfo), in DeviceId order; spec §1 table.
   std::array<core::Pose2D, kDeviceCount> device_poses = default_device_poses();
 
   /// Throws core::ConfigError naming the first bad field ("refbox.production_s: must be > 0").
   void validate() const;
+  /// True in MASTER and SLAVE mode (synchronised play-off game with overtime).
+  bool synchronised() const { return mode != RefBoxMode::kStandalone; }
   /// The device poses of the spec's table (RBX facts.clp).
   static std::array<core::Pose2D, kDeviceCount> default_device_poses();
 };

@@ -102,6 +102,22 @@ struct MachineReport {
   std::vector<MachineReportEntry> machines;
 };
 
+/// A robot pose seen by the overhead camera (the world reports it; spec §7 whack-a-mole,
+/// Robot.vision_pose). Keyed by jersey number.
+struct RobotPose {
+  int number = 0;     ///< jersey number of a robot of this field's team
+  core::Pose2D pose;  ///< field frame, metres and radians
+};
+
+/// The GameState last received from the other refbox of a synchronised game (spec §10): what
+/// the engine needs to decide on overtime.
+struct PeerGameState {
+  GamePhase phase = GamePhase::kPreGame;
+  GameState state = GameState::kInit;
+  SimTime game_time;  ///< phase-relative, as in GameState.game_time
+  int points = 0;
+};
+
 /// Everything that reaches the refbox during one step. Spans borrow the caller's storage.
 struct StepInput {
   std::span<const RfidEvent> rfid;
@@ -110,6 +126,12 @@ struct StepInput {
   std::span<const MachineReport> reports;
   /// True if a puck lies in the late-order insertion slot (the world knows, the refbox does not).
   bool insertion_slot_occupied = false;
+  /// Overhead-camera poses of the robots this step (optional; scores whack-a-mole, stored as
+  /// Robot::vision_pose).
+  std::span<const RobotPose> robot_poses;
+  /// Synchronised mode (MASTER/SLAVE): the other field's latest GameState, if one arrived
+  /// (decides overtime at the end of regular production).
+  std::optional<PeerGameState> peer_game_state;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -129,6 +151,8 @@ enum class AwardReason : std::uint8_t {
   kDeliveryIntermediate,     ///< S0/S1/S2 at a gate (0)
   kPenaltyMinor,             ///< referee: −25 %, at least −1
   kPenaltyMajor,             ///< referee: −50 %, at least −5
+  kMoleReached,              ///< whack-a-mole: a robot's vision pose in the mole's box (+1)
+  kMoleReachedReferee,       ///< whack-a-mole: the referee paused on the mole (+1)
 };
 /// "EXPLORATION_CORRECT", ...
 std::string_view to_string(AwardReason r);

@@ -38,8 +38,12 @@ inline constexpr int kOrderCount = kRegularOrderCount + kLateOrderCount;
 /// Length of a late order's delivery window.
 inline constexpr int kLateOrderWindowS = 120;
 /// Production length the plan is made for (the schedule covers it even if a config shortens
-/// the phase; a synchronised play-off game would use 1200 s).
+/// the phase).
 inline constexpr int kPlanProductionS = 900;
+/// Overtime of a synchronised play-off game with equal non-zero points (spec §10).
+inline constexpr int kOvertimeS = 300;
+/// Production length a synchronised (MASTER/SLAVE) plan's gate schedule covers (spec §8).
+inline constexpr int kPlanSynchronisedS = kPlanProductionS + kOvertimeS;
 /// Default order quantities of RBX (used by quirk 1 when T5 received no down time).
 inline constexpr std::array<int, kRegularOrderCount> kDefaultOrderQuantities = {3, 2, 4, 1, 6,
                                                                                 2, 3, 3, 3};
@@ -67,10 +71,18 @@ struct GameParams {
 /// Draws a game's parameterisation as RBX 0.6.1 does (spec §2.1, §5, §6, §8), from `stream`
 /// (the engine passes rng.stream("refbox")). Deterministic in the stream's state.
 GameParams draw_game_params(core::RandomStream& stream, const RulesVariant& rules);
+/// As above, with the gate schedule covering `gate_schedule_end_s` (kPlanProductionS, or
+/// kPlanSynchronisedS in synchronised mode; its last period is stretched to that end). Down
+/// times and late orders stay within kPlanProductionS. With kPlanProductionS the draws are
+/// exactly those of the two-argument form.
+GameParams draw_game_params(core::RandomStream& stream, const RulesVariant& rules,
+                            int gate_schedule_end_s);
 
 /// Throws core::ConfigError "<path>.<field>: reason" if `p` breaks the spec's structure
 /// (type counts, distinct non-empty codes, positive times, window and schedule ranges).
 void validate_game_params(const GameParams& p, const std::string& path = "params");
+/// As above, requiring the gate schedule to cover at least `gate_schedule_end_s`.
+void validate_game_params(const GameParams& p, const std::string& path, int gate_schedule_end_s);
 
 /// The 7 steady exploration light codes in RBX order: G, Y, GY, R, RG, RY, RYG.
 const std::array<Lights, 7>& exploration_light_codes();

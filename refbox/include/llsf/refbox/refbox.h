@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <optional>
 #include <span>
 #include <string>
@@ -88,6 +89,8 @@ struct Robot {
   int port = 0;
   SimTime last_seen;  ///< simulated receive time of the last beacon
   std::optional<core::Pose2D> pose;
+  /// Last overhead-camera pose (StepInput::robot_poses), if any (Robot.vision_pose).
+  std::optional<core::Pose2D> vision_pose;
   RobotState state = RobotState::kActive;
   bool lost = false;  ///< no beacon for robot_lost_after (warned once)
   int maintenance_cycles = 0;
@@ -104,6 +107,19 @@ struct ExplorationSignal {
   Lights lights;
 };
 
+/// What Refbox::sync_from() did with a master's plan.
+struct SyncResult {
+  enum class Status : std::uint8_t {
+    kApplied,               ///< the slave will play this plan
+    kNotSlave,              ///< only a SLAVE takes a master's plan; nothing changed
+    kAlreadyParameterised,  ///< the game has its plan already (it left PRE_GAME); nothing changed
+    kInvalid,  ///< the plan breaks the spec's structure (see `reason`); nothing changed
+  };
+  Status status = Status::kApplied;
+  std::string reason;  ///< for kInvalid: the validation message
+  bool ok() const { return status == Status::kApplied; }
+};
+
 /// The referee box. Copyable (a copy continues identically), so snapshots are plain copies.
 class Refbox {
  public:
@@ -111,16 +127,39 @@ class Refbox {
   Refbox(RefboxConfig config, const core::Rng& rng);
 
   /// Advances to simulated time `now` (>= the previous now) and processes `in`. Tick order:
-  /// 1. game time advances by the elapsed time if RUNNING, phases end and switch;
-  /// 2. controller commands, in order; 3. beacons and machine reports;
+  /// 1. game time advances by the elapsed time if RUNNING, phases end and switch; the peer's
+  /// GameState may decide overtime (synchronised mode);
+  /// 2. controller commands, in order; 3. beacons and machine reports, vision poses and
+  /// whack-a-mole;
   /// 4. RFID events; 5. scheduled rules of PRODUCTION (down times, gates, late orders, pending
   /// deliveries, processing ends); 6. the machines poll their readers; 7. robots (lost,
   /// maintenance); 8. lights. Returns this step's outputs (valid until the next step).
   const StepOutput& step(SimTime now, const StepInput& in);
 
+  // --- master/slave synchronisation (spec §10) -------------------------------------------------
+  /// SLAVE: plays `master_params` (the SyncInfo content of the master) instead of drawing a plan.
+  /// Accepted until the game leaves PRE_GAME; validated like a config's params (in synchronised
+  /// mode the gate schedule must cover kPlanSynchronisedS). Returns what happened.
+  SyncResult sync_from(const GameParams& master_params);
+  /// The plan to send in SyncInfo (MASTER). Fixes the plan now if the game has none yet: the
+  /// same plan the game would draw on leaving PRE_GAME, so calling it changes nothing else.
+  const GameParams& sync_params();
+
   // --- snapshot (everything the 2013 messages need) --------------------------------------------
   const RefboxConfig& config() const { return config_; }
   const RulesVariant& rules() const { return rules_; }
+  /// GameState.refbox_mode (from the config).
+  RefBoxMode mode() const { return config_.mode; }
+  /// True while a synchronised game plays its overtime (PRODUCTION beyond the regular end).
+  bool overtime() const { return overtime_; }
+  /// True while a synchronised game stands PAUSED at the regular production end, waiting for
+  /// the other field's GameState to decide between overtime and POST_GAME.
+  bool awaiting_overtime_decision() const;
+  /// The machine the robots have to reach (WHACK_A_MOLE_CHALLENGE, while one is lit).
+  std::optional<DeviceId> mole() const { return mole_; }
+  /// Length of `phase` in game time (0 for untimed phases); PRODUCTION includes the overtime
+  /// once it has started.
+  SimTime phase_duration(GamePhase p) const;
   SimTime now() const { return now_; }
   GameState state() const { return state_; }
   GamePhase phase() const { return phase_; }
@@ -165,7 +204,12 @@ class Refbox {
   void enter_phase(GamePhase p);
   void parameterise();
   void init_production();
-  SimTime phase_duration(GamePhase p) const;
+  bool timed(GamePhase p) const { return phase_duration(p) > SimTime(); }
+  void handle_peer(const PeerGameState& p);
+  // Technical challenges.
+  void update_vision(std::span<const RobotPose> poses);
+  void update_whack_a_mole(std::span<const RobotPose> poses);
+  void next_mole();
   // Inputs.
   void apply(const Command& c);
   void handle_beacon(const Beacon& b);
@@ -217,10 +261,17 @@ class Refbox {
   std::string team_;
   bool setup_warned_ = false;
   std::optional<GameParams> params_;
+  /// A master's plan taken by sync_from() (SLAVE).
+  std::optional<GameParams> synced_params_;
+  /// Synchronised mode: the overtime is being played.
+  bool overtime_ = false;
+  /// Whack-a-mole: the lit machine, and the previous one (never drawn twice in a row).
+  std::optional<DeviceId> mole_;
+  DeviceId last_mole_;
   std::array<ExplorationSignal, 5> signals_{};
   bool slot_occupied_ = false;
   /// Raw points per phase, indexed by phase_slot().
-  std::array<int, 5> phase_sums_{};
+  std::array<int, 8> phase_sums_{};
   /// (host:port) of other refboxes already warned about.
   std::vector<std::string> warned_refboxes_;
 

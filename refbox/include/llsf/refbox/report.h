@@ -63,6 +63,8 @@ struct GameReport {
   std::uint64_t seed = 0;
   GameState final_state = GameState::kInit;
   GamePhase final_phase = GamePhase::kPreGame;
+  RefBoxMode mode = RefBoxMode::kStandalone;
+  bool overtime = false;  ///< a synchronised game played its overtime
   std::optional<GameParams> params;
   std::vector<PointsAward> awards;
   std::vector<PhaseTotal> phase_totals;  ///< EXPLORATION, PRODUCTION (and any other with awards)

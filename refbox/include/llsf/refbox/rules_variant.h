@@ -64,6 +64,14 @@ struct RulesVariant {
   core::SimTime delivery_time = core::SimTime::from_sec(1);
   /// How long attention messages about late orders are shown.
   double late_order_attention_s = 15.0;
+
+  // --- technical challenges (spec §4, §7) ----------------------------------------------------
+  /// Length of NAVIGATION_CHALLENGE and WHACK_A_MOLE_CHALLENGE (game time while RUNNING).
+  core::SimTime navigation_challenge_duration = core::SimTime::from_sec(60);
+  core::SimTime whack_a_mole_duration = core::SimTime::from_sec(300);
+  /// Side of the square box around the mole machine (centred on its pose) in which a robot's
+  /// vision pose counts as reaching it, metres (0.65 x 0.65 m).
+  double whack_a_mole_box_m = 0.65;
 };
 
 /// Names accepted by make_rules_variant().

@@ -21,14 +21,20 @@ using core::SimTime;
 
 /// GameState.State of the 2013 protocol.
 enum class GameState : std::uint8_t { kInit = 0, kWaitStart = 1, kRunning = 2, kPaused = 3 };
-/// GameState.Phase of the 2013 protocol (the technical-challenge phases are not modelled).
+/// GameState.Phase of the 2013 protocol, including the technical-challenge phases (spec §4).
 enum class GamePhase : std::uint16_t {
   kPreGame = 0,
   kSetup = 10,
   kExploration = 20,
   kProduction = 30,
-  kPostGame = 40
+  kPostGame = 40,
+  kOpenChallenge = 1000,
+  kNavigationChallenge = 1001,
+  kWhackAMoleChallenge = 1002
 };
+/// GameState.RefBoxMode of the 2013 protocol: a refbox alone, or the master / a slave of a
+/// synchronised two-field play-off game (spec §10).
+enum class RefBoxMode : std::uint8_t { kStandalone = 0, kMaster = 1, kSlave = 2 };
 /// PuckState of the 2013 protocol (there is no value 3).
 enum class PuckState : std::uint8_t {
   kS0 = 0,
@@ -93,6 +99,16 @@ inline bool blink_phase_on(SimTime now) { return (now.ns() / (kBlinkPeriod.ns() 
 std::string_view to_string(GameState s);
 /// "PRE_GAME", "SETUP", ... (protocol enum names).
 std::string_view to_string(GamePhase p);
+/// "STANDALONE", "MASTER", "SLAVE" (protocol enum names).
+std::string_view to_string(RefBoxMode m);
+/// Parses a name of to_string(RefBoxMode).
+std::optional<RefBoxMode> refbox_mode_from_string(std::string_view s);
+/// True for the technical-challenge phases OPEN_CHALLENGE, NAVIGATION_CHALLENGE and
+/// WHACK_A_MOLE_CHALLENGE.
+inline bool is_challenge(GamePhase p) {
+  return p == GamePhase::kOpenChallenge || p == GamePhase::kNavigationChallenge ||
+         p == GamePhase::kWhackAMoleChallenge;
+}
 /// "S0", ..., "CONSUMED", "FINISHED".
 std::string_view to_string(PuckState s);
 /// "OFF", "ON", "BLINK".
