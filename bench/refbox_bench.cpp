@@ -128,3 +128,47 @@ LLSF_BENCH(refbox_step,
   bench::report("refbox_step", "rfid_events_per_s", rec.rfid.size() / (steps / 100.0), "1/s");
   bench::report("refbox_step", "game_points", points, "points");
 }
+
+namespace {
+
+/// CPU microseconds per step of a whole WHACK_A_MOLE_CHALLENGE at 100 Hz with three robots'
+/// camera poses every step; one robot reaches the mole every 5 s. Also returns the points.
+double whack_a_mole_us_per_step(std::uint64_t seed, int* points) {
+  const RefboxConfig cfg = bench_config();
+  Refbox rb(cfg, core::Rng(seed));
+  std::vector<Command> start;
+  start.emplace_back(std::in_place_type<command::SetGamePhase>,
+                     command::SetGamePhase{GamePhase::kWhackAMoleChallenge});
+  start.emplace_back(std::in_place_type<command::SetGameState>,
+                     command::SetGameState{GameState::kRunning});
+  StepInput in;
+  in.commands = start;
+  SimTime now;
+  rb.step(now, in);
+  std::vector<RobotPose> poses = {{1, {0.8, 0.8, 0.0}}, {2, {0.8, 4.5, 0.0}}, {3, {4.6, 4.6, 0.0}}};
+  int steps = 0;
+  const double t0 = bench::cpu_seconds();
+  while (rb.phase() == GamePhase::kWhackAMoleChallenge) {
+    now += kStep;
+    ++steps;
+    poses[0].pose = core::Pose2D{0.8, 0.8, 0.0};
+    if (steps % 500 == 0 && rb.mole()) poses[0].pose = cfg.device_poses[rb.mole()->value()];
+    StepInput s;
+    s.robot_poses = poses;
+    rb.step(now, s);
+  }
+  const double us = (bench::cpu_seconds() - t0) * 1e6 / steps;
+  *points = rb.points();
+  return us;
+}
+
+}  // namespace
+
+LLSF_BENCH(refbox_step_whack_a_mole,
+           "Refbox::step at 100 Hz over a whole WHACK_A_MOLE_CHALLENGE, 3 robots' vision poses") {
+  int points = 0;
+  const double us =
+      bench::median_of(kRepeats, [&] { return whack_a_mole_us_per_step(7, &points); });
+  bench::report("refbox_step_whack_a_mole", "us_per_step", us, "us");
+  bench::report("refbox_step_whack_a_mole", "game_points", points, "points");
+}

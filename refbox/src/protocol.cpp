@@ -344,7 +344,7 @@ struct RefboxProtocol::Pools {
 RefboxProtocol::RefboxProtocol(RefboxConfig config, const core::Rng& rng, ProtocolConfig protocol)
     : config_(std::move(protocol)),
       refbox_(std::move(config), rng),
-      pools_(std::make_shared<Pools>()) {
+      pools_(std::make_unique<Pools>()) {
   config_.validate();
   commands_.reserve(8);
   beacons_.reserve(8);
@@ -356,6 +356,8 @@ RefboxProtocol::RefboxProtocol(RefboxConfig config, const core::Rng& rng, Protoc
   static const StepOutput kNoOutput{};
   engine_out_ = &kNoOutput;
 }
+
+RefboxProtocol::~RefboxProtocol() = default;
 
 void RefboxProtocol::client_connected(int client) {
   if (std::find(clients_.begin(), clients_.end(), client) != clients_.end()) return;
@@ -402,11 +404,11 @@ ReceiveResult RefboxProtocol::reject(std::string reason) {
 
 ReceiveResult RefboxProtocol::illegal(const char* what, const Origin& from, bool applied) {
   std::string reason = std::string("Illegal ") + what + " message received from " +
-                       origin_label(from) + (applied ? " (applied anyway, as refbox 0.6.1 does)"
-                                                     : " (controller messages only via stream)");
+                       origin_label(from) +
+                       (applied ? " (applied anyway, as refbox 0.6.1 does)"
+                                : " (controller messages only via stream)");
   log(Level::kWarn, reason);
-  return {applied ? ReceiveStatus::kAcceptedIllegal : ReceiveStatus::kRejected,
-          std::move(reason)};
+  return {applied ? ReceiveStatus::kAcceptedIllegal : ReceiveStatus::kRejected, std::move(reason)};
 }
 
 ReceiveResult RefboxProtocol::receive(const Message& msg, const Origin& from) {
@@ -486,7 +488,8 @@ ReceiveResult RefboxProtocol::receive(const Message& msg, const Origin& from) {
 
   // Robots: beacons (UDP only) and exploration reports (any channel).
   if (const auto* m = as(msg, p.in_beacon)) {
-    if (stream) return reject("BeaconSignal is only accepted via UDP (from " + origin_label(from) + ")");
+    if (stream)
+      return reject("BeaconSignal is only accepted via UDP (from " + origin_label(from) + ")");
     if (!fits_int(m->number())) {
       return reject("BeaconSignal.number " + std::to_string(m->number()) + " out of range");
     }
@@ -518,11 +521,10 @@ ReceiveResult RefboxProtocol::receive(const Message& msg, const Origin& from) {
     const auto same = [&](const std::string& h, int port) {
       return h == from.host && port == from.port;
     };
-    const bool known =
-        std::any_of(refbox_.robots().begin(), refbox_.robots().end(),
-                    [&](const Robot& r) { return same(r.host, r.port); }) ||
-        std::any_of(pending_sources_.begin(), pending_sources_.end(),
-                    [&](const auto& s) { return same(s.first, s.second); });
+    const bool known = std::any_of(refbox_.robots().begin(), refbox_.robots().end(),
+                                   [&](const Robot& r) { return same(r.host, r.port); }) ||
+                       std::any_of(pending_sources_.begin(), pending_sources_.end(),
+                                   [&](const auto& s) { return same(s.first, s.second); });
     if (!known && !refbox_beacon) {
       pending_sources_.emplace_back(from.host, from.port);
       version_burst_requested_ = true;
@@ -582,8 +584,8 @@ ReceiveResult RefboxProtocol::receive(const Message& msg, const Origin& from) {
       return reject("SetRobotMaintenance.robot_number " + std::to_string(m->robot_number()) +
                     " out of range");
     }
-    queue_command(command::SetRobotMaintenance{static_cast<int>(m->robot_number()),
-                                               m->maintenance()});
+    queue_command(
+        command::SetRobotMaintenance{static_cast<int>(m->robot_number()), m->maintenance()});
     return {};
   }
 
@@ -637,7 +639,8 @@ ReceiveResult RefboxProtocol::receive(const Message& msg, const Origin& from) {
     command::SetPucks c;
     c.ids.reserve(std::size_t(m->ids_size()));
     for (std::uint32_t id : m->ids()) {
-      if (id == 0 || !fits_int(id)) return reject("SetPucks: invalid puck id " + std::to_string(id));
+      if (id == 0 || !fits_int(id))
+        return reject("SetPucks: invalid puck id " + std::to_string(id));
       if (std::find(c.ids.begin(), c.ids.end(), int(id)) != c.ids.end()) {
         return reject("SetPucks: puck id " + std::to_string(id) + " given twice");
       }
@@ -993,7 +996,7 @@ void to_sync_info(const GameParams& params, llsf_msgs::SyncInfo& out) {
   for (int i = 0; i < kRegularOrderCount; ++i) {
     auto* o = out.add_orders();
     o->set_id(static_cast<std::uint32_t>(i + 1));
-    o->set_product(i % 3 == 0 ? llsf_msgs::Order::P1
+    o->set_product(i % 3 == 0   ? llsf_msgs::Order::P1
                    : i % 3 == 1 ? llsf_msgs::Order::P2
                                 : llsf_msgs::Order::P3);
     o->set_quantity_requested(static_cast<std::uint32_t>(params.order_quantities[std::size_t(i)]));
@@ -1137,7 +1140,8 @@ std::optional<GameParams> from_sync_info(const llsf_msgs::SyncInfo& in, std::str
     const auto dev = device_by_name(g.machine_name());
     const auto from = whole_seconds(g.gt_from());
     const auto to = whole_seconds(g.gt_to());
-    if (!dev || !is_gate(*dev)) return fail("delivery_gates: unknown gate '" + g.machine_name() + "'");
+    if (!dev || !is_gate(*dev))
+      return fail("delivery_gates: unknown gate '" + g.machine_name() + "'");
     if (!from || !to) return fail("delivery_gates: " + g.machine_name() + ": bad game times");
     p.gate_schedule.push_back({*dev, *from, *to});
   }

@@ -47,8 +47,7 @@ struct Sent {
 /// Drives a RefboxProtocol at 10 ms steps from t = 0 and records every outgoing message.
 class Harness {
  public:
-  explicit Harness(RefboxConfig cfg = test_config(), ProtocolConfig pc = {},
-                   SimTime dt = kStep)
+  explicit Harness(RefboxConfig cfg = test_config(), ProtocolConfig pc = {}, SimTime dt = kStep)
       : p(std::move(cfg), core::Rng(1), std::move(pc)), dt_(dt) {}
 
   /// One step at `next`.
@@ -69,7 +68,9 @@ class Harness {
     REQUIRE(pred());
   }
 
-  ReceiveResult tcp(const Message& m, int client = 1) { return p.receive(m, Origin::stream(client)); }
+  ReceiveResult tcp(const Message& m, int client = 1) {
+    return p.receive(m, Origin::stream(client));
+  }
   ReceiveResult udp(const Message& m, const char* host = "172.26.1.1", int port = 4444) {
     return p.receive(m, Origin::peer(host, port));
   }
@@ -193,11 +194,14 @@ void check_times(const std::vector<double>& got, const std::vector<double>& want
 }  // namespace
 
 TEST_CASE("protocol: enum conversions cover every §9.4 value") {
-  const std::vector<std::pair<GamePhase, int>> phases = {
-      {GamePhase::kPreGame, 0},         {GamePhase::kSetup, 10},
-      {GamePhase::kExploration, 20},    {GamePhase::kProduction, 30},
-      {GamePhase::kPostGame, 40},       {GamePhase::kOpenChallenge, 1000},
-      {GamePhase::kNavigationChallenge, 1001}, {GamePhase::kWhackAMoleChallenge, 1002}};
+  const std::vector<std::pair<GamePhase, int>> phases = {{GamePhase::kPreGame, 0},
+                                                         {GamePhase::kSetup, 10},
+                                                         {GamePhase::kExploration, 20},
+                                                         {GamePhase::kProduction, 30},
+                                                         {GamePhase::kPostGame, 40},
+                                                         {GamePhase::kOpenChallenge, 1000},
+                                                         {GamePhase::kNavigationChallenge, 1001},
+                                                         {GamePhase::kWhackAMoleChallenge, 1002}};
   for (const auto& [ph, n] : phases) {
     CHECK(int(to_msg_phase(ph)) == n);
     CHECK(from_msg_phase(n) == ph);
@@ -579,11 +583,12 @@ TEST_CASE("protocol: a late order restarts the OrderInfo burst") {
     return -1.0;
   }();
   REQUIRE(first_with_10 > 190);
-  const auto burst = h.times<llsf_msgs::OrderInfo>(Kind::kAllPeers, first_with_10, first_with_10 + 4.6);
+  const auto burst =
+      h.times<llsf_msgs::OrderInfo>(Kind::kAllPeers, first_with_10, first_with_10 + 4.6);
   CHECK(burst.size() == 10);
   // Before it, the regular 5 s rhythm.
-  const auto before = h.times<llsf_msgs::OrderInfo>(Kind::kAllPeers, first_with_10 - 20,
-                                                    first_with_10 - 1e-6);
+  const auto before =
+      h.times<llsf_msgs::OrderInfo>(Kind::kAllPeers, first_with_10 - 20, first_with_10 - 1e-6);
   CHECK(before.size() == 4);
 }
 
@@ -817,8 +822,7 @@ TEST_CASE("protocol: a short game driven only by messages") {
   // for an S1; the S1 under M2 completes the T2 (20 s): S2, +4.
   CHECK(h.tcp(puck_cmd<llsf_msgs::PlacePuckUnderMachine>("M1", 1)).status ==
         ReceiveStatus::kAccepted);
-  CHECK(h.tcp(puck_cmd<llsf_msgs::LoadPuckInMachine>("M2", 2)).status ==
-        ReceiveStatus::kAccepted);
+  CHECK(h.tcp(puck_cmd<llsf_msgs::LoadPuckInMachine>("M2", 2)).status == ReceiveStatus::kAccepted);
   h.run_s(4.5);
   CHECK(h.p.refbox().puck_state(PuckId(1)) == PuckState::kS1);
   CHECK(h.p.refbox().machine(M(2)).state == MachineState::kWaiting);
@@ -893,7 +897,8 @@ TEST_CASE("protocol: bad ProtocolConfig is refused at construction") {
                        "protocol.order_info_period: must be > 0", core::ConfigError);
 }
 
-TEST_CASE("protocol: GameState.refbox_mode follows the engine's mode; vision poses reach RobotInfo") {
+TEST_CASE(
+    "protocol: GameState.refbox_mode follows the engine's mode; vision poses reach RobotInfo") {
   RefboxConfig cfg = test_config();
   cfg.mode = RefBoxMode::kMaster;
   cfg.params.reset();  // a synchronised plan covers the overtime; let the engine draw one
@@ -1005,12 +1010,16 @@ TEST_CASE("protocol: master/slave: InitiateSync, SyncInfo, GameState between the
   CHECK(*slave.refbox().params() == *master.refbox().params());
   // At the regular end both pause; each one's GameState tells the other that the game is over
   // with 0 : 0 points, so no overtime: POST_GAME.
-  while (t < SimTime::from_sec(3 + 10) + SimTime::from_ms(50)) relay();
-  CHECK(master.refbox().awaiting_overtime_decision());
-  CHECK(slave.refbox().awaiting_overtime_decision());
   while (t < SimTime::from_sec(3 + 13)) relay();
   CHECK(master.refbox().phase() == GamePhase::kPostGame);
   CHECK(slave.refbox().phase() == GamePhase::kPostGame);
+  // Without the other's GameState a master keeps waiting.
+  RefboxProtocol lone(mc, core::Rng(1));
+  lone.receive(set_phase(llsf_msgs::GameState::PRODUCTION), Origin::stream(1));
+  lone.receive(set_state(llsf_msgs::GameState::RUNNING), Origin::stream(1));
+  for (SimTime u; u < SimTime::from_sec(13); u += kStep) lone.step(u, {});
+  CHECK(lone.refbox().phase() == GamePhase::kProduction);
+  CHECK(lone.refbox().awaiting_overtime_decision());
   // Once the game left PRE_GAME, a SyncInfo is refused with the engine's reason.
   llsf_msgs::SyncInfo again;
   to_sync_info(*master.refbox().params(), again);

@@ -96,7 +96,7 @@ struct ReceiveResult {
 /// A line of the adapter's log (sent as llsf_log_msgs.LogMessage when enabled).
 struct ProtocolLogLine {
   enum class Level : std::uint8_t { kDebug = 0, kInfo = 1, kWarn = 2, kError = 4 };
-  SimTime time;  ///< simulated time of the step it belongs to
+  SimTime time;  ///< simulated time of the last step when it was written
   Level level = Level::kInfo;
   std::string text;
 };
@@ -153,11 +153,18 @@ std::optional<GameState> from_msg_state(int state);
 
 /// The referee box as a protocol endpoint: owns a Refbox, turns accepted messages into its
 /// inputs (spec §9.7) and its snapshot into the messages of spec §9.6, on their schedule in
-/// simulated time. Single-threaded; copyable (a copy shares already sent, immutable messages).
+/// simulated time. Single-threaded. Neither copyable nor movable: engine_output() refers into
+/// the owned engine (take a snapshot with `Refbox(refbox())`; hold the adapter in place or in a
+/// unique_ptr).
 class RefboxProtocol {
  public:
   /// Builds the engine from `config` and `rng` (as Refbox does) and validates `protocol`.
   RefboxProtocol(RefboxConfig config, const core::Rng& rng, ProtocolConfig protocol = {});
+  ~RefboxProtocol();
+  RefboxProtocol(const RefboxProtocol&) = delete;
+  RefboxProtocol& operator=(const RefboxProtocol&) = delete;
+  RefboxProtocol(RefboxProtocol&&) = delete;
+  RefboxProtocol& operator=(RefboxProtocol&&) = delete;
 
   /// Takes a message that arrived from `from`, checks it against spec §9.7 (channel, fields,
   /// phase) and queues it for the next step. Never throws on bad content.
@@ -176,9 +183,9 @@ class RefboxProtocol {
 
   /// Runs the engine to simulated time `now` (never decreasing) with the received messages and
   /// `world`, then emits every message that is due. Returns the messages, valid until the next
-  /// step. Order within a step: connect greetings, BeaconSignal, VersionInfo, GameState,
-  /// ExplorationInfo, MachineReportInfo, MachineInfo (robot, controller), OrderInfo, RobotInfo
-  /// (stream, peers), PuckInfo, AttentionMessage, LogMessage.
+  /// step. Order within a step: connect greetings, InitiateSync / SyncInfo, BeaconSignal,
+  /// VersionInfo, GameState, ExplorationInfo, MachineReportInfo, MachineInfo (robot,
+  /// controller), OrderInfo, RobotInfo (stream, peers), PuckInfo, AttentionMessage, LogMessage.
   std::span<const Outgoing> step(SimTime now, const WorldInputs& world);
 
   /// The messages of the last step.
@@ -242,7 +249,7 @@ class RefboxProtocol {
   ProtocolConfig config_;
   Refbox refbox_;
   const StepOutput* engine_out_ = nullptr;
-  std::shared_ptr<Pools> pools_;
+  std::unique_ptr<Pools> pools_;
   SimTime now_;
   bool stepped_ = false;
   std::uint64_t beacon_seq_ = 0;
