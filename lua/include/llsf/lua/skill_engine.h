@@ -1,0 +1,127 @@
+// SPDX-License-Identifier: MIT
+// The skill engine: one sandboxed Lua 5.4 interpreter per robot running Fawkes-style skills
+// (SkillHSM state machines) and the skill strings an agent sends (`goto_place{place="M1"}`).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "llsf/core/config.h"
+#include "llsf/core/sim_time.h"
+#include "llsf/lua/robot_api.h"
+
+namespace llsf::lua {
+
+/// Status of a skill string or of one skill (the Fawkes values S_INACTIVE..S_FAILED).
+enum class SkillStatus : std::uint8_t { kInactive = 0, kFinal = 1, kRunning = 2, kFailed = 3 };
+
+/// "INACTIVE", "FINAL", "RUNNING" or "FAILED".
+const char* to_string(SkillStatus status);
+
+/// Severity of a line a skill logs (print_debug, print/print_info, print_warn, print_error).
+enum class LogLevel : std::uint8_t { kDebug = 0, kInfo = 1, kWarn = 2, kError = 3 };
+
+/// Read-only settings of a skill engine.
+struct SkillEngineConfig {
+  /// Directories whose `*.lua` files (not recursive, `init.lua` excluded) are skills; a skill of
+  /// a later directory replaces one of the same name in an earlier one.
+  std::vector<std::string> skill_dirs;
+  /// Rate at which `sim/` calls cycle(), in simulated Hz (the engine itself never waits).
+  double rate_hz = 30.0;
+  /// Lua VM instructions one cycle (or loading one file) may execute; beyond, the skill fails.
+  std::int64_t instruction_budget = 1'000'000;
+  /// Heap limit of the interpreter in bytes; allocations beyond fail with "not enough memory".
+  std::int64_t memory_limit_bytes = 64LL << 20;
+  /// Reload skill files that changed (mtime or size) when a new skill string is executed.
+  bool hot_reload = true;
+  /// Seed of `math.random` inside the interpreter (e.g. from rng.stream("lua/robot1")).
+  std::uint64_t random_seed = 0;
+
+  /// Throws core::ConfigError naming the bad field.
+  void validate() const;
+  /// Reads `skill_dirs`, `rate_hz`, `instruction_budget`, `memory_limit_bytes`, `hot_reload`,
+  /// `random_seed` from a map node (unknown keys are errors); relative dirs stay as written.
+  static SkillEngineConfig from_config(const core::ConfigNode& node);
+};
+
+/// Outcome of exec(): `ok`, or the reason the skill string was refused.
+struct ExecResult {
+  bool ok = false;
+  std::string error;
+  explicit operator bool() const { return ok; }
+};
+
+/// What the engine knows about one skill file.
+struct SkillInfo {
+  std::string name;
+  std::string path;
+  std::string documentation;
+  std::vector<std::string> depends_skills;
+  std::string load_error;  ///< empty if the skill loaded ("file:line: ..." otherwise)
+};
+
+/// One robot's skill engine. Owns its Lua interpreter and borrows `robot` (which must outlive it).
+/// Not thread-safe: one thread drives an engine; different engines are independent. Movable, not
+/// copyable. Errors in skill files and skill strings never throw: they show up as load errors,
+/// exec() errors or a FAILED status with the error text.
+class SkillEngine {
+ public:
+  /// Loads every skill of `cfg.skill_dirs`. Throws core::ConfigError for a bad config or a
+  /// missing directory; a broken skill file is recorded (load_errors()) and fails when called.
+  SkillEngine(const SkillEngineConfig& cfg, RobotApi& robot);
+  ~SkillEngine();
+  SkillEngine(SkillEngine&&) noexcept;
+  SkillEngine& operator=(SkillEngine&&) noexcept;
+  SkillEngine(const SkillEngine&) = delete;
+  SkillEngine& operator=(const SkillEngine&) = delete;
+
+  /// Aborts the running skill string (exit hooks run), reloads changed skill files (hot reload)
+  /// and compiles `skill_string`; it runs from the next cycle(). A syntax error refuses the string
+  /// (status FAILED, error() set).
+  ExecResult exec(std::string_view skill_string);
+  /// Aborts the running skill string and stops the robot (navigator and motor); status INACTIVE.
+  void stop();
+  /// Runs the skill string once (all skills it calls take one step) and returns the status. Does
+  /// nothing unless RUNNING; when the string ends (FINAL/FAILED) its skills are reset.
+  SkillStatus cycle();
+
+  /// Status of the current (or last) skill string.
+  SkillStatus status() const;
+  /// Why the skill string failed ("skill: STATE: file:line: ..."); empty unless FAILED.
+  const std::string& error() const;
+  /// The current (or last) skill string.
+  const std::string& skill_string() const;
+  /// Simulated period between cycles (1 / rate_hz).
+  core::SimTime cycle_period() const;
+
+  /// Status of one skill in the current string (also sub-skills); kInactive for unknown names.
+  SkillStatus skill_status(std::string_view skill) const;
+  /// A skill's error text (empty unless it failed).
+  std::string skill_error(std::string_view skill) const;
+  /// The state a skill's state machine is in ("" if inactive or not an FSM skill).
+  std::string skill_state(std::string_view skill) const;
+
+  /// Every skill file found, in name order.
+  std::vector<SkillInfo> skills() const;
+  /// "file:line: ..." of every skill that failed to load (syntax, declarations, dependencies).
+  std::vector<std::string> load_errors() const;
+
+  /// Rebuilds the interpreter from the skill files now (aborting a running string).
+  void reload();
+  /// Number of times the skill files were loaded (1 after construction).
+  int load_count() const;
+
+  /// Receives the lines skills log; without a sink they are dropped.
+  void set_log_sink(std::function<void(LogLevel, std::string_view)> sink);
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace llsf::lua

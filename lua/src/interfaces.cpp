@@ -1,0 +1,477 @@
+// SPDX-License-Identifier: MIT
+// The robot interfaces skills declare in depends_interfaces (the simulated Fawkes blackboard),
+// bound to RobotApi: every read goes to the robot at call time; commands take effect at once.
+#include <cmath>
+#include <exception>
+#include <limits>
+
+#include "engine_impl.h"
+
+namespace llsf::lua {
+
+namespace {
+
+using Impl = SkillEngine::Impl;
+
+// Runs `f` (which pushes results and returns their count); a C++ exception from RobotApi becomes
+// a Lua error at the calling skill's file:line (raised outside the catch block: no longjmp across
+// a live exception).
+template <class F>
+int guarded(lua_State* L, F&& f) {
+  Impl& e = Impl::of(L);
+  int n = -1;
+  try {
+    n = f(e);
+  } catch (const std::exception& ex) {
+    e.cpp_error = ex.what();
+  } catch (...) {
+    e.cpp_error = "unknown C++ exception";
+  }
+  if (n < 0) return luaL_error(L, "robot: %s", e.cpp_error.c_str());
+  return n;
+}
+
+const char* nav_status_name(NavStatus s) {
+  switch (s) {
+    case NavStatus::kIdle:
+      return "IDLE";
+    case NavStatus::kRunning:
+      return "RUNNING";
+    case NavStatus::kArrived:
+      return "ARRIVED";
+    case NavStatus::kNoPath:
+      return "NO_PATH";
+    case NavStatus::kInvalidGoal:
+      return "INVALID_GOAL";
+    case NavStatus::kBlocked:
+      return "BLOCKED";
+    case NavStatus::kStuck:
+      return "STUCK";
+    case NavStatus::kAborted:
+      return "ABORTED";
+  }
+  return "?";
+}
+
+bool nav_failed(NavStatus s) {
+  return s == NavStatus::kNoPath || s == NavStatus::kInvalidGoal || s == NavStatus::kBlocked ||
+         s == NavStatus::kStuck || s == NavStatus::kAborted;
+}
+
+const char* lamp_name(Lamp l) {
+  switch (l) {
+    case Lamp::kOff:
+      return "OFF";
+    case Lamp::kOn:
+      return "ON";
+    case Lamp::kBlink:
+      return "BLINKING";
+  }
+  return "?";
+}
+
+// ---- Position3DInterface (pose) ----
+int pose_x(lua_State* L) {
+  return guarded(L, [&](Impl& e) {
+    lua_pushnumber(L, e.robot.pose().pose.x);
+    return 1;
+  });
+}
+int pose_y(lua_State* L) {
+  return guarded(L, [&](Impl& e) {
+    lua_pushnumber(L, e.robot.pose().pose.y);
+    return 1;
+  });
+}
+int pose_theta(lua_State* L) {
+  return guarded(L, [&](Impl& e) {
+    lua_pushnumber(L, e.robot.pose().pose.theta);
+    return 1;
+  });
+}
+int pose_get(lua_State* L) {
+  return guarded(L, [&](Impl& e) {
+    const PoseEstimate p = e.robot.pose();
+    lua_pushnumber(L, p.pose.x);
+    lua_pushnumber(L, p.pose.y);
+    lua_pushnumber(L, p.pose.theta);
+    return 3;
+  });
+}
+int pose_is_valid(lua_State* L) {
+  return guarded(L, [&](Impl& e) {
+    lua_pushboolean(L, e.robot.pose().valid);
+    return 1;
+  });
+}
+int pose_stamp(lua_State* L) {
+  return guarded(L, [&](Impl& e) {
+    lua_pushnumber(L, e.robot.pose().stamp.seconds());
+    return 1;
+  });
+}
+int pose_distance_to(lua_State* L) {
+  const double x = luaL_checknumber(L, 2);
+  const double y = luaL_checknumber(L, 3);
+  return guarded(L, [&](Impl& e) {
+    const PoseEstimate p = e.robot.pose();
+    lua_pushnumber(L, std::hypot(p.pose.x - x, p.pose.y - y));
+    return 1;
+  });
+}
+
+// ---- NavigatorInterface (navigator) ----
+int nav_goto_place(lua_State* L) {
+  std::size_t n = 0;
+  const char* place = luaL_checklstring(L, 2, &n);
+  const bool forward = lua_toboolean(L, 3) != 0;
+  return guarded(L, [&](Impl& e) {
+    e.robot.goto_place(std::string_view(place, n), forward);
+    return 0;
+  });
+}
+int nav_goto_pose(lua_State* L) {
+  const core::Pose2D goal{luaL_checknumber(L, 2), luaL_checknumber(L, 3),
+                          luaL_optnumber(L, 4, 0.0)};
+  const bool forward = lua_toboolean(L, 5) != 0;
+  return guarded(L, [&](Impl& e) {
+    e.robot.goto_pose(goal, forward);
+    return 0;
+  });
+}
+int robot_stop(lua_State* L) {
+  return guarded(L, [&](Impl& e) {
+    e.robot.stop();
+    return 0;
+  });
+}
+// Reads the navigator into the engine's cache and pushes one derived value.
+template <class Push>
+int nav_read(lua_State* L, Push&& push) {
+  return guarded(L, [&](Impl& e) {
+    e.nav = e.robot.navigator();
+    return push(e.nav);
+  });
+}
+int nav_status(lua_State* L) {
+  return nav_read(L, [&](const NavState& s) {
+    lua_pushstring(L, nav_status_name(s.status));
+    return 1;
+  });
+}
+int nav_arrived(lua_State* L) {
+  return nav_read(L, [&](const NavState& s) {
+    lua_pushboolean(L, s.status == NavStatus::kArrived);
+    return 1;
+  });
+}
+int nav_failed_fn(lua_State* L) {
+  return nav_read(L, [&](const NavState& s) {
+    lua_pushboolean(L, nav_failed(s.status));
+    return 1;
+  });
+}
+int nav_running(lua_State* L) {
+  return nav_read(L, [&](const NavState& s) {
+    lua_pushboolean(L, s.status == NavStatus::kRunning);
+    return 1;
+  });
+}
+int nav_is_final(lua_State* L) {
+  return nav_read(L, [&](const NavState& s) {
+    lua_pushboolean(L, s.status == NavStatus::kArrived || nav_failed(s.status));
+    return 1;
+  });
+}
+int nav_error_code(lua_State* L) {
+  return nav_read(L, [&](const NavState& s) {
+    lua_pushinteger(L, nav_failed(s.status) ? static_cast<lua_Integer>(s.status) : 0);
+    return 1;
+  });
+}
+int nav_error_message(lua_State* L) {
+  return nav_read(L, [&](const NavState& s) {
+    lua_pushlstring(L, s.error.data(), s.error.size());
+    return 1;
+  });
+}
+int nav_blocked_by(lua_State* L) {
+  return nav_read(L, [&](const NavState& s) {
+    lua_pushlstring(L, s.blocked_by.data(), s.blocked_by.size());
+    return 1;
+  });
+}
+int nav_msgid(lua_State* L) {
+  return nav_read(L, [&](const NavState& s) {
+    lua_pushinteger(L, static_cast<lua_Integer>(s.goal_id));
+    return 1;
+  });
+}
+
+// ---- MotorInterface (motor) ----
+int motor_set_velocity(lua_State* L) {
+  const double vx = luaL_checknumber(L, 2);
+  const double vy = luaL_checknumber(L, 3);
+  const double omega = luaL_checknumber(L, 4);
+  return guarded(L, [&](Impl& e) {
+    e.robot.set_velocity(vx, vy, omega);
+    return 0;
+  });
+}
+
+// ---- RobotinoSensorInterface (sensor) ----
+int sensor_puck_in_holder(lua_State* L) {
+  return guarded(L, [&](Impl& e) {
+    lua_pushboolean(L, e.robot.puck_in_holder());
+    return 1;
+  });
+}
+int sensor_ir_distance(lua_State* L) {
+  return guarded(L, [&](Impl& e) {
+    lua_pushnumber(L, e.robot.ir_distance_m());
+    return 1;
+  });
+}
+int sensor_optical_left(lua_State* L) {
+  return guarded(L, [&](Impl& e) {
+    lua_pushboolean(L, e.robot.optical().left);
+    return 1;
+  });
+}
+int sensor_optical_right(lua_State* L) {
+  return guarded(L, [&](Impl& e) {
+    lua_pushboolean(L, e.robot.optical().right);
+    return 1;
+  });
+}
+
+// ---- RobotinoLightInterface (light) ----
+template <class Push>
+int light_read(lua_State* L, Push&& push) {
+  return guarded(L, [&](Impl& e) {
+    e.light = e.robot.light();
+    return push(e, e.light);
+  });
+}
+int light_red(lua_State* L) {
+  return light_read(L, [&](Impl&, const LightReading& r) {
+    lua_pushstring(L, lamp_name(r.red));
+    return 1;
+  });
+}
+int light_yellow(lua_State* L) {
+  return light_read(L, [&](Impl&, const LightReading& r) {
+    lua_pushstring(L, lamp_name(r.yellow));
+    return 1;
+  });
+}
+int light_green(lua_State* L) {
+  return light_read(L, [&](Impl&, const LightReading& r) {
+    lua_pushstring(L, lamp_name(r.green));
+    return 1;
+  });
+}
+int light_visible(lua_State* L) {
+  return light_read(L, [&](Impl&, const LightReading& r) {
+    lua_pushboolean(L, r.visible);
+    return 1;
+  });
+}
+int light_device(lua_State* L) {
+  return light_read(L, [&](Impl&, const LightReading& r) {
+    lua_pushlstring(L, r.device.data(), r.device.size());
+    return 1;
+  });
+}
+int light_stable_for(lua_State* L) {
+  return light_read(L, [&](Impl& e, const LightReading& r) {
+    lua_pushnumber(L, r.visible ? (e.robot.now() - r.stable_since).seconds() : 0.0);
+    return 1;
+  });
+}
+
+// ---- PuckVisionInterface (pucks) ----
+int pucks_count(lua_State* L) {
+  return guarded(L, [&](Impl& e) {
+    lua_pushinteger(L, static_cast<lua_Integer>(e.robot.pucks().size()));
+    return 1;
+  });
+}
+int pucks_puck(lua_State* L) {
+  const lua_Integer i = luaL_checkinteger(L, 2);
+  return guarded(L, [&](Impl& e) {
+    const auto pucks = e.robot.pucks();
+    if (i < 1 || i > static_cast<lua_Integer>(pucks.size())) return 0;
+    const core::Vec2& p = pucks[static_cast<std::size_t>(i - 1)].position;
+    lua_pushnumber(L, p.x());
+    lua_pushnumber(L, p.y());
+    return 2;
+  });
+}
+int pucks_nearest(lua_State* L) {
+  return guarded(L, [&](Impl& e) {
+    const auto pucks = e.robot.pucks();
+    if (pucks.empty()) return 0;
+    const PuckSighting* best = &pucks[0];
+    for (const PuckSighting& p : pucks) {
+      if (p.position.norm() < best->position.norm()) best = &p;
+    }
+    lua_pushnumber(L, best->position.x());
+    lua_pushnumber(L, best->position.y());
+    lua_pushnumber(L, best->position.norm());
+    return 3;
+  });
+}
+
+// ---- Laser360Interface (laser) ----
+int laser_num_beams(lua_State* L) {
+  return guarded(L, [&](Impl& e) {
+    lua_pushinteger(L, static_cast<lua_Integer>(e.robot.laser().ranges.size()));
+    return 1;
+  });
+}
+int laser_distances(lua_State* L) {
+  const lua_Integer i = luaL_checkinteger(L, 2);
+  return guarded(L, [&](Impl& e) {
+    const LaserView v = e.robot.laser();
+    if (i < 0 || i >= static_cast<lua_Integer>(v.ranges.size())) return 0;
+    lua_pushnumber(L, v.ranges[static_cast<std::size_t>(i)]);
+    return 1;
+  });
+}
+int laser_angle(lua_State* L) {
+  const lua_Integer i = luaL_checkinteger(L, 2);
+  return guarded(L, [&](Impl& e) {
+    const LaserView v = e.robot.laser();
+    lua_pushnumber(L, v.angle_min_rad + static_cast<double>(i) * v.angle_increment_rad);
+    return 1;
+  });
+}
+int laser_min_distance(lua_State* L) {
+  const double from = luaL_checknumber(L, 2);
+  const double to = luaL_checknumber(L, 3);
+  return guarded(L, [&](Impl& e) {
+    const LaserView v = e.robot.laser();
+    double best = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < v.ranges.size(); ++i) {
+      const double a =
+          core::normalize_angle(v.angle_min_rad + static_cast<double>(i) * v.angle_increment_rad);
+      if (a >= from && a <= to && v.ranges[i] < best) best = v.ranges[i];
+    }
+    lua_pushnumber(L, best);
+    return 1;
+  });
+}
+
+// ---- clock (a global, no declaration needed) ----
+int clock_now(lua_State* L) {
+  return guarded(L, [&](Impl& e) {
+    lua_pushnumber(L, e.robot.now().seconds());
+    return 1;
+  });
+}
+int clock_now_ns(lua_State* L) {
+  return guarded(L, [&](Impl& e) {
+    lua_pushinteger(L, static_cast<lua_Integer>(e.robot.now().ns()));
+    return 1;
+  });
+}
+
+int read_only(lua_State* L) { return luaL_error(L, "interfaces are read-only"); }
+
+// Pushes an interface object: an empty table whose metatable serves `methods` and refuses writes.
+void push_object(lua_State* L, const char* type, const luaL_Reg* methods,
+                 void (*extra)(lua_State*) = nullptr) {
+  lua_newtable(L);           // object
+  lua_createtable(L, 0, 4);  // metatable
+  lua_newtable(L);           // methods
+  luaL_setfuncs(L, methods, 0);
+  lua_pushstring(L, type);
+  lua_setfield(L, -2, "type");
+  if (extra != nullptr) extra(L);
+  lua_setfield(L, -2, "__index");
+  lua_pushcfunction(L, read_only);
+  lua_setfield(L, -2, "__newindex");
+  lua_pushboolean(L, 0);
+  lua_setfield(L, -2, "__metatable");
+  lua_setmetatable(L, -2);
+}
+
+void light_constants(lua_State* L) {
+  for (const char* c : {"ON", "OFF", "BLINKING"}) {
+    lua_pushstring(L, c);
+    lua_setfield(L, -2, c);
+  }
+}
+
+}  // namespace
+
+void push_interfaces(lua_State* L) {
+  static const luaL_Reg pose[] = {{"x", pose_x},         {"y", pose_y},
+                                  {"theta", pose_theta}, {"ori", pose_theta},
+                                  {"get", pose_get},     {"is_valid", pose_is_valid},
+                                  {"stamp", pose_stamp}, {"distance_to", pose_distance_to},
+                                  {nullptr, nullptr}};
+  static const luaL_Reg navigator[] = {{"goto_place", nav_goto_place},
+                                       {"goto_pose", nav_goto_pose},
+                                       {"stop", robot_stop},
+                                       {"status", nav_status},
+                                       {"arrived", nav_arrived},
+                                       {"failed", nav_failed_fn},
+                                       {"running", nav_running},
+                                       {"is_final", nav_is_final},
+                                       {"error_code", nav_error_code},
+                                       {"error_message", nav_error_message},
+                                       {"blocked_by", nav_blocked_by},
+                                       {"msgid", nav_msgid},
+                                       {nullptr, nullptr}};
+  static const luaL_Reg motor[] = {
+      {"set_velocity", motor_set_velocity}, {"stop", robot_stop}, {nullptr, nullptr}};
+  static const luaL_Reg sensor[] = {{"puck_in_holder", sensor_puck_in_holder},
+                                    {"ir_distance", sensor_ir_distance},
+                                    {"optical_left", sensor_optical_left},
+                                    {"optical_right", sensor_optical_right},
+                                    {nullptr, nullptr}};
+  static const luaL_Reg light[] = {{"red", light_red},       {"yellow", light_yellow},
+                                   {"green", light_green},   {"visible", light_visible},
+                                   {"device", light_device}, {"stable_for", light_stable_for},
+                                   {nullptr, nullptr}};
+  static const luaL_Reg pucks[] = {
+      {"count", pucks_count}, {"puck", pucks_puck}, {"nearest", pucks_nearest}, {nullptr, nullptr}};
+  static const luaL_Reg laser[] = {{"num_beams", laser_num_beams},
+                                   {"distances", laser_distances},
+                                   {"angle", laser_angle},
+                                   {"min_distance", laser_min_distance},
+                                   {nullptr, nullptr}};
+  static const luaL_Reg clock[] = {
+      {"now", clock_now}, {"now_ns", clock_now_ns}, {nullptr, nullptr}};
+
+  struct Entry {
+    const char* type;
+    const luaL_Reg* methods;
+    void (*extra)(lua_State*);
+  };
+  const Entry entries[] = {{"Position3DInterface", pose, nullptr},
+                           {"NavigatorInterface", navigator, nullptr},
+                           {"MotorInterface", motor, nullptr},
+                           {"RobotinoSensorInterface", sensor, nullptr},
+                           {"RobotinoLightInterface", light, light_constants},
+                           {"PuckVisionInterface", pucks, nullptr},
+                           {"Laser360Interface", laser, nullptr}};
+  // native (at -1).interfaces = {Type = object, ...}; native.interface_names = "A, B, ..."
+  lua_newtable(L);
+  std::string names;
+  for (const Entry& en : entries) {
+    push_object(L, en.type, en.methods, en.extra);
+    lua_setfield(L, -2, en.type);
+    if (!names.empty()) names += ", ";
+    names += en.type;
+  }
+  lua_setfield(L, -2, "interfaces");
+  lua_pushstring(L, names.c_str());
+  lua_setfield(L, -2, "interface_names");
+  push_object(L, "Clock", clock);
+  lua_setfield(L, -2, "clock");
+}
+
+}  // namespace llsf::lua

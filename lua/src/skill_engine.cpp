@@ -1,0 +1,527 @@
+// SPDX-License-Identifier: MIT
+// SkillEngine: builds the sandboxed interpreter, loads skill files, runs skill strings under an
+// instruction budget, and reloads changed files between skill strings.
+#include "llsf/lua/skill_engine.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <system_error>
+
+#include <sys/stat.h>
+
+#include "engine_impl.h"
+#include "llsf/core/assert.h"
+#include "llsf/core/error.h"
+
+namespace llsf::lua {
+
+namespace fs = std::filesystem;
+
+const char* to_string(SkillStatus status) {
+  switch (status) {
+    case SkillStatus::kInactive:
+      return "INACTIVE";
+    case SkillStatus::kFinal:
+      return "FINAL";
+    case SkillStatus::kRunning:
+      return "RUNNING";
+    case SkillStatus::kFailed:
+      return "FAILED";
+  }
+  return "?";
+}
+
+// ---- config ------------------------------------------------------------------------------------
+
+void SkillEngineConfig::validate() const {
+  if (!(rate_hz > 0.0 && rate_hz <= 10000.0)) {
+    throw core::ConfigError("skill engine: rate_hz must be in (0, 10000], got " +
+                            std::to_string(rate_hz));
+  }
+  if (instruction_budget < 1000) {
+    throw core::ConfigError("skill engine: instruction_budget must be >= 1000, got " +
+                            std::to_string(instruction_budget));
+  }
+  if (memory_limit_bytes < (1LL << 20)) {
+    throw core::ConfigError("skill engine: memory_limit_bytes must be >= 1 MiB, got " +
+                            std::to_string(memory_limit_bytes));
+  }
+  for (const std::string& dir : skill_dirs) {
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec)) {
+      throw core::ConfigError("skill engine: skill directory '" + dir + "' does not exist");
+    }
+  }
+}
+
+SkillEngineConfig SkillEngineConfig::from_config(const core::ConfigNode& node) {
+  node.require_map();
+  node.check_keys({"skill_dirs", "rate_hz", "instruction_budget", "memory_limit_bytes",
+                   "hot_reload", "random_seed"});
+  SkillEngineConfig cfg;
+  const core::ConfigNode dirs = node["skill_dirs"];
+  if (dirs.defined()) {
+    if (!dirs.is_sequence()) dirs.fail("expected a list of directories");
+    for (const core::ConfigNode& d : dirs.elements()) cfg.skill_dirs.push_back(d.as_string());
+  }
+  node.read("rate_hz", cfg.rate_hz);
+  node.read("instruction_budget", cfg.instruction_budget);
+  node.read("memory_limit_bytes", cfg.memory_limit_bytes);
+  node.read("hot_reload", cfg.hot_reload);
+  std::int64_t seed = 0;
+  node.read("random_seed", seed);
+  cfg.random_seed = static_cast<std::uint64_t>(seed);
+  try {
+    cfg.validate();
+  } catch (const core::ConfigError& e) {
+    node.fail(e.what());
+  }
+  return cfg;
+}
+
+// ---- interpreter plumbing
+// ------------------------------------------------------------------------
+
+namespace {
+
+// Allocator with a heap limit: refusing an allocation makes Lua raise "not enough memory".
+void* limited_alloc(void* ud, void* ptr, std::size_t osize, std::size_t nsize) {
+  auto* heap = static_cast<LuaHeap*>(ud);
+  const std::int64_t old_size = ptr != nullptr ? static_cast<std::int64_t>(osize) : 0;
+  if (nsize == 0) {
+    std::free(ptr);
+    heap->used -= old_size;
+    return nullptr;
+  }
+  const std::int64_t grow = static_cast<std::int64_t>(nsize) - old_size;
+  if (grow > 0 && heap->used + grow > heap->limit) return nullptr;
+  void* p = std::realloc(ptr, nsize);
+  if (p != nullptr) heap->used += grow;
+  return p;
+}
+
+int panic(lua_State* L) {
+  // Only reachable through an unprotected call, which the engine never makes: a bug.
+  const char* msg = lua_tostring(L, -1);
+  LLSF_DEMAND_MSG(false, std::string("unprotected Lua error: ") + (msg ? msg : "?"));
+  return 0;
+}
+
+// Count hook: the cycle used up its instruction budget. Names the running code's file:line.
+void budget_hook(lua_State* L, lua_Debug* ar) {
+  SkillEngine::Impl& e = SkillEngine::Impl::of(L);
+  e.budget_exhausted = true;
+  lua_getinfo(L, "Sl", ar);
+  lua_pushfstring(
+      L, "%s:%d: instruction budget exhausted (%I instructions per cycle; endless loop?)",
+      ar->short_src, ar->currentline, static_cast<LUA_INTEGER>(e.config.instruction_budget));
+  lua_error(L);
+}
+
+// pcall for skills: like the standard one, but an exhausted budget cannot be caught.
+int sandbox_pcall(lua_State* L) {
+  luaL_checkany(L, 1);
+  const int status = lua_pcall(L, lua_gettop(L) - 1, LUA_MULTRET, 0);
+  if (status != LUA_OK && SkillEngine::Impl::of(L).budget_exhausted) return lua_error(L);
+  lua_pushboolean(L, status == LUA_OK);
+  lua_insert(L, 1);
+  return lua_gettop(L);
+}
+
+int native_now_ns(lua_State* L) {
+  lua_pushinteger(L, static_cast<lua_Integer>(SkillEngine::Impl::of(L).robot.now().ns()));
+  return 1;
+}
+
+int native_exhausted(lua_State* L) {
+  lua_pushboolean(L, SkillEngine::Impl::of(L).budget_exhausted);
+  return 1;
+}
+
+int native_log(lua_State* L) {
+  const lua_Integer level = luaL_checkinteger(L, 1);
+  std::size_t n = 0;
+  const char* text = luaL_checklstring(L, 2, &n);
+  SkillEngine::Impl& e = SkillEngine::Impl::of(L);
+  if (e.log_sink) {
+    bool failed = false;
+    try {
+      e.log_sink(static_cast<LogLevel>(std::clamp<lua_Integer>(level, 0, 3)),
+                 std::string_view(text, n));
+    } catch (const std::exception& ex) {
+      e.cpp_error = ex.what();
+      failed = true;
+    }
+    if (failed) return luaL_error(L, "log sink: %s", e.cpp_error.c_str());
+  }
+  return 0;
+}
+
+void open_lib(lua_State* L, const char* name, lua_CFunction fn) {
+  luaL_requiref(L, name, fn, 1);
+  lua_pop(L, 1);
+}
+
+std::string read_file(const std::string& path, bool& ok) {
+  std::ifstream in(path, std::ios::binary);
+  ok = static_cast<bool>(in);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+bool is_identifier(const std::string& s) {
+  if (s.empty() || std::isdigit(static_cast<unsigned char>(s[0]))) return false;
+  return std::all_of(s.begin(), s.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+  });
+}
+
+std::string pop_message(lua_State* L) {
+  const char* msg = lua_tostring(L, -1);
+  std::string out = msg != nullptr ? msg : "(error object is not a string)";
+  lua_pop(L, 1);
+  return out;
+}
+
+}  // namespace
+
+SkillEngine::Impl::Impl(const SkillEngineConfig& cfg, RobotApi& robot_api)
+    : config(cfg), robot(robot_api) {}
+
+SkillEngine::Impl::~Impl() { close(); }
+
+void SkillEngine::Impl::close() {
+  if (L != nullptr) lua_close(L);
+  L = nullptr;
+  engine_ref = chunk_ref = LUA_NOREF;
+  heap.used = 0;
+}
+
+void SkillEngine::Impl::arm_budget() {
+  budget_exhausted = false;
+  lua_sethook(L, budget_hook, LUA_MASKCOUNT,
+              static_cast<int>(std::min<std::int64_t>(config.instruction_budget, 1'000'000'000)));
+}
+
+int SkillEngine::Impl::call_entry(const char* fn, int nargs, int nresults) {
+  lua_rawgeti(L, LUA_REGISTRYINDEX, engine_ref);
+  lua_getfield(L, -1, fn);
+  lua_remove(L, -2);
+  lua_insert(L, -(nargs + 1));
+  arm_budget();
+  return lua_pcall(L, nargs, nresults, 0);
+}
+
+std::vector<SkillFile> SkillEngine::Impl::scan() const {
+  std::vector<SkillFile> out;
+  for (const std::string& dir : config.skill_dirs) {
+    std::vector<SkillFile> in_dir;
+    std::error_code ec;
+    for (const fs::directory_entry& entry : fs::directory_iterator(dir, ec)) {
+      const fs::path& p = entry.path();
+      if (p.extension() != ".lua" || p.filename() == "init.lua") continue;
+      // One stat() per file: this runs at every exec() with hot reload on.
+      struct stat st {};
+      if (::stat(p.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) continue;
+      SkillFile f;
+      f.name = p.stem().string();
+      f.path = p.string();
+      f.size = static_cast<std::int64_t>(st.st_size);
+      f.mtime_ns = static_cast<std::int64_t>(st.st_mtim.tv_sec) * 1'000'000'000 +
+                   static_cast<std::int64_t>(st.st_mtim.tv_nsec);
+      in_dir.push_back(std::move(f));
+    }
+    for (SkillFile& f : in_dir) {
+      auto same = std::find_if(out.begin(), out.end(),
+                               [&](const SkillFile& o) { return o.name == f.name; });
+      if (same != out.end()) {
+        *same = std::move(f);
+      } else {
+        out.push_back(std::move(f));
+      }
+    }
+  }
+  std::sort(out.begin(), out.end(),
+            [](const SkillFile& a, const SkillFile& b) { return a.name < b.name; });
+  return out;
+}
+
+void SkillEngine::Impl::build() {
+  close();
+  files = scan();
+  ++loads;
+  heap.limit = config.memory_limit_bytes;
+  L = lua_newstate(limited_alloc, &heap);
+  LLSF_DEMAND_MSG(L != nullptr, "cannot create a Lua state");
+  *static_cast<Impl**>(lua_getextraspace(L)) = this;
+  lua_atpanic(L, panic);
+
+  // Only the libraries the prelude needs: no io, os, package; debug stays inside the prelude.
+  open_lib(L, LUA_GNAME, luaopen_base);
+  open_lib(L, LUA_TABLIBNAME, luaopen_table);
+  open_lib(L, LUA_STRLIBNAME, luaopen_string);
+  open_lib(L, LUA_MATHLIBNAME, luaopen_math);
+  open_lib(L, LUA_UTF8LIBNAME, luaopen_utf8);
+  open_lib(L, LUA_DBLIBNAME, luaopen_debug);
+  for (const char* name : {"dofile", "loadfile", "collectgarbage"}) {
+    lua_pushnil(L);
+    lua_setglobal(L, name);
+  }
+  // Deterministic math.random.
+  lua_getglobal(L, "math");
+  lua_getfield(L, -1, "randomseed");
+  lua_pushinteger(L, static_cast<lua_Integer>(config.random_seed));
+  lua_call(L, 1, 0);
+  lua_pop(L, 1);
+
+  // The prelude gets the natives and returns the engine's entry table.
+  if (luaL_loadbufferx(L, kPrelude, std::char_traits<char>::length(kPrelude), "=llsf/prelude.lua",
+                       "t") != LUA_OK) {
+    LLSF_DEMAND_MSG(false, "prelude: " + pop_message(L));
+  }
+  lua_newtable(L);
+  const luaL_Reg natives[] = {{"now_ns", native_now_ns},
+                              {"exhausted", native_exhausted},
+                              {"log", native_log},
+                              {"pcall", sandbox_pcall},
+                              {nullptr, nullptr}};
+  luaL_setfuncs(L, natives, 0);
+  lua_pushlstring(L, robot.name().data(), robot.name().size());
+  lua_setfield(L, -2, "robot_name");
+  push_interfaces(L);  // sets native.interfaces, interface_names, clock
+  arm_budget();
+  if (lua_pcall(L, 1, 1, 0) != LUA_OK) LLSF_DEMAND_MSG(false, "prelude: " + pop_message(L));
+  engine_ref = luaL_ref(L, LUA_REGISTRYINDEX);
+
+  // Handles for every skill first, so that depends_skills can be checked while files load.
+  lua_createtable(L, static_cast<int>(files.size()), 0);
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    lua_pushstring(L, files[i].name.c_str());
+    lua_rawseti(L, -2, static_cast<lua_Integer>(i + 1));
+  }
+  if (call_entry("declare_skills", 1, 0) != LUA_OK) {
+    LLSF_DEMAND_MSG(false, "declare_skills: " + pop_message(L));
+  }
+
+  for (const SkillFile& f : files) {
+    std::string load_error;
+    bool ok = false;
+    const std::string text = read_file(f.path, ok);
+    if (!ok) {
+      load_error = f.path + ": cannot read the file";
+    } else if (!is_identifier(f.name)) {
+      load_error = f.path + ": a skill's file name must be a Lua identifier";
+    } else {
+      lua_pushstring(L, f.name.c_str());
+      lua_pushstring(L, f.path.c_str());
+      if (call_entry("begin_module", 2, 1) != LUA_OK) {
+        load_error = pop_message(L);
+      } else {
+        const std::string chunkname = "@" + f.path;
+        if (luaL_loadbufferx(L, text.data(), text.size(), chunkname.c_str(), "t") != LUA_OK) {
+          load_error = pop_message(L);
+          lua_pop(L, 1);  // the module env
+        } else {
+          lua_insert(L, -2);                      // chunk, env
+          LLSF_DEMAND(lua_setupvalue(L, -2, 1));  // _ENV = env
+          arm_budget();
+          if (lua_pcall(L, 0, 0, 0) != LUA_OK) {
+            load_error = pop_message(L);
+          } else {
+            lua_pushstring(L, f.name.c_str());
+            if (call_entry("finish_module", 1, 0) != LUA_OK) load_error = pop_message(L);
+          }
+        }
+      }
+    }
+    if (!load_error.empty()) {
+      lua_pushstring(L, f.name.c_str());
+      lua_pushstring(L, load_error.c_str());
+      if (call_entry("set_load_error", 2, 0) != LUA_OK) {
+        LLSF_DEMAND_MSG(false, "set_load_error: " + pop_message(L));
+      }
+    }
+  }
+  if (call_entry("resolve", 0, 0) != LUA_OK) LLSF_DEMAND_MSG(false, "resolve: " + pop_message(L));
+  lua_settop(L, 0);
+}
+
+void SkillEngine::Impl::abort_running() {
+  if (L == nullptr) return;
+  if (chunk_ref != LUA_NOREF) {
+    luaL_unref(L, LUA_REGISTRYINDEX, chunk_ref);
+    chunk_ref = LUA_NOREF;
+  }
+  if (call_entry("reset_all", 0, 0) != LUA_OK) {
+    const std::string msg = pop_message(L);
+    if (log_sink) log_sink(LogLevel::kError, "resetting skills: " + msg);
+  }
+}
+
+// ---- SkillEngine
+// -----------------------------------------------------------------------------------
+
+SkillEngine::SkillEngine(const SkillEngineConfig& cfg, RobotApi& robot)
+    : impl_(std::make_unique<Impl>(cfg, robot)) {
+  cfg.validate();
+  impl_->build();
+}
+
+SkillEngine::~SkillEngine() = default;
+SkillEngine::SkillEngine(SkillEngine&&) noexcept = default;
+SkillEngine& SkillEngine::operator=(SkillEngine&&) noexcept = default;
+
+ExecResult SkillEngine::exec(std::string_view skill_string) {
+  Impl& e = *impl_;
+  e.abort_running();
+  if (e.config.hot_reload) {
+    const std::vector<SkillFile> now = e.scan();
+    const bool changed =
+        now.size() != e.files.size() ||
+        !std::equal(now.begin(), now.end(), e.files.begin(), [](const auto& a, const auto& b) {
+          return a.path == b.path && a.mtime_ns == b.mtime_ns && a.size == b.size;
+        });
+    if (changed) e.build();
+  }
+  e.skill_string.assign(skill_string);
+  e.error.clear();
+  lua_pushlstring(e.L, skill_string.data(), skill_string.size());
+  if (e.call_entry("compile", 1, 2) != LUA_OK || lua_isnil(e.L, -2)) {
+    e.error = lua_isstring(e.L, -1) ? lua_tostring(e.L, -1) : "cannot compile the skill string";
+    lua_settop(e.L, 0);
+    e.status = SkillStatus::kFailed;
+    return {false, e.error};
+  }
+  lua_pop(e.L, 1);
+  e.chunk_ref = luaL_ref(e.L, LUA_REGISTRYINDEX);
+  e.status = SkillStatus::kRunning;
+  return {true, {}};
+}
+
+void SkillEngine::stop() {
+  Impl& e = *impl_;
+  e.abort_running();
+  e.status = SkillStatus::kInactive;
+  e.error.clear();
+  e.skill_string.clear();
+  e.robot.stop();
+}
+
+SkillStatus SkillEngine::cycle() {
+  Impl& e = *impl_;
+  if (e.status != SkillStatus::kRunning) return e.status;
+  lua_rawgeti(e.L, LUA_REGISTRYINDEX, e.chunk_ref);
+  if (e.call_entry("run_cycle", 1, 2) != LUA_OK) {
+    e.status = SkillStatus::kFailed;
+    e.error = pop_message(e.L);
+  } else {
+    const lua_Integer s = lua_tointeger(e.L, -2);
+    e.status = static_cast<SkillStatus>(std::clamp<lua_Integer>(s, 0, 3));
+    if (e.status == SkillStatus::kFailed) {
+      e.error = lua_isstring(e.L, -1) ? lua_tostring(e.L, -1) : "FAILED";
+    }
+    lua_pop(e.L, 2);
+  }
+  if (e.status != SkillStatus::kRunning) e.abort_running();
+  return e.status;
+}
+
+SkillStatus SkillEngine::status() const { return impl_->status; }
+const std::string& SkillEngine::error() const { return impl_->error; }
+const std::string& SkillEngine::skill_string() const { return impl_->skill_string; }
+core::SimTime SkillEngine::cycle_period() const {
+  return core::SimTime::period_of_hz(impl_->config.rate_hz);
+}
+
+namespace {
+
+// Calls skill_info(name) and hands its results (status, error, state, load_error, path,
+// documentation, depends) to `fn`; false for unknown skills.
+template <class Fn>
+bool with_skill_info(SkillEngine::Impl& e, std::string_view skill, Fn&& fn) {
+  lua_pushlstring(e.L, skill.data(), skill.size());
+  if (e.call_entry("skill_info", 1, 7) != LUA_OK) {
+    lua_settop(e.L, 0);
+    return false;
+  }
+  const bool found = !lua_isnil(e.L, -7);
+  if (found) {
+    auto str = [&](int i) {
+      const char* s = lua_tostring(e.L, i - 8);
+      return std::string(s != nullptr ? s : "");
+    };
+    fn(static_cast<SkillStatus>(lua_tointeger(e.L, -7)), str(2), str(3), str(4), str(5), str(6),
+       str(7));
+  }
+  lua_settop(e.L, 0);
+  return found;
+}
+
+}  // namespace
+
+SkillStatus SkillEngine::skill_status(std::string_view skill) const {
+  SkillStatus out = SkillStatus::kInactive;
+  with_skill_info(*impl_, skill, [&](SkillStatus s, auto&&...) { out = s; });
+  return out;
+}
+
+std::string SkillEngine::skill_error(std::string_view skill) const {
+  std::string out;
+  with_skill_info(*impl_, skill, [&](SkillStatus, std::string err, auto&&...) { out = err; });
+  return out;
+}
+
+std::string SkillEngine::skill_state(std::string_view skill) const {
+  std::string out;
+  with_skill_info(
+      *impl_, skill,
+      [&](SkillStatus, const std::string&, std::string state, auto&&...) { out = state; });
+  return out;
+}
+
+std::vector<SkillInfo> SkillEngine::skills() const {
+  std::vector<SkillInfo> out;
+  for (const SkillFile& f : impl_->files) {
+    SkillInfo info;
+    info.name = f.name;
+    info.path = f.path;
+    with_skill_info(*impl_, f.name,
+                    [&](SkillStatus, const std::string&, const std::string&, std::string load_error,
+                        const std::string&, std::string doc, const std::string& deps) {
+                      info.load_error = std::move(load_error);
+                      info.documentation = std::move(doc);
+                      std::stringstream ss(deps);
+                      for (std::string d; std::getline(ss, d, ',');) {
+                        info.depends_skills.push_back(d);
+                      }
+                    });
+    out.push_back(std::move(info));
+  }
+  return out;
+}
+
+std::vector<std::string> SkillEngine::load_errors() const {
+  std::vector<std::string> out;
+  for (const SkillInfo& s : skills()) {
+    if (!s.load_error.empty()) out.push_back(s.name + ": " + s.load_error);
+  }
+  return out;
+}
+
+void SkillEngine::reload() {
+  impl_->abort_running();
+  if (impl_->status == SkillStatus::kRunning) impl_->status = SkillStatus::kInactive;
+  impl_->build();
+}
+
+int SkillEngine::load_count() const { return impl_->loads; }
+
+void SkillEngine::set_log_sink(std::function<void(LogLevel, std::string_view)> sink) {
+  impl_->log_sink = std::move(sink);
+}
+
+}  // namespace llsf::lua
