@@ -1,0 +1,171 @@
+// SPDX-License-Identifier: MIT
+// Game: the game loop. Owns the world, the refbox (behind its protocol adapter), the radio hub,
+// the planner and one RobotStack per robot, and steps them in the tick order of
+// ARCHITECTURE.md ("One tick"), written in Game::step(). Knows no file formats and no CLI: the
+// scenario runner builds a GameConfig and drives this loop.
+#pragma once
+
+#include <google/protobuf/message.h>
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "llsf/comm/hub.h"
+#include "llsf/comm/registry.h"
+#include "llsf/core/rng.h"
+#include "llsf/kinematic/world.h"
+#include "llsf/planner/planner.h"
+#include "llsf/refbox/protocol.h"
+#include "llsf/refbox/refbox.h"
+#include "llsf/sim/game_config.h"
+#include "llsf/sim/robot_stack.h"
+
+namespace llsf::sim {
+
+/// The hub peer name of the refbox (channel "*": hears and is heard by every channel).
+inline constexpr std::string_view kRefboxPeer = "refbox";
+/// The hub channel of the robots.
+inline constexpr std::string_view kTeamChannel = "team";
+
+/// Registers the 2013 refbox messages (llsf_msgs, component 2000, and llsf_log_msgs.LogMessage)
+/// in `registry`.
+void add_refbox_messages(comm::MessageRegistry& registry);
+
+/// A summary of the game so far (the RunResult of a scenario run takes it).
+struct GameSummary {
+  SimTime time;
+  std::int64_t ticks = 0;
+  refbox::GamePhase phase = refbox::GamePhase::kPreGame;
+  refbox::GameState state = refbox::GameState::kInit;
+  int points = 0;              ///< GameState.points: sum of the phases' sums floored at 0
+  int exploration_points = 0;  ///< raw sum of the phase's awards
+  int production_points = 0;
+  int whack_a_mole_points = 0;
+  int collisions_robot_robot = 0;  ///< contacts that started, from the world's events
+  int collisions_robot_wall = 0;
+  int collisions_robot_device = 0;
+  comm::TrafficCounters comm;        ///< everything the hub carried
+  std::int64_t refbox_accepted = 0;  ///< messages the refbox took from the radio
+  std::int64_t refbox_rejected = 0;
+  std::int64_t controller_rejected = 0;  ///< controller commands the refbox refused
+  std::uint64_t world_hash = 0;
+  std::uint64_t refbox_hash = 0;
+};
+
+/// The game loop. Not copyable or movable (stacks and the adapter hold references into it);
+/// not thread-safe; games in different threads are independent.
+class Game {
+ public:
+  /// Validates `config` (throws core::ConfigError) and builds everything: world, refbox +
+  /// protocol adapter (hub peer "refbox" on "*"), hub with the refbox and agent messages
+  /// registered, planner, and a RobotStack + hub peer (channel "team") per world robot.
+  explicit Game(GameConfig config);
+  ~Game();
+  Game(const Game&) = delete;
+  Game& operator=(const Game&) = delete;
+
+  /// One tick:
+  /// 1. time advances by the physics step;
+  /// 2. actuators: every stack's command (navigator or motor) goes to World::set_command;
+  /// 3. the world steps; its RFID and collision events are collected;
+  /// 4. refbox: RFID events in (same device and puck ids), insertion-slot occupancy, messages
+  ///    received in the previous tick; its lights go to World::set_lights, its referee actions
+  ///    are carried out (delivered pucks removed, late-order S0 added), its messages broadcast;
+  /// 5. comm: robots' beacons (every beacon_period) broadcast, the hub steps, deliveries go to
+  ///    the refbox (llsf_msgs only) and to the inboxes of robots with a brain;
+  /// 6. sensors: every stack perceives the world at its abstraction levels;
+  /// 7. skills: brains' on_skill_cycle at skill_rate_hz;
+  /// 8. agents: brains' on_agent_cycle at agent_rate_hz (inboxes are then cleared);
+  /// 9. the tick hook, if set.
+  void step();
+  /// Steps until time() >= `until`.
+  void run_until(SimTime until);
+
+  /// Simulated time (of the last tick).
+  SimTime time() const { return world_->time(); }
+  std::int64_t ticks() const { return ticks_; }
+  const GameConfig& config() const { return config_; }
+
+  kinematic::World& world() { return *world_; }
+  const kinematic::World& world() const { return *world_; }
+  /// The world's events of the last tick.
+  const kinematic::WorldEvents& last_events() const { return *events_; }
+  const refbox::Refbox& refbox() const { return protocol_->refbox(); }
+  refbox::RefboxProtocol& refbox_protocol() { return *protocol_; }
+  comm::Hub& hub() { return *hub_; }
+  const comm::Hub& hub() const { return *hub_; }
+  comm::PeerId refbox_peer() const { return refbox_peer_; }
+  planner::Planner& planner() { return *planner_; }
+
+  int robot_count() const { return static_cast<int>(stacks_.size()); }
+  RobotStack& robot(int index) { return *stacks_.at(static_cast<std::size_t>(index)); }
+  const RobotStack& robot(int index) const { return *stacks_.at(static_cast<std::size_t>(index)); }
+  /// The stack of the robot called `name`, or nullptr.
+  RobotStack* robot(std::string_view name);
+  /// The hub peer of robot `index`.
+  comm::PeerId robot_peer(int index) const { return robot_peers_.at(std::size_t(index)); }
+
+  /// Plugs `brain` (borrowed; must outlive the game or be unset with nullptr) into robot `index`.
+  void set_brain(int index, RobotBrain* brain);
+  /// A controller command (as if sent over the refbox's TCP port): applied at the next tick's
+  /// refbox step. Returns the adapter's verdict.
+  refbox::ReceiveResult controller_command(const google::protobuf::Message& message);
+  /// Called at the end of every tick (step 9), e.g. by a recorder.
+  void set_tick_hook(std::function<void(const Game&)> hook) { tick_hook_ = std::move(hook); }
+
+  GameSummary summary() const;
+
+ private:
+  void apply_refbox_output(const refbox::StepOutput& out);
+  core::Vec2 free_storage_spot() const;
+  bool insertion_slot_occupied() const;
+
+  GameConfig config_;
+  core::Rng rng_;
+  std::unique_ptr<kinematic::World> world_;
+  std::unique_ptr<refbox::RefboxProtocol> protocol_;
+  comm::MessageRegistry registry_;  // before hub_: the hub borrows it
+  std::unique_ptr<comm::Hub> hub_;
+  comm::PeerId refbox_peer_;
+  std::unique_ptr<planner::Planner> planner_;
+  std::vector<std::unique_ptr<RobotStack>> stacks_;
+  std::vector<comm::PeerId> robot_peers_;
+  std::function<void(const Game&)> tick_hook_;
+
+  const kinematic::WorldEvents* events_ = nullptr;
+  kinematic::WorldEvents no_events_;
+  std::int64_t ticks_ = 0;
+  bool lights_applied_ = false;
+  SimTime next_skill_;
+  SimTime next_agent_;
+  SimTime skill_period_;
+  SimTime agent_period_;
+  std::vector<SimTime> next_beacon_;
+  std::vector<std::uint64_t> beacon_seq_;
+  std::unique_ptr<google::protobuf::Message> beacon_;  // reused BeaconSignal
+
+  // Per-tick scratch (reserved at construction; the steady tick does not grow them).
+  std::vector<refbox::RfidEvent> rfid_;
+  std::vector<planner::DiscObstacle> discs_;
+  std::vector<planner::DiscObstacle> others_;
+  std::vector<core::Vec2> puck_positions_;
+  std::array<kinematic::SignalLights, kinematic::kDeviceCount> lights_{};
+
+  // Counters.
+  std::array<int, 3> collisions_{};  // by kinematic::CollisionKind
+  std::int64_t refbox_accepted_ = 0;
+  std::int64_t refbox_rejected_ = 0;
+  std::int64_t controller_rejected_ = 0;
+};
+
+/// The planner's map of a world configuration: devices with their footprints and RFID zone
+/// centres, and the marked areas, copied one to one.
+planner::FieldMap field_map_from_world(const kinematic::WorldConfig& world);
+
+}  // namespace llsf::sim

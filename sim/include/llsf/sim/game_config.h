@@ -1,0 +1,112 @@
+// SPDX-License-Identifier: MIT
+// GameConfig: everything a game is built from -- world, refbox, radio, navigation, the robots'
+// abstraction levels, the seed and the tick rates (docs/sim.md documents every field).
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "llsf/comm/hub_config.h"
+#include "llsf/core/sim_time.h"
+#include "llsf/kinematic/world_config.h"
+#include "llsf/planner/config.h"
+#include "llsf/refbox/config.h"
+#include "llsf/refbox/protocol.h"
+
+namespace llsf::sim {
+
+using core::SimTime;
+
+/// Localization abstraction level: what RobotApi::pose() returns.
+enum class LocalizationLevel : std::uint8_t {
+  kGroundTruth,  ///< the world's true pose
+  kNoisy,        ///< wheel odometry between periodic noisy corrections (an AMCL stand-in)
+};
+/// Light-signal and puck detection abstraction levels.
+enum class DetectionLevel : std::uint8_t {
+  kGroundTruth,  ///< what is there, at once
+  kVision,       ///< a camera: field of view, range, delay, errors, merged sightings
+};
+/// "ground_truth", "noisy", "vision".
+const char* to_string(LocalizationLevel level);
+const char* to_string(DetectionLevel level);
+
+/// Localization. `noisy`: the estimate follows the odometry sensor's motion; every
+/// `correction_period` it is pulled towards the true pose plus Gaussian noise
+/// (estimate += correction_gain * (truth + noise - estimate)), like an AMCL update.
+struct LocalizationConfig {
+  LocalizationLevel level = LocalizationLevel::kGroundTruth;
+  SimTime correction_period = SimTime::from_sec(1);
+  double correction_gain = 1.0;  ///< (0, 1]: 1 = jump to the noisy measurement
+  /// Std of the correction's x and y error. The default keeps the jumps mostly within the
+  /// navigator's 2 cm arrival tolerance (see docs/sim.md).
+  double position_noise_m = 0.01;
+  double heading_noise_rad = 0.01;  ///< std of the correction's heading error
+};
+
+/// Light-signal detection of the device in front. A device is "in front" when its front (the
+/// RFID zone centre) lies within `range_m` of the robot and within `half_angle_rad` of its
+/// heading, and the robot is on the front's side; the nearest such device is read. `vision`
+/// additionally needs the robot within `facing_half_angle_rad` of the device's facing (looking
+/// at the front of the light, not from the side), samples at `frame_rate_hz`,
+/// reports a reading only after a full blink period of frames of one device (blink = lit and
+/// unlit frames within that period), `delay` late, and with probability `error_rate` per
+/// reading one lamp is reported wrong.
+struct LightDetectionConfig {
+  DetectionLevel level = DetectionLevel::kGroundTruth;
+  double range_m = 1.0;
+  double half_angle_rad = 0.35;
+  double facing_half_angle_rad = 1.0;    ///< vision only
+  double frame_rate_hz = 10.0;           ///< vision only
+  SimTime delay = SimTime::from_sec(1);  ///< vision only
+  double error_rate = 0.05;              ///< vision only; [0, 1]
+};
+
+/// Puck detection (relative positions in the robot frame). `ground_truth`: every puck within
+/// `range_m`. `vision`: pucks within `vision_range_m` and `half_angle_rad` of the heading,
+/// pucks closer than `merge_distance_m` to each other merged into one sighting (their centroid),
+/// updated at `frame_rate_hz`.
+struct PuckDetectionConfig {
+  DetectionLevel level = DetectionLevel::kGroundTruth;
+  double range_m = 2.0;
+  double vision_range_m = 1.2;
+  double half_angle_rad = 0.6;
+  double merge_distance_m = 0.12;
+  double frame_rate_hz = 10.0;
+};
+
+/// The abstraction levels of every robot's interfaces (RobotApi).
+struct RobotLevelsConfig {
+  LocalizationConfig localization;
+  LightDetectionConfig light;
+  PuckDetectionConfig puck;
+};
+
+/// Everything a Game is built from. Aggregate with defaults; validate() (the Game constructor
+/// calls it) throws core::ConfigError naming the field.
+struct GameConfig {
+  kinematic::WorldConfig world = kinematic::WorldConfig::default_2013();
+  refbox::RefboxConfig refbox;
+  refbox::ProtocolConfig protocol;
+  comm::HubConfig hub;
+  planner::PlannerConfig planner;
+  planner::ControllerConfig controller;
+  RobotLevelsConfig levels;
+  /// Scenario seed: every random draw comes from a named stream of it.
+  std::uint64_t seed = 1;
+  /// Skill cycles per second (RobotBrain::on_skill_cycle); the physics step comes from
+  /// world.physics.step, the refbox is stepped every tick.
+  double skill_rate_hz = 30.0;
+  /// Agent cycles per second (RobotBrain::on_agent_cycle).
+  double agent_rate_hz = 10.0;
+  /// Period of every robot's BeaconSignal to the refbox.
+  SimTime beacon_period = SimTime::from_sec(1);
+  /// Team name in the robots' beacons (empty: the refbox's team).
+  std::string team;
+
+  /// Throws core::ConfigError "game.<field>: reason" for the first bad field (the world,
+  /// refbox, protocol, hub and navigation configs are validated by their own validate()).
+  void validate() const;
+};
+
+}  // namespace llsf::sim

@@ -1,0 +1,192 @@
+// SPDX-License-Identifier: MIT
+// RobotStack: one simulated Robotino as its skills and agent see it -- the Fawkes blackboard
+// (lua::RobotApi) at the game's abstraction levels, its navigator and its radio. The stack never
+// touches the World: the Game hands it what its sensors perceive (RobotPercept, tick step 6) and
+// takes its motor command (tick step 2).
+#pragma once
+
+#include <google/protobuf/message.h>
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "llsf/comm/hub.h"
+#include "llsf/core/rng.h"
+#include "llsf/kinematic/sensors.h"
+#include "llsf/kinematic/world.h"
+#include "llsf/lua/robot_api.h"
+#include "llsf/planner/navigator.h"
+#include "llsf/sim/game_config.h"
+
+namespace llsf::sim {
+
+/// What one robot's sensors perceive in one tick. Borrowed views, valid during sense().
+struct RobotPercept {
+  SimTime now;
+  core::Pose2D true_pose;                            ///< for ground truth and the AMCL stand-in
+  const kinematic::RobotSensors* sensors = nullptr;  ///< the world's readings of this robot
+  /// Lamps of the 16 devices (DeviceId order), as the world shows them.
+  std::span<const kinematic::SignalLights> lights;
+  /// Field positions of every puck on the field.
+  std::span<const core::Vec2> pucks;
+};
+
+/// Static description of a device for the light detection: its pose (heading = the facing, the
+/// direction its front looks onto the field) and its front (the RFID zone centre).
+struct DeviceView {
+  std::string name;
+  core::Pose2D pose;
+  core::Vec2 front{0.0, 0.0};
+};
+
+/// Messages a robot received and a way to send: the agent's side of the radio.
+class RobotRadio {
+ public:
+  /// Messages received since the last agent cycle, in delivery order (cleared after it).
+  std::span<const std::unique_ptr<google::protobuf::Message>> inbox() const { return inbox_; }
+  /// Broadcasts `message` to the robot's channel (the team and the refbox) at the current time.
+  /// Returns what the hub said (kNone = accepted). Requires the stack to be attached to a hub.
+  comm::FrameError broadcast(const google::protobuf::Message& message);
+
+ private:
+  friend class RobotStack;
+  friend class Game;
+  comm::Hub* hub_ = nullptr;
+  comm::PeerId peer_;
+  SimTime now_;
+  std::vector<std::unique_ptr<google::protobuf::Message>> inbox_;
+};
+
+/// A robot's skills and agent, plugged into the game loop (the Lua engine and the CLIPS agent
+/// implement it). Called on the simulation thread.
+class RobotBrain {
+ public:
+  virtual ~RobotBrain() = default;
+  /// Tick step 7, at GameConfig::skill_rate_hz.
+  virtual void on_skill_cycle(lua::RobotApi& robot) { static_cast<void>(robot); }
+  /// Tick step 8, at GameConfig::agent_rate_hz; `radio.inbox()` holds what arrived since the
+  /// previous agent cycle.
+  virtual void on_agent_cycle(lua::RobotApi& robot, RobotRadio& radio) {
+    static_cast<void>(robot);
+    static_cast<void>(radio);
+  }
+};
+
+/// One robot's interfaces (lua::RobotApi) at the configured abstraction levels. Not copyable;
+/// borrows the game's planner (for its navigator), which must outlive it.
+class RobotStack final : public lua::RobotApi {
+ public:
+  /// `index` is the robot's world index (also its id towards other robots' navigators);
+  /// `robot_names` names every robot by index (for NavState::blocked_by); `devices` the 16
+  /// devices in DeviceId order. Random draws come from rng streams "sim/<name>/localization",
+  /// "sim/<name>/light"; the navigator's from "planner/<name>".
+  RobotStack(std::string name, int index, const core::Pose2D& start, const GameConfig& config,
+             planner::Planner& planner, std::vector<std::string> robot_names,
+             std::vector<DeviceView> devices, const core::Rng& rng);
+  RobotStack(const RobotStack&) = delete;
+  RobotStack& operator=(const RobotStack&) = delete;
+
+  // --- the game loop's side ----------------------------------------------------------------
+  /// Tick step 2: the motor command for this tick (navigator or set velocity; zero when idle).
+  /// `others`: the other robots as discs (ids = their indices).
+  kinematic::MotorCommand actuate(SimTime now, std::span<const planner::DiscObstacle> others);
+  /// Tick step 6: updates pose, holder, optical, laser, light and puck views from `percept`.
+  void sense(const RobotPercept& percept);
+  int index() const { return index_; }
+  /// The radio of this robot (agent side).
+  RobotRadio& radio() { return radio_; }
+  const planner::Navigator& nav() const { return nav_; }
+  /// Brain plugged into this robot (borrowed), or nullptr.
+  RobotBrain* brain() const { return brain_; }
+  void set_brain(RobotBrain* brain) { brain_ = brain; }
+
+  // --- lua::RobotApi -----------------------------------------------------------------------
+  SimTime now() const override { return now_; }
+  std::string_view name() const override { return name_; }
+  lua::PoseEstimate pose() const override { return pose_; }
+  void goto_place(std::string_view place, bool forward_only) override;
+  void goto_pose(const core::Pose2D& pose, bool forward_only) override;
+  lua::NavState navigator() const override;
+  void stop() override;
+  void set_velocity(double vx_mps, double vy_mps, double omega_rps) override;
+  bool puck_in_holder() const override { return puck_in_holder_; }
+  double ir_distance_m() const override { return ir_distance_m_; }
+  lua::OpticalSensors optical() const override { return optical_; }
+  lua::LightReading light() const override { return light_; }
+  std::span<const lua::PuckSighting> pucks() const override { return sightings_; }
+  lua::LaserView laser() const override { return laser_; }
+
+ private:
+  enum class Drive : std::uint8_t { kIdle, kNavigator, kMotor };
+  /// A light reading of one vision frame (before the delay).
+  struct Frame {
+    SimTime stamp;
+    lua::LightReading reading;
+  };
+
+  void sense_localization(const RobotPercept& p);
+  void sense_light(const RobotPercept& p);
+  void sense_light_vision(const RobotPercept& p);
+  void sense_pucks(const RobotPercept& p);
+  /// The nearest device whose front is in front of `pose` (within the range and the heading
+  /// cone, with the robot on the front's side); with `vision` the robot must also stand within
+  /// the facing cone of the device. -1 if none.
+  int device_in_front(const core::Pose2D& pose, bool vision) const;
+  void set_light(const lua::LightReading& r, SimTime now);
+
+  std::string name_;
+  int index_;
+  RobotLevelsConfig levels_;
+  std::vector<std::string> robot_names_;
+  std::vector<DeviceView> devices_;
+  planner::Navigator nav_;
+  RobotRadio radio_;
+  RobotBrain* brain_ = nullptr;
+  SimTime now_;
+
+  // Actuation.
+  Drive drive_ = Drive::kIdle;
+  kinematic::MotorCommand velocity_;
+  std::uint64_t goal_id_ = 0;
+
+  // Localization.
+  core::RandomStream loc_rng_;
+  lua::PoseEstimate pose_;
+  core::Pose2D est_ref_;  ///< estimate at the last correction
+  core::Pose2D odo_ref_;  ///< odometry at the last correction
+  SimTime next_correction_;
+
+  // Holder, optical, laser.
+  bool puck_in_holder_ = false;
+  double ir_distance_m_ = 0.0;
+  lua::OpticalSensors optical_;
+  lua::LaserView laser_;
+
+  // Light detection.
+  core::RandomStream light_rng_;
+  lua::LightReading light_;
+  SimTime light_next_frame_;
+  int light_device_ = -1;         ///< device observed by the vision frames, -1 none
+  SimTime light_observed_since_;  ///< first frame of the current device
+  /// Recent frames of the current device: stamp and lit lamps (bit 0 red, 1 yellow, 2 green).
+  std::vector<std::pair<SimTime, std::uint8_t>> lit_history_;
+  int lit_head_ = 0;
+  int lit_count_ = 0;
+  std::vector<Frame> frames_;  ///< ring buffer of vision frames awaiting their delay
+  int frame_head_ = 0;         ///< index of the oldest frame
+  int frame_count_ = 0;
+
+  // Puck detection.
+  SimTime puck_next_frame_;
+  std::vector<lua::PuckSighting> sightings_;
+  std::vector<core::Vec2> scratch_;
+  std::vector<int> cluster_;
+};
+
+}  // namespace llsf::sim
