@@ -678,6 +678,8 @@ void World::remove_puck(PuckId puck) {
   auto& p = impl_->pucks[i];
   p.removed = true;
   p.body->SetEnabled(false);
+  auto& ids = impl_->puck_ids;
+  ids.erase(std::find(ids.begin(), ids.end(), puck));
   impl_->pending_zone_check.push_back(i);
 }
 void World::teleport_puck(PuckId puck, const Vec2& position) {

@@ -162,6 +162,7 @@ TEST_CASE("RFID zones report pucks added, moved and removed by the referee") {
   REQUIRE(ev.size() == 1);
   CHECK(ev[0].kind == RfidEventKind::kLeft);
   CHECK_FALSE(w.has_puck(PuckId(42)));
+  for (PuckId p : w.pucks()) CHECK(p != PuckId(42));
   CHECK_THROWS_AS(w.add_puck(PuckId(42), {1.0, 1.0}), core::ConfigError);
   CHECK_THROWS_AS(w.add_puck(PuckId(43), {-1.0, 1.0}), core::ConfigError);
 }

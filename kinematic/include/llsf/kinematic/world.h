@@ -96,7 +96,7 @@ class World {
   const RobotSensors& sensors(RobotId robot) const;
 
   // --- pucks --------------------------------------------------------------------------------
-  /// Ids of all pucks in the world, in insertion order.
+  /// Ids of the pucks in the world (removed ones are gone), in insertion order.
   std::span<const PuckId> pucks() const;
   bool has_puck(PuckId puck) const;
   Vec2 puck_position(PuckId puck) const;
