@@ -46,8 +46,8 @@ enum class Lamp : std::uint8_t { kOff, kOn, kBlink };
 
 /// The signal light of the device the robot faces, as its light detection reports it.
 struct LightReading {
-  bool visible = false;      ///< a device is in front, within range, and has been read
-  std::string device;        ///< "M1", "R2", "D3", ...
+  bool visible = false;  ///< a device is in front, within range, and has been read
+  std::string device;    ///< "M1", "R2", "D3", ...
   Lamp red = Lamp::kOff;
   Lamp yellow = Lamp::kOff;
   Lamp green = Lamp::kOff;
