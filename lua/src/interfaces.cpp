@@ -4,6 +4,7 @@
 #include <cmath>
 #include <exception>
 #include <limits>
+#include <optional>
 
 #include "engine_impl.h"
 
@@ -139,6 +140,69 @@ int nav_goto_pose(lua_State* L) {
     return 0;
   });
 }
+// navigator:place(name) -> x, y, theta, target_x, target_y (nothing for unknown names).
+int nav_place(lua_State* L) {
+  std::size_t n = 0;
+  const char* place = luaL_checklstring(L, 2, &n);
+  return guarded(L, [&](Impl& e) {
+    const std::optional<PlaceInfo> p = e.robot.place(std::string_view(place, n));
+    if (!p) return 0;
+    lua_pushnumber(L, p->pose.x);
+    lua_pushnumber(L, p->pose.y);
+    lua_pushnumber(L, p->pose.theta);
+    lua_pushnumber(L, p->target.x());
+    lua_pushnumber(L, p->target.y());
+    return 5;
+  });
+}
+
+// ---- SymbolicInterface (sym) ----
+int sym_active(lua_State* L) {
+  return guarded(L, [&](Impl& e) {
+    lua_pushboolean(L, e.robot.symbolic() ? 1 : 0);
+    return 1;
+  });
+}
+// sym:travel(x, y [, theta]) -> seconds, length_m  |  nil, error
+int sym_travel(lua_State* L) {
+  const core::Pose2D goal{luaL_checknumber(L, 2), luaL_checknumber(L, 3),
+                          luaL_optnumber(L, 4, 0.0)};
+  return guarded(L, [&](Impl& e) {
+    const TravelEstimate t = e.robot.symbolic_travel(goal);
+    if (!t.ok) {
+      lua_pushnil(L);
+      lua_pushstring(L, t.error.c_str());
+      return 2;
+    }
+    lua_pushnumber(L, t.seconds);
+    lua_pushnumber(L, t.length_m);
+    return 2;
+  });
+}
+int sym_move(lua_State* L) {
+  const core::Pose2D goal{luaL_checknumber(L, 2), luaL_checknumber(L, 3),
+                          luaL_optnumber(L, 4, 0.0)};
+  return guarded(L, [&](Impl& e) {
+    e.robot.symbolic_move(goal);
+    return 0;
+  });
+}
+int sym_pick(lua_State* L) {
+  const core::Vec2 p{luaL_checknumber(L, 2), luaL_checknumber(L, 3)};
+  const double radius = luaL_optnumber(L, 4, 0.1);
+  return guarded(L, [&](Impl& e) {
+    e.robot.symbolic_pick(p, radius);
+    return 0;
+  });
+}
+int sym_drop(lua_State* L) {
+  const core::Vec2 p{luaL_checknumber(L, 2), luaL_checknumber(L, 3)};
+  return guarded(L, [&](Impl& e) {
+    e.robot.symbolic_drop(p);
+    return 0;
+  });
+}
+
 int robot_stop(lua_State* L) {
   return guarded(L, [&](Impl& e) {
     e.robot.stop();
@@ -412,19 +476,14 @@ void push_interfaces(lua_State* L) {
                                   {"get", pose_get},     {"is_valid", pose_is_valid},
                                   {"stamp", pose_stamp}, {"distance_to", pose_distance_to},
                                   {nullptr, nullptr}};
-  static const luaL_Reg navigator[] = {{"goto_place", nav_goto_place},
-                                       {"goto_pose", nav_goto_pose},
-                                       {"stop", robot_stop},
-                                       {"status", nav_status},
-                                       {"arrived", nav_arrived},
-                                       {"failed", nav_failed_fn},
-                                       {"running", nav_running},
-                                       {"is_final", nav_is_final},
-                                       {"error_code", nav_error_code},
-                                       {"error_message", nav_error_message},
-                                       {"blocked_by", nav_blocked_by},
-                                       {"msgid", nav_msgid},
-                                       {nullptr, nullptr}};
+  static const luaL_Reg navigator[] = {
+      {"goto_place", nav_goto_place}, {"goto_pose", nav_goto_pose},
+      {"stop", robot_stop},           {"status", nav_status},
+      {"arrived", nav_arrived},       {"failed", nav_failed_fn},
+      {"running", nav_running},       {"is_final", nav_is_final},
+      {"error_code", nav_error_code}, {"error_message", nav_error_message},
+      {"blocked_by", nav_blocked_by}, {"msgid", nav_msgid},
+      {"place", nav_place},           {nullptr, nullptr}};
   static const luaL_Reg motor[] = {
       {"set_velocity", motor_set_velocity}, {"stop", robot_stop}, {nullptr, nullptr}};
   static const luaL_Reg sensor[] = {{"puck_in_holder", sensor_puck_in_holder},
@@ -443,6 +502,9 @@ void push_interfaces(lua_State* L) {
                                    {"angle", laser_angle},
                                    {"min_distance", laser_min_distance},
                                    {nullptr, nullptr}};
+  static const luaL_Reg sym[] = {{"active", sym_active}, {"travel", sym_travel},
+                                 {"move", sym_move},     {"pick", sym_pick},
+                                 {"drop", sym_drop},     {nullptr, nullptr}};
   static const luaL_Reg clock[] = {
       {"now", clock_now}, {"now_ns", clock_now_ns}, {nullptr, nullptr}};
 
@@ -457,7 +519,8 @@ void push_interfaces(lua_State* L) {
                            {"RobotinoSensorInterface", sensor, nullptr},
                            {"RobotinoLightInterface", light, light_constants},
                            {"PuckVisionInterface", pucks, nullptr},
-                           {"Laser360Interface", laser, nullptr}};
+                           {"Laser360Interface", laser, nullptr},
+                           {"SymbolicInterface", sym, nullptr}};
   // native (at -1).interfaces = {Type = object, ...}; native.interface_names = "A, B, ..."
   lua_newtable(L);
   std::string names;

@@ -438,7 +438,7 @@ reset_skill = function(h)
     end
   end
   if h.fsm then
-    h.fsm.current, h.fsm.error, h.fsm.vars = nil, nil, {}
+    h.fsm.current, h.fsm.error, h.fsm.result, h.fsm.vars = nil, nil, nil, {}
     for _, st in ipairs(h.fsm.state_list) do st.visit = 0 end
   end
   h.active, h.status, h.error, h.vars = false, S_INACTIVE, nil, nil
@@ -597,8 +597,13 @@ function E.run_cycle(chunk)
   for i = #called, 1, -1 do called[i] = nil end
   depth, caller = 0, nil
   chunk()
-  local status, errors = S_FINAL, nil
+  local status, errors, results = S_FINAL, nil, nil
   for _, h in ipairs(called) do
+    local r = h.fsm and h.fsm.result
+    if r ~= nil and h.status ~= S_RUNNING then
+      results = results or {}
+      results[#results + 1] = tostring(r)
+    end
     if h.status == S_FAILED then
       status = S_FAILED
       errors = errors or {}
@@ -607,7 +612,7 @@ function E.run_cycle(chunk)
       status = S_RUNNING
     end
   end
-  return status, errors and concat(errors, "; ") or nil
+  return status, errors and concat(errors, "; ") or nil, results and concat(results, "; ") or ""
 end
 
 function E.reset_all()

@@ -389,6 +389,7 @@ ExecResult SkillEngine::exec(std::string_view skill_string) {
   }
   e.skill_string.assign(skill_string);
   e.error.clear();
+  e.result.clear();
   lua_pushlstring(e.L, skill_string.data(), skill_string.size());
   if (e.call_entry("compile", 1, 2) != LUA_OK || lua_isnil(e.L, -2)) {
     e.error = lua_isstring(e.L, -1) ? lua_tostring(e.L, -1) : "cannot compile the skill string";
@@ -407,6 +408,7 @@ void SkillEngine::stop() {
   e.abort_running();
   e.status = SkillStatus::kInactive;
   e.error.clear();
+  e.result.clear();
   e.skill_string.clear();
   e.robot.stop();
 }
@@ -415,16 +417,20 @@ SkillStatus SkillEngine::cycle() {
   Impl& e = *impl_;
   if (e.status != SkillStatus::kRunning) return e.status;
   lua_rawgeti(e.L, LUA_REGISTRYINDEX, e.chunk_ref);
-  if (e.call_entry("run_cycle", 1, 2) != LUA_OK) {
+  if (e.call_entry("run_cycle", 1, 3) != LUA_OK) {
     e.status = SkillStatus::kFailed;
     e.error = pop_message(e.L);
   } else {
-    const lua_Integer s = lua_tointeger(e.L, -2);
+    const lua_Integer s = lua_tointeger(e.L, -3);
     e.status = static_cast<SkillStatus>(std::clamp<lua_Integer>(s, 0, 3));
     if (e.status == SkillStatus::kFailed) {
-      e.error = lua_isstring(e.L, -1) ? lua_tostring(e.L, -1) : "FAILED";
+      e.error = lua_isstring(e.L, -2) ? lua_tostring(e.L, -2) : "FAILED";
     }
-    lua_pop(e.L, 2);
+    if (e.status != SkillStatus::kRunning) {
+      const char* r = lua_tostring(e.L, -1);
+      e.result = r != nullptr ? r : "";
+    }
+    lua_pop(e.L, 3);
   }
   if (e.status != SkillStatus::kRunning) e.abort_running();
   return e.status;
@@ -432,6 +438,7 @@ SkillStatus SkillEngine::cycle() {
 
 SkillStatus SkillEngine::status() const { return impl_->status; }
 const std::string& SkillEngine::error() const { return impl_->error; }
+const std::string& SkillEngine::result() const { return impl_->result; }
 const std::string& SkillEngine::skill_string() const { return impl_->skill_string; }
 core::SimTime SkillEngine::cycle_period() const {
   return core::SimTime::period_of_hz(impl_->config.rate_hz);

@@ -189,12 +189,79 @@ void Game::run_until(SimTime until) {
 
 // --- the tick --------------------------------------------------------------------------------
 
+std::optional<core::PuckId> Game::puck_in_pocket(int robot) const {
+  const core::RobotId id(robot);
+  if (const auto held = world_->held_puck(id)) return held;
+  // Physical holder (or not yet taken): the puck whose centre is within 2 cm of the pocket.
+  const core::Vec2 pocket = world_->robot_pose(id).to_parent({pocket_offset_m(), 0.0});
+  std::optional<core::PuckId> best;
+  double best_d = 0.02;
+  for (const core::PuckId p : world_->pucks()) {
+    const double d = (world_->puck_position(p) - pocket).norm();
+    if (d <= best_d) {
+      best_d = d;
+      best = p;
+    }
+  }
+  return best;
+}
+
+double Game::pocket_offset_m() const {
+  return config_.world.robot.radius_m + config_.world.puck.radius_m;
+}
+
+void Game::apply_symbolic(int robot) {
+  RobotStack& stack = *stacks_[static_cast<std::size_t>(robot)];
+  std::vector<SymbolicRequest>& requests = stack.symbolic_requests();
+  if (requests.empty()) return;
+  const core::RobotId id(robot);
+  for (const SymbolicRequest& r : requests) {
+    switch (r.kind) {
+      case SymbolicRequest::Kind::kMove: {
+        const std::optional<core::PuckId> held = puck_in_pocket(robot);
+        const core::Pose2D from = world_->robot_pose(id);
+        world_->teleport_robot(id, r.pose);
+        if (held) world_->teleport_puck(*held, r.pose.to_parent({pocket_offset_m(), 0.0}));
+        stack.on_teleported(from, r.pose);
+        break;
+      }
+      case SymbolicRequest::Kind::kPick: {
+        if (puck_in_pocket(robot)) break;  // already holding one
+        std::optional<core::PuckId> best;
+        double best_d = r.radius_m;
+        for (const core::PuckId p : world_->pucks()) {
+          bool taken = false;
+          for (int o = 0; o < robot_count() && !taken; ++o) {
+            taken = o != robot && puck_in_pocket(o) == p;
+          }
+          const double d = (world_->puck_position(p) - r.point).norm();
+          if (!taken && d <= best_d) {
+            best_d = d;
+            best = p;
+          }
+        }
+        if (best) {
+          world_->teleport_puck(*best, world_->robot_pose(id).to_parent({pocket_offset_m(), 0.0}));
+        }
+        break;
+      }
+      case SymbolicRequest::Kind::kDrop: {
+        if (const auto held = puck_in_pocket(robot)) world_->teleport_puck(*held, r.point);
+        break;
+      }
+    }
+  }
+  requests.clear();
+}
+
 void Game::step() {
   // 1. Time advances by the physics step; everything in this tick happens at `now`.
   const SimTime now = world_->time() + config_.world.physics.step;
   const int n = robot_count();
 
-  // 2. Actuators: each stack's navigator or motor command, with the other robots as discs.
+  // 2. Actuators: symbolic skills' changes of the world first; then each stack's navigator or
+  //    motor command, with the other robots as discs.
+  for (int i = 0; i < n; ++i) apply_symbolic(i);
   discs_.clear();
   const double disc_r = planner_->config().inflated_radius_m();
   for (int i = 0; i < n; ++i) {

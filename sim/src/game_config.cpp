@@ -47,6 +47,10 @@ const char* to_string(DetectionLevel level) {
   return level == DetectionLevel::kGroundTruth ? "ground_truth" : "vision";
 }
 
+const char* to_string(SkillLevel level) {
+  return level == SkillLevel::kPhysical ? "physical" : "symbolic";
+}
+
 void GameConfig::validate() const {
   // Localization.
   const LocalizationConfig& l = levels.localization;
@@ -58,6 +62,11 @@ void GameConfig::validate() const {
   }
   non_negative("levels.localization.position_noise_m", l.position_noise_m);
   non_negative("levels.localization.heading_noise_rad", l.heading_noise_rad);
+  // Symbolic skill level.
+  if (!(levels.symbolic.cruise_speed_mps > 0.0)) {
+    fail("levels.symbolic.cruise_speed_mps", "must be > 0");
+  }
+  if (!(levels.symbolic.turn_rate_rps > 0.0)) fail("levels.symbolic.turn_rate_rps", "must be > 0");
   // Light detection.
   const LightDetectionConfig& li = levels.light;
   positive("levels.light.range_m", li.range_m);

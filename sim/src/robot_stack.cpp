@@ -82,6 +82,7 @@ RobotStack::RobotStack(std::string name, int index, const core::Pose2D& start,
       levels_(config.levels),
       robot_names_(std::move(robot_names)),
       devices_(std::move(devices)),
+      planner_(&planner),
       nav_(planner, config.controller, rng.stream("planner/" + name_)),
       loc_rng_(rng.stream("sim/" + name_ + "/localization")),
       light_rng_(rng.stream("sim/" + name_ + "/light")) {
@@ -155,6 +156,86 @@ void RobotStack::set_velocity(double vx_mps, double vy_mps, double omega_rps) {
   velocity_ = {vx_mps, vy_mps, omega_rps};
 }
 
+std::optional<lua::PlaceInfo> RobotStack::place(std::string_view name) const {
+  const planner::Place* p = planner_->place(name);
+  if (p == nullptr) return std::nullopt;
+  return lua::PlaceInfo{p->pose, p->target};
+}
+
+// --- symbolic skill level --------------------------------------------------------------------
+
+namespace {
+void require_symbolic(bool symbolic, const char* what) {
+  if (!symbolic) {
+    throw std::logic_error(std::string(what) +
+                           ": the robot does not run at the symbolic skill level");
+  }
+}
+}  // namespace
+
+lua::TravelEstimate RobotStack::symbolic_travel(const core::Pose2D& goal) const {
+  require_symbolic(symbolic(), "symbolic_travel");
+  planner::PlanRequest req;
+  req.start = pose_.pose;
+  req.goal = goal;
+  req.seed = ++travel_queries_;
+  const planner::PlanResult r = planner_->plan(req);
+  lua::TravelEstimate out;
+  if (r.status != planner::PlanStatus::kFound) {
+    out.error = std::string(planner::to_string(r.status)) + ": " + r.message;
+    return out;
+  }
+  out.ok = true;
+  out.length_m = r.path.length_m();
+  // Turning: along the path's segments, and to the goal heading at the end.
+  double turn = 0.0;
+  double heading = pose_.pose.theta;
+  const auto& pts = r.path.points;
+  for (std::size_t i = 1; i < pts.size(); ++i) {
+    const core::Vec2 d = pts[i] - pts[i - 1];
+    if (d.norm() < 1e-6) continue;
+    const double h = std::atan2(d.y(), d.x());
+    turn += std::abs(core::angle_diff(h, heading));
+    heading = h;
+  }
+  turn += std::abs(core::angle_diff(goal.theta, heading));
+  out.seconds =
+      out.length_m / levels_.symbolic.cruise_speed_mps + turn / levels_.symbolic.turn_rate_rps;
+  return out;
+}
+
+void RobotStack::symbolic_move(const core::Pose2D& pose) {
+  require_symbolic(symbolic(), "symbolic_move");
+  stop();
+  SymbolicRequest r;
+  r.kind = SymbolicRequest::Kind::kMove;
+  r.pose = pose;
+  symbolic_requests_.push_back(r);
+}
+
+void RobotStack::on_teleported(const core::Pose2D& from, const core::Pose2D& to) {
+  teleported_ = true;
+  teleport_from_ = from;
+  teleport_to_ = to;
+}
+
+void RobotStack::symbolic_pick(const core::Vec2& point, double radius_m) {
+  require_symbolic(symbolic(), "symbolic_pick");
+  SymbolicRequest r;
+  r.kind = SymbolicRequest::Kind::kPick;
+  r.point = point;
+  r.radius_m = radius_m;
+  symbolic_requests_.push_back(r);
+}
+
+void RobotStack::symbolic_drop(const core::Vec2& point) {
+  require_symbolic(symbolic(), "symbolic_drop");
+  SymbolicRequest r;
+  r.kind = SymbolicRequest::Kind::kDrop;
+  r.point = point;
+  symbolic_requests_.push_back(r);
+}
+
 // --- sensing ---------------------------------------------------------------------------------
 
 void RobotStack::sense(const RobotPercept& p) {
@@ -188,6 +269,14 @@ void RobotStack::sense_localization(const RobotPercept& p) {
   if (o.seq > 0) {
     const double dt = (p.now - o.stamp).seconds();
     odo = o.pose.compose({o.vx_mps * dt, o.vy_mps * dt, o.omega_rps * dt});
+  }
+  if (teleported_) {
+    // Moved by a symbolic skill (odometry did not see it): the estimate jumps with the robot,
+    // keeping its error relative to the truth.
+    teleported_ = false;
+    est_ref_ = teleport_to_.compose(
+        teleport_from_.inverse().compose(est_ref_.compose(odo_ref_.inverse().compose(odo))));
+    odo_ref_ = odo;
   }
   core::Pose2D est = est_ref_.compose(odo_ref_.inverse().compose(odo));
   if (p.now >= next_correction_) {

@@ -86,6 +86,16 @@ class FakeRobot : public lua::RobotApi {
   lua::OpticalSensors optical() const override { return optical_sensors; }
   lua::LightReading light() const override { return light_reading; }
   std::span<const lua::PuckSighting> pucks() const override { return puck_sightings; }
+  std::optional<lua::PlaceInfo> place(std::string_view name) const override {
+    if (places.find(name) == places.end()) return std::nullopt;
+    // Places on a line, 1 m apart in the order of the set, facing +x.
+    double x = 0.0;
+    for (const auto& p : places) {
+      if (p == name) break;
+      x += 1.0;
+    }
+    return lua::PlaceInfo{{x, 0.0, 0.0}, {x + 0.2225, 0.0}};
+  }
   lua::LaserView laser() const override {
     return {-core::kPi, 2.0 * core::kPi / 360.0, laser_ranges};
   }

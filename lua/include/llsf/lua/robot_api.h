@@ -5,7 +5,9 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 
@@ -73,6 +75,21 @@ struct LaserView {
   std::span<const float> ranges;
 };
 
+/// A named place of the field (docs/planner.md "Places"): where the robot stands and the point
+/// it is about (e.g. the RFID zone centre a held puck lands on).
+struct PlaceInfo {
+  core::Pose2D pose;
+  core::Vec2 target{0.0, 0.0};
+};
+
+/// Estimated duration of a drive at the symbolic skill level.
+struct TravelEstimate {
+  bool ok = false;
+  double length_m = 0.0;  ///< planned path length
+  double seconds = 0.0;   ///< path length over the cruise speed plus turning
+  std::string error;      ///< why there is no estimate (no path, invalid goal)
+};
+
 /// One robot's interfaces. Implementations are owned by `sim/`; the skill engine borrows one per
 /// robot. Calls happen on the simulation thread during the skill cycle.
 class RobotApi {
@@ -111,6 +128,39 @@ class RobotApi {
   virtual std::span<const PuckSighting> pucks() const = 0;
   /// The latest laser scan.
   virtual LaserView laser() const = 0;
+
+  /// A named place ("M3", "M3_left", "INS_2", ...); nullopt for unknown names.
+  virtual std::optional<PlaceInfo> place(std::string_view name) const = 0;
+
+  // --- Symbolic skill level (docs/skills.md "The symbolic level") ------------------------------
+  // Skills at the symbolic level do not drive: they wait an estimated duration and then change
+  // the world directly. Requests take effect at the start of the next tick. Robots at the
+  // physical level throw std::logic_error from these (the skill fails with that message).
+
+  /// True if this robot runs at the symbolic skill level.
+  virtual bool symbolic() const { return false; }
+  /// Estimated time to drive from the robot's pose to `goal`.
+  virtual TravelEstimate symbolic_travel(const core::Pose2D& goal) const;
+  /// Puts the robot at `pose`; a puck it holds comes along.
+  virtual void symbolic_move(const core::Pose2D& pose);
+  /// Puts the free puck nearest to `point` (within `radius_m`, not held by another robot) into
+  /// the holder; puck_in_holder() tells whether there was one.
+  virtual void symbolic_pick(const core::Vec2& point, double radius_m);
+  /// Lays the held puck down at `point` and lets go of it.
+  virtual void symbolic_drop(const core::Vec2& point);
 };
+
+inline TravelEstimate RobotApi::symbolic_travel(const core::Pose2D&) const {
+  throw std::logic_error("symbolic_travel: the robot does not run at the symbolic skill level");
+}
+inline void RobotApi::symbolic_move(const core::Pose2D&) {
+  throw std::logic_error("symbolic_move: the robot does not run at the symbolic skill level");
+}
+inline void RobotApi::symbolic_pick(const core::Vec2&, double) {
+  throw std::logic_error("symbolic_pick: the robot does not run at the symbolic skill level");
+}
+inline void RobotApi::symbolic_drop(const core::Vec2&) {
+  throw std::logic_error("symbolic_drop: the robot does not run at the symbolic skill level");
+}
 
 }  // namespace llsf::lua

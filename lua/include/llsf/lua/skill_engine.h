@@ -93,6 +93,10 @@ class SkillEngine {
   SkillStatus status() const;
   /// Why the skill string failed ("skill: STATE: file:line: ..."); empty unless FAILED.
   const std::string& error() const;
+  /// What the string's skills reported when it ended (FINAL or FAILED): the `fsm.result` of
+  /// each skill it called that set one, joined by "; " (e.g. "WAITING", "R:ON Y:OFF G:BLINK");
+  /// empty while RUNNING or if none did.
+  const std::string& result() const;
   /// The current (or last) skill string.
   const std::string& skill_string() const;
   /// Simulated period between cycles (1 / rate_hz).

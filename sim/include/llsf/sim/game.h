@@ -91,6 +91,8 @@ class Game {
   SimTime time() const { return world_->time(); }
   std::int64_t ticks() const { return ticks_; }
   const GameConfig& config() const { return config_; }
+  /// The scenario seed's random streams (components draw from named streams of it).
+  const core::Rng& rng() const { return rng_; }
 
   kinematic::World& world() { return *world_; }
   const kinematic::World& world() const { return *world_; }
@@ -123,6 +125,17 @@ class Game {
 
  private:
   void apply_refbox_output(const refbox::StepOutput& out);
+  /// Carries out robot `robot`'s symbolic skill requests (tick step 2).
+  void apply_symbolic(int robot);
+  /// Distance from a robot's centre to the centre of a puck in its pocket.
+  double pocket_offset_m() const;
+
+ public:
+  /// The puck in robot `robot`'s holder pocket (held by an assisted holder, or lying within
+  /// 2 cm of the pocket), if any.
+  std::optional<core::PuckId> puck_in_pocket(int robot) const;
+
+ private:
   core::Vec2 free_storage_spot() const;
   bool insertion_slot_occupied() const;
 

@@ -27,9 +27,15 @@ enum class DetectionLevel : std::uint8_t {
   kGroundTruth,  ///< what is there, at once
   kVision,       ///< a camera: field of view, range, delay, errors, merged sightings
 };
-/// "ground_truth", "noisy", "vision".
+/// Skill abstraction level: how the skill library acts on the world.
+enum class SkillLevel : std::uint8_t {
+  kPhysical,  ///< skills drive the robot through navigator and motor; pucks move by contact
+  kSymbolic,  ///< skills wait an estimated duration, then the world is changed directly
+};
+/// "ground_truth", "noisy", "vision", "physical", "symbolic".
 const char* to_string(LocalizationLevel level);
 const char* to_string(DetectionLevel level);
+const char* to_string(SkillLevel level);
 
 /// Localization. `noisy`: the estimate follows the odometry sensor's motion; every
 /// `correction_period` it is pulled towards the true pose plus Gaussian noise
@@ -75,11 +81,20 @@ struct PuckDetectionConfig {
   double frame_rate_hz = 10.0;
 };
 
+/// The symbolic skill level's duration estimate of a drive: planned path length over
+/// `cruise_speed_mps` plus the heading change over `turn_rate_rps`.
+struct SymbolicConfig {
+  double cruise_speed_mps = 0.6;
+  double turn_rate_rps = 1.5;
+};
+
 /// The abstraction levels of every robot's interfaces (RobotApi).
 struct RobotLevelsConfig {
   LocalizationConfig localization;
   LightDetectionConfig light;
   PuckDetectionConfig puck;
+  SkillLevel skill = SkillLevel::kPhysical;
+  SymbolicConfig symbolic;
 };
 
 /// Everything a Game is built from. Aggregate with defaults; validate() (the Game constructor

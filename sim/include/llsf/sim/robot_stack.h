@@ -10,6 +10,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -43,6 +44,16 @@ struct DeviceView {
   std::string name;
   core::Pose2D pose;
   core::Vec2 front{0.0, 0.0};
+};
+
+/// A change of the world a symbolic skill asked for (lua::RobotApi::symbolic_*); the Game
+/// carries it out at the start of the next tick.
+struct SymbolicRequest {
+  enum class Kind : std::uint8_t { kMove, kPick, kDrop };
+  Kind kind = Kind::kMove;
+  core::Pose2D pose;           ///< kMove: where the robot goes
+  core::Vec2 point{0.0, 0.0};  ///< kPick: near where; kDrop: where the puck goes
+  double radius_m = 0.0;       ///< kPick: how far from `point` a puck may be
 };
 
 /// Messages a robot received and a way to send: the agent's side of the radio.
@@ -121,6 +132,18 @@ class RobotStack final : public lua::RobotApi {
   lua::LightReading light() const override { return light_; }
   std::span<const lua::PuckSighting> pucks() const override { return sightings_; }
   lua::LaserView laser() const override { return laser_; }
+  std::optional<lua::PlaceInfo> place(std::string_view name) const override;
+  bool symbolic() const override { return levels_.skill == SkillLevel::kSymbolic; }
+  lua::TravelEstimate symbolic_travel(const core::Pose2D& goal) const override;
+  void symbolic_move(const core::Pose2D& pose) override;
+  void symbolic_pick(const core::Vec2& point, double radius_m) override;
+  void symbolic_drop(const core::Vec2& point) override;
+
+  /// Tells the stack that the game moved the robot from true pose `from` to `to` (a symbolic
+  /// move): a noisy pose estimate jumps along.
+  void on_teleported(const core::Pose2D& from, const core::Pose2D& to);
+  /// The symbolic requests since the last call (the Game carries them out in tick step 2).
+  std::vector<SymbolicRequest>& symbolic_requests() { return symbolic_requests_; }
 
  private:
   enum class Drive : std::uint8_t { kIdle, kNavigator, kMotor };
@@ -145,8 +168,11 @@ class RobotStack final : public lua::RobotApi {
   RobotLevelsConfig levels_;
   std::vector<std::string> robot_names_;
   std::vector<DeviceView> devices_;
+  planner::Planner* planner_;
   planner::Navigator nav_;
   RobotRadio radio_;
+  std::vector<SymbolicRequest> symbolic_requests_;
+  mutable std::uint64_t travel_queries_ = 0;
   RobotBrain* brain_ = nullptr;
   SimTime now_;
 
@@ -160,6 +186,9 @@ class RobotStack final : public lua::RobotApi {
   lua::PoseEstimate pose_;
   core::Pose2D est_ref_;  ///< estimate at the last correction
   core::Pose2D odo_ref_;  ///< odometry at the last correction
+  bool teleported_ = false;
+  core::Pose2D teleport_from_;
+  core::Pose2D teleport_to_;
   SimTime next_correction_;
 
   // Holder, optical, laser.

@@ -1,0 +1,75 @@
+-- SPDX-License-Identifier: MIT
+-- drive_to: the navigator to a named place or a pose.
+name               = "drive_to"
+fsm                = SkillHSM:new{name=name, start="DRIVE"}
+depends_skills     = nil
+depends_interfaces = {
+   {v = "navigator", type = "NavigatorInterface", id = "Navigator"},
+   {v = "sensor",    type = "RobotinoSensorInterface", id = "Robotino"},
+}
+documentation      = [==[Drives to a named place or to a pose with the navigator.
+@param place         a place name: "M3" (= "M3_input"), "M3_left", "M3_look", "INS_2",
+                     "LATE_ORDER", "WAIT_INS", ... (see docs/planner.md "Places")
+@param x, y          a field pose instead of a place (metres)
+@param ori           heading at the pose (rad, default 0)
+@param forward_only  keep the holder in front, never drive backwards (default: true while a
+                     puck is in the holder, so that it is not lost)
+@param timeout       seconds before giving up (default 120)
+Fails: "drive_to needs place=<name> or x=, y=", the navigator's outcome with its reason
+("navigator NO_PATH: ...", "INVALID_GOAL: unknown place 'M11'", "BLOCKED by robot2",
+"STUCK: ..."), or "no arrival within N s".
+]==]
+
+local function navigator_failed(self)
+   if navigator:failed() and navigator:msgid() == self.fsm.vars.msgid then
+      local status = navigator:status()
+      local why = navigator:error_message()
+      if status == "BLOCKED" and navigator:blocked_by() ~= "" then
+         why = "by " .. navigator:blocked_by() .. (why ~= "" and (": " .. why) or "")
+      end
+      self.fsm.error = string.format("navigator %s: %s", status, why)
+      return true
+   end
+   return false
+end
+
+local function timed_out(self, vars)
+   if clock.now() < vars.deadline then return false end
+   self.fsm.error = string.format("no arrival within %g s", vars.timeout or 120)
+   return true
+end
+
+local function bad_args(self, vars)
+   if vars.place ~= nil then return type(vars.place) ~= "string" end
+   return type(vars.x) ~= "number" or type(vars.y) ~= "number"
+end
+
+fsm:define_states{ export_to=_M,
+   {"DRIVE", JumpState},
+}
+
+fsm:add_transitions{
+   {"DRIVE", "FAILED", precond=bad_args, error="drive_to needs place=<name> or x=, y="},
+   {"DRIVE", "FINAL", cond="navigator:arrived() and navigator:msgid() == vars.msgid",
+    desc="arrived"},
+   {"DRIVE", "FAILED", cond=navigator_failed, desc="navigator failed"},
+   {"DRIVE", "FAILED", cond=timed_out, desc="timeout"},
+}
+
+function DRIVE:init()
+   local v = self.fsm.vars
+   local forward = v.forward_only
+   if forward == nil then forward = sensor:puck_in_holder() end
+   v.deadline = clock.now() + (v.timeout or 120)
+   if v.place ~= nil then
+      navigator:goto_place(v.place, forward)
+   else
+      navigator:goto_pose(v.x, v.y, v.ori or 0, forward)
+   end
+   v.msgid = navigator:msgid()
+end
+
+function DRIVE:exit()
+   -- Aborted (new skill string, stop, timeout): do not leave the robot driving.
+   if not navigator:arrived() then navigator:stop() end
+end

@@ -1,0 +1,169 @@
+-- SPDX-License-Identifier: MIT
+-- finish_puck_at: bring the held puck under a machine's RFID reader and read the outcome.
+name               = "finish_puck_at"
+fsm                = SkillHSM:new{name=name, start="APPROACH"}
+depends_skills     = {"drive_to", "motor_move", "leave_puck"}
+depends_interfaces = {
+   {v = "navigator", type = "NavigatorInterface", id = "Navigator"},
+   {v = "pose",      type = "Position3DInterface", id = "Pose"},
+   {v = "sensor",    type = "RobotinoSensorInterface", id = "Robotino"},
+   {v = "light",     type = "RobotinoLightInterface", id = "Light"},
+   {v = "pucks",     type = "PuckVisionInterface", id = "Puck"},
+}
+documentation      = [==[Brings the held puck into the RFID zone of a machine (production machine,
+recycler or test station), watches the signal light until it settles and reports the outcome as
+the skill's result:
+  "DONE"     the machine processed the puck and shows green: the product (an S1, S2, P1..P3 or,
+             at a recycler, an S0) is in the holder;
+  "WAITING"  the machine took the puck as an intermediate input and waits for more (yellow): the
+             puck is put down beside the machine (left, or right if a puck lies left) and the
+             robot backs off with an empty holder.
+@param place  the machine: "M1".."M10", "R1", "R2" or "TST"
+@param settle seconds a final light must hold before it counts (default 0.5)
+Fails: "finish_puck_at: no puck in the holder", "finish_puck_at: unknown place 'X'",
+"M3 is down (red)", "M3 rejected the puck (yellow blinking: invalid input)", "M3 did not react
+(the puck is not under its RFID reader?)", "M3: no final light within 90 s", "finish_puck_at:
+lost the puck", drive_to's failure. The puck stays in the holder unless the outcome was WAITING.
+]==]
+
+local PRE = 0.30          -- the approach stops this far before the input place
+local REACT_S = 6.0       -- processing must show within this time (vision adds a delay)
+local LIMIT_S = 90.0      -- T3/T4 take up to 60 s
+
+local function bad(self, vars)
+   if type(vars.place) ~= "string" then
+      self.fsm.error = "finish_puck_at needs place=<machine>"
+      return true
+   end
+   if navigator:place(vars.place .. "_input") == nil then
+      self.fsm.error = string.format("finish_puck_at: unknown place '%s'", vars.place)
+      return true
+   end
+   return false
+end
+
+-- True if a puck lies near field point (x, y).
+local function puck_near(x, y)
+   local rx, ry, th = pose:get()
+   local c, s = math.cos(th), math.sin(th)
+   for i = 1, pucks:count() do
+      local px, py = pucks:puck(i)
+      local fx, fy = rx + c * px - s * py, ry + s * px + c * py
+      if (fx - x) ^ 2 + (fy - y) ^ 2 < 0.1 ^ 2 then return true end
+   end
+   return false
+end
+
+-- The light of the machine, as a short code ("GY" = green + yellow on, "Yb" = yellow blinking)
+-- or nil if the robot does not see it.
+local function lights(vars)
+   if not light:visible() or light:device() ~= vars.place then return nil end
+   local function lamp(v, ch)
+      if v == light.ON then return ch elseif v == light.BLINKING then return ch:lower() end
+      return ""
+   end
+   return lamp(light:red(), "R") .. lamp(light:yellow(), "Y") .. lamp(light:green(), "G")
+end
+
+-- Watches the light; sets vars.outcome once it settles.
+local function watch(self, vars)
+   local code = lights(vars)
+   local now = clock.now()
+   if code == "YG" then vars.processing = true end
+   local settled = code ~= nil and light:stable_for() >= (vars.settle or 0.5)
+   if code ~= nil and string.find(code, "y") and light:stable_for() >= 0.6 then
+      self.fsm.error = vars.place .. " rejected the puck (yellow blinking: invalid input)"
+      return true
+   end
+   if settled and code == "R" then
+      self.fsm.error = vars.place .. " is down (red)"
+      return true
+   end
+   if vars.processing and settled and code == "G" then
+      vars.outcome = "DONE"
+      return true
+   end
+   if vars.processing and settled and code == "Y" then
+      vars.outcome = "WAITING"
+      return true
+   end
+   if not vars.processing and now - vars.arrived >= REACT_S then
+      self.fsm.error = vars.place .. " did not react (the puck is not under its RFID reader?)"
+      return true
+   end
+   if now - vars.arrived >= LIMIT_S then
+      self.fsm.error = string.format("%s: no final light within %.0f s", vars.place, LIMIT_S)
+      return true
+   end
+   return false
+end
+
+local function lost(self, vars)
+   if sensor:puck_in_holder() then
+      vars.lost_since = nil
+      return false
+   end
+   vars.lost_since = vars.lost_since or clock.now()
+   if clock.now() - vars.lost_since < 0.3 then return false end
+   self.fsm.error = "finish_puck_at: lost the puck"
+   return true
+end
+
+fsm:define_states{ export_to=_M,
+   {"APPROACH", SkillJumpState, skills={{drive_to}}, final_to="LOOK_SIDES", fail_to="FAILED"},
+   {"LOOK_SIDES", JumpState},
+   {"INSERT",   SkillJumpState, skills={{drive_to}}, final_to="WAIT_LIGHT", fail_to="FAILED"},
+   {"WAIT_LIGHT", JumpState},
+   {"DECIDE",   JumpState},
+   {"ASIDE",    SkillJumpState, skills={{motor_move}}, final_to="LEAVE", fail_to="FAILED"},
+   {"LEAVE",    SkillJumpState, skills={{leave_puck}}, final_to="FINAL", fail_to="FAILED"},
+}
+
+fsm:add_transitions{
+   {"APPROACH", "FAILED", precond=bad, desc="bad arguments"},
+   {"APPROACH", "FAILED", precond="not sensor:puck_in_holder()",
+    error="finish_puck_at: no puck in the holder"},
+   {"LOOK_SIDES", "INSERT", timeout=0.3},
+   {"WAIT_LIGHT", "DECIDE", cond=watch, desc="light settled"},
+   {"WAIT_LIGHT", "FAILED", cond=lost, desc="puck lost"},
+   {"DECIDE", "FINAL", cond="vars.outcome == 'DONE'", desc="done"},
+   {"DECIDE", "ASIDE", cond="vars.outcome == 'WAITING'", desc="waiting for more"},
+   {"APPROACH", "FAILED", cond=lost, desc="puck lost"},
+   {"INSERT", "FAILED", cond=lost, desc="puck lost"},
+}
+
+function APPROACH:init()
+   local v = self.fsm.vars
+   local px, py, pth = navigator:place(v.place .. "_input")
+   self.args["drive_to"] = {x = px - math.cos(pth) * PRE, y = py - math.sin(pth) * PRE,
+                            ori = pth, forward_only = true}
+end
+
+function LOOK_SIDES:exit()
+   local v = self.fsm.vars
+   local lx, ly = select(4, navigator:place(v.place .. "_left"))
+   local rx, ry = select(4, navigator:place(v.place .. "_right"))
+   v.left_busy = lx ~= nil and puck_near(lx, ly)
+   v.right_busy = rx ~= nil and puck_near(rx, ry)
+end
+
+function INSERT:init()
+   self.args["drive_to"] = {place = self.fsm.vars.place .. "_input", forward_only = true}
+end
+
+function WAIT_LIGHT:init()
+   self.fsm.vars.arrived = clock.now()
+   self.fsm.vars.processing = false
+end
+
+function DECIDE:init()
+   self.fsm.result = self.fsm.vars.outcome
+end
+
+function ASIDE:init()
+   local v = self.fsm.vars
+   -- Beside the reader, where the intermediate inputs lie (the <M>_left / <M>_right spots).
+   local side = 0.22
+   if v.left_busy and not v.right_busy then side = -0.22 end
+   self.args["motor_move"] = {y = side, vel_trans = 0.2}
+end

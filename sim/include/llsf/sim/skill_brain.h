@@ -1,0 +1,66 @@
+// SPDX-License-Identifier: MIT
+// SkillBrain: a robot's skill layer in the game loop -- a lua::SkillEngine over the robot's
+// RobotStack, cycled at the game's skill rate, with the LLSF skill library (lua/skills/) at the
+// robot's skill level. Agents (or tools such as `llsfsim skill`) send it skill strings.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "llsf/lua/skill_engine.h"
+#include "llsf/sim/game.h"
+
+namespace llsf::sim {
+
+/// The skill directories of the LLSF skill library for `level`: `lua/skills` of the source tree
+/// (or `library_dir` if not empty), plus its `symbolic/` subdirectory at the symbolic level
+/// (whose primitives replace the physical ones of the same name).
+std::vector<std::string> skill_library_dirs(SkillLevel level, std::string_view library_dir = {});
+
+/// A change of a skill string's status, for listeners.
+struct SkillStatusChange {
+  SimTime time;
+  std::string robot;
+  std::string skill_string;
+  lua::SkillStatus status = lua::SkillStatus::kInactive;
+  std::string error;   ///< set when FAILED
+  std::string result;  ///< what the skills reported when the string ended
+};
+
+/// Runs a skill engine as robot `index`'s brain (on_skill_cycle). Plugs itself into the game on
+/// construction and out on destruction; the game must outlive it.
+class SkillBrain final : public RobotBrain {
+ public:
+  /// `config.skill_dirs` empty: the skill library of the game's skill level. The engine's rate
+  /// is the game's skill rate; its `math.random` seed comes from the stream "lua/<robot>".
+  /// Throws core::ConfigError for a bad config or a missing skill directory.
+  SkillBrain(Game& game, int index, lua::SkillEngineConfig config = {});
+  ~SkillBrain() override;
+  SkillBrain(const SkillBrain&) = delete;
+  SkillBrain& operator=(const SkillBrain&) = delete;
+
+  lua::SkillEngine& engine() { return engine_; }
+  const lua::SkillEngine& engine() const { return engine_; }
+  /// exec() on the engine, reporting the new status to the listener.
+  lua::ExecResult exec(std::string_view skill_string);
+  /// Called after every status change of the skill string (RUNNING, FINAL, FAILED, INACTIVE).
+  void set_listener(std::function<void(const SkillStatusChange&)> listener) {
+    listener_ = std::move(listener);
+  }
+
+  void on_skill_cycle(lua::RobotApi& robot) override;
+
+ private:
+  void report();
+
+  Game& game_;
+  int index_;
+  lua::SkillEngine engine_;
+  std::function<void(const SkillStatusChange&)> listener_;
+  lua::SkillStatus last_ = lua::SkillStatus::kInactive;
+  std::string last_string_;
+};
+
+}  // namespace llsf::sim
