@@ -11,7 +11,8 @@ depends_interfaces = {
 }
 documentation      = [==[Delivers the held product (P1, P2 or P3): looks at the delivery gates one
 after another (nearest first) until one shows green (the active gate), puts the puck under its
-reader, waits for all three lamps (delivered), and backs away. Result: "DELIVERED D2".
+reader, waits until the gate has processed it (green + yellow, then all three lamps or the
+referee taking the puck away), and backs away. Result: "DELIVERED D2".
 @param gate    "D1", "D2" or "D3" to try that gate first (default: the nearest)
 @param rounds  how many times to look at all three gates before giving up (default 3)
 Fails: "deliver: no puck in the holder", "deliver: no active gate (D1 R, D2 R, D3 R)",
@@ -68,7 +69,10 @@ end
 local function watch(self, vars)
    local c = code(vars.current)
    local now = clock.now()
-   if c == "RYG" and light:stable_for() >= 0.3 then return true end
+   if c == "YG" then vars.processing = true end
+   -- Delivered: all three lamps, or the referee took the puck after the gate processed it.
+   if c == "RYG" then return true end
+   if vars.processing and not sensor:puck_in_holder() then return true end
    if c ~= nil and string.find(c, "y") and light:stable_for() >= 0.6 then
       self.fsm.error = vars.current .. " refused the puck (yellow blinking: no active order for it)"
       return true
@@ -134,6 +138,7 @@ end
 
 function WAIT:init()
    self.fsm.vars.put_at = clock.now()
+   self.fsm.vars.processing = false
 end
 
 function BACK_OFF:init()

@@ -17,8 +17,6 @@ Fails: "get_consumed: already holding a puck", "get_consumed: unknown machine 'X
 "get_consumed: no puck beside M3", take_puck's/drive_to's failure.
 ]==]
 
-local LOOK_BACK = 0.5   -- the look position lies this far out from the machine's input place
-
 local function bad(self, vars)
    if type(vars.place) ~= "string" or navigator:place(vars.place .. "_left") == nil then
       self.fsm.error = string.format("get_consumed: unknown machine '%s'", tostring(vars.place))
@@ -61,10 +59,9 @@ fsm:add_transitions{
 }
 
 function GOTO:init()
-   local px, py, pth = navigator:place(self.fsm.vars.place .. "_input")
-   self.fsm.vars.ori = pth
-   self.args["drive_to"] = {x = px - math.cos(pth) * LOOK_BACK, y = py - math.sin(pth) * LOOK_BACK,
-                            ori = pth}
+   -- From the look position the puck detection sees both sides of the machine.
+   self.fsm.vars.ori = select(3, navigator:place(self.fsm.vars.place .. "_input"))
+   self.args["drive_to"] = {place = self.fsm.vars.place .. "_look"}
 end
 
 function TAKE:init()

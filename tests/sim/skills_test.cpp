@@ -101,3 +101,102 @@ TEST_CASE("get_s0 then finish_puck_at a T1: the refbox makes it an S1") {
     MESSAGE(std::string(to_string(level)), " finish_puck_at took ", o.seconds, " s");
   }
 }
+
+namespace {
+
+/// A game in PRODUCTION with robot 0 running the skill library at `level`.
+struct ProductionGame {
+  explicit ProductionGame(SkillLevel level, std::uint64_t seed = 7) : game(config(level, seed)) {
+    test::start_phase(game, refbox::GamePhase::kProduction);
+    game.step();
+    brain = std::make_unique<SkillBrain>(game, 0);
+  }
+  static GameConfig config(SkillLevel level, std::uint64_t seed) {
+    GameConfig c = test::small_game(1, seed);
+    c.levels.skill = level;
+    return c;
+  }
+  Outcome run(const std::string& s, double max_s = 180) {
+    Outcome o = run_skill(game, *brain, s, max_s);
+    MESSAGE(std::string(to_string(game.config().levels.skill)), " ", s, ": ",
+            lua::to_string(o.status), " after ", o.seconds, " s ", o.result, " ", o.error);
+    return o;
+  }
+  std::string machine(refbox::MachineType type) {
+    auto m = machine_of_type(game.refbox(), type, 150);
+    if (!m) m = machine_of_type(game.refbox(), type, 0);
+    REQUIRE(m);
+    return machine_name(*m);
+  }
+  Game game;
+  std::unique_ptr<SkillBrain> brain;
+};
+
+#define REQUIRE_FINAL(o)                                \
+  do {                                                  \
+    const Outcome& o_ = (o);                            \
+    INFO(o_.error);                                     \
+    REQUIRE(o_.status == lua::SkillStatus::kFinal);     \
+  } while (false)
+
+}  // namespace
+
+TEST_CASE("the P3 chain: get_s0, finish_puck_at the T5, deliver scores the order") {
+  for (const SkillLevel level : {SkillLevel::kPhysical, SkillLevel::kSymbolic}) {
+    CAPTURE(std::string(to_string(level)));
+    ProductionGame pg(level);
+    const std::string t5 = pg.machine(refbox::MachineType::kT5);
+    REQUIRE_FINAL(pg.run("get_s0{}"));
+    const Outcome made = pg.run("finish_puck_at{place=\"" + t5 + "\"}");
+    REQUIRE_FINAL(made);
+    CHECK(made.result == "DONE");
+    REQUIRE(held_state(pg.game, 0) == refbox::PuckState::kP3);
+    const int before = pg.game.summary().production_points;
+    const Outcome d = pg.run("deliver{}", 240);
+    REQUIRE_FINAL(d);
+    CHECK(d.result.rfind("DELIVERED D", 0) == 0);
+    CHECK(pg.game.summary().production_points >= before + 10);
+    int delivered = 0;
+    for (const auto& o : pg.game.refbox().orders()) {
+      if (o.product == refbox::PuckState::kP3) delivered += o.quantity_delivered;
+    }
+    CHECK(delivered == 1);
+    CHECK_FALSE(pg.game.puck_in_pocket(0).has_value());
+  }
+}
+
+TEST_CASE("a T2 chain leaves a consumed puck beside the machine; recycle makes it an S0") {
+  for (const SkillLevel level : {SkillLevel::kPhysical, SkillLevel::kSymbolic}) {
+    CAPTURE(std::string(to_string(level)));
+    ProductionGame pg(level);
+    const std::string t1 = pg.machine(refbox::MachineType::kT1);
+    const std::string t2 = pg.machine(refbox::MachineType::kT2);
+    // S1 first: the T2 takes it as its first input and waits; the skill puts it aside.
+    REQUIRE_FINAL(pg.run("get_s0{}"));
+    REQUIRE_FINAL(pg.run("finish_puck_at{place=\"" + t1 + "\"}"));
+    REQUIRE(held_state(pg.game, 0) == refbox::PuckState::kS1);
+    const core::PuckId s1 = *pg.game.puck_in_pocket(0);
+    const Outcome waiting = pg.run("finish_puck_at{place=\"" + t2 + "\"}");
+    REQUIRE_FINAL(waiting);
+    CHECK(waiting.result == "WAITING");
+    CHECK_FALSE(pg.game.puck_in_pocket(0).has_value());
+    // An S0 completes the set: S2 in the holder, the S1 beside the machine is CONSUMED.
+    REQUIRE_FINAL(pg.run("get_s0{}"));
+    const Outcome done = pg.run("finish_puck_at{place=\"" + t2 + "\"}");
+    REQUIRE_FINAL(done);
+    CHECK(done.result == "DONE");
+    CHECK(held_state(pg.game, 0) == refbox::PuckState::kS2);
+    CHECK(pg.game.refbox().puck_state(s1) == refbox::PuckState::kConsumed);
+    // Put the S2 down out of the way (facing the wall of the insertion area), then recycle the
+    // consumed puck.
+    REQUIRE_FINAL(pg.run("drive_to{x=0.7, y=1.2, ori=math.pi}"));
+    REQUIRE_FINAL(pg.run("leave_puck{}"));
+    const int before = pg.game.summary().production_points;
+    const Outcome r = pg.run("recycle{from=\"" + t2 + "\"}");
+    REQUIRE_FINAL(r);
+    CHECK(r.result == "DONE");
+    REQUIRE(pg.game.puck_in_pocket(0) == s1);
+    CHECK(pg.game.refbox().puck_state(s1) == refbox::PuckState::kS0);
+    CHECK(pg.game.summary().production_points >= before + 3);
+  }
+}

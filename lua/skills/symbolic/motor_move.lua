@@ -42,11 +42,12 @@ function MOVE:init()
    v.arrive_at = clock.now() + math.sqrt(dx * dx + dy * dy) / (v.vel_trans or 0.3) +
                  math.abs(dth) / (v.vel_rot or 1.0)
    if dx < 0 and sensor:puck_in_holder() then
-      sym:drop(x + c * OFFSET, y + s * OFFSET)   -- the holder lets go when backing
+      v.drop_x, v.drop_y = x + c * OFFSET, y + s * OFFSET   -- the holder lets go when backing
    end
 end
 
 function ARRIVE:init()
    local v = self.fsm.vars
    sym:move(v.gx, v.gy, v.gth)
+   if v.drop_x then sym:drop(v.drop_x, v.drop_y) end   -- after the move: the puck stays behind
 end
