@@ -200,3 +200,88 @@ TEST_CASE("a T2 chain leaves a consumed puck beside the machine; recycle makes i
     CHECK(pg.game.summary().production_points >= before + 3);
   }
 }
+
+namespace {
+
+/// "M3 red=ON yellow=OFF green=BLINKING" for the refbox's exploration code of machine `i`.
+std::string expected_code(const Game& g, int i) {
+  const refbox::Lights l = g.refbox().machine(core::DeviceId(i)).lights;
+  auto name = [](refbox::LightState s) {
+    return s == refbox::LightState::kOn ? "ON" : s == refbox::LightState::kBlink ? "BLINKING"
+                                                                                  : "OFF";
+  };
+  return machine_name(i) + " red=" + name(l.red) + " yellow=" + name(l.yellow) +
+         " green=" + name(l.green);
+}
+
+/// Explores all ten machines with one robot; returns how many codes were read correctly.
+int explore_all(DetectionLevel light, std::uint64_t seed) {
+  GameConfig c = test::small_game(1, seed);
+  c.levels.light.level = light;
+  Game g(c);
+  test::start_phase(g, refbox::GamePhase::kExploration);
+  g.step();
+  SkillBrain brain(g, 0);
+  int correct = 0;
+  for (int i = 0; i < refbox::kProductionMachineCount; ++i) {
+    const Outcome o = run_skill(g, brain, "explore_machine{place=\"" + machine_name(i) + "\"}", 60);
+    INFO(machine_name(i), ": ", o.error);
+    CHECK(o.status == lua::SkillStatus::kFinal);
+    if (o.result == expected_code(g, i)) {
+      ++correct;
+    } else {
+      MESSAGE("read ", o.result, ", expected ", expected_code(g, i));
+    }
+  }
+  return correct;
+}
+
+}  // namespace
+
+TEST_CASE("explore_machine reads all ten codes at ground truth, most of them at vision") {
+  CHECK(explore_all(DetectionLevel::kGroundTruth, 7) == 10);
+  int vision = 0;
+  for (const std::uint64_t seed : {7, 8}) vision += explore_all(DetectionLevel::kVision, seed);
+  MESSAGE("vision: ", vision, " of 20 codes correct");
+  CHECK(vision >= 16);
+}
+
+TEST_CASE("a puck knocked out of the holder fails the skill with a reason") {
+  for (const SkillLevel level : {SkillLevel::kPhysical, SkillLevel::kSymbolic}) {
+    CAPTURE(std::string(to_string(level)));
+    ProductionGame pg(level);
+    REQUIRE_FINAL(pg.run("get_s0{}"));
+    const core::PuckId puck = *pg.game.puck_in_pocket(0);
+    REQUIRE(pg.brain->exec("finish_puck_at{place=\"M10\"}").ok);
+    // A second later something knocks the puck away.
+    for (int i = 0; i < 100; ++i) pg.game.step();
+    const core::Pose2D r = pg.game.world().robot_pose(core::RobotId(0));
+    pg.game.world().teleport_puck(puck, r.to_parent({0.0, 0.6}));
+    const SimTime end = pg.game.time() + SimTime::from_sec(30);
+    while (pg.game.time() < end && pg.brain->engine().status() == lua::SkillStatus::kRunning) {
+      pg.game.step();
+    }
+    CHECK(pg.brain->engine().status() == lua::SkillStatus::kFailed);
+    CHECK(pg.brain->engine().error().find("lost the puck") != std::string::npos);
+    MESSAGE(pg.brain->engine().error());
+  }
+}
+
+TEST_CASE("skill failures name their reason: bad arguments, unknown places, empty holder") {
+  ProductionGame pg(SkillLevel::kPhysical);
+  auto failed_with = [&](const std::string& s, const std::string& text) {
+    const Outcome o = run_skill(pg.game, *pg.brain, s, 30);
+    INFO(s, " -> ", o.error);
+    CHECK(o.status == lua::SkillStatus::kFailed);
+    CHECK(o.error.find(text) != std::string::npos);
+  };
+  failed_with("drive_to{place=\"M11\"}", "unknown place 'M11'");
+  failed_with("drive_to{}", "drive_to needs place=<name> or x=, y=");
+  failed_with("finish_puck_at{place=\"M3\"}", "no puck in the holder");
+  failed_with("deliver{}", "deliver: no puck in the holder");
+  failed_with("get_s0{place=\"NOWHERE\"}", "get_s0: unknown place 'NOWHERE'");
+  failed_with("explore_machine{place=\"X1\"}", "unknown device 'X1'");
+  failed_with("get_consumed{place=\"D1\"}", "unknown machine 'D1'");
+  failed_with("recycle{}", "recycle: no puck in the holder");
+  failed_with("motor_move{x=\"far\"}", "motor_move needs numbers");
+}
