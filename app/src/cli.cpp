@@ -1,0 +1,62 @@
+// SPDX-License-Identifier: MIT
+#include "llsf/app/cli.h"
+
+#include <CLI/CLI.hpp>
+
+#include <exception>
+#include <ostream>
+#include <vector>
+
+#include "commands.h"
+
+namespace llsf::app {
+
+int run(std::span<const std::string> args, std::ostream& out, std::ostream& err) {
+  CLI::App app{
+      "llsfsim: a fast, deterministic simulator of the RoboCup Logistics League 2013 (LLSF).\n"
+      "Exit codes: 0 ok, 1 a skill or test case failed, 2 bad input.",
+      "llsfsim"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "llsfsim 0.1.0");
+  std::vector<std::pair<CLI::App*, Action>> commands;
+  {
+    CLI::App* sub = app.add_subcommand(
+        "skill", "Run skill strings on one robot in a fresh game; print status changes");
+    commands.emplace_back(sub, add_skill_command(*sub));
+  }
+  std::vector<std::string> argv_rest(args.begin() + (args.empty() ? 0 : 1), args.end());
+  std::reverse(argv_rest.begin(), argv_rest.end());  // CLI11 parses a reversed vector
+  try {
+    app.parse(argv_rest);
+  } catch (const CLI::CallForHelp&) {
+    out << app.help();
+    return kExitOk;
+  } catch (const CLI::CallForAllHelp&) {
+    out << app.help("", CLI::AppFormatMode::All);
+    return kExitOk;
+  } catch (const CLI::CallForVersion&) {
+    out << app.version() << "\n";
+    return kExitOk;
+  } catch (const CLI::ParseError& e) {
+    err << "llsfsim: " << e.what() << "\n";
+    if (app.get_subcommands().empty()) {
+      err << "Run 'llsfsim --help' for the commands.\n";
+    } else {
+      err << "Run 'llsfsim " << app.get_subcommands().front()->get_name()
+          << " --help' for its options.\n";
+    }
+    return kExitBadInput;
+  }
+  for (auto& [sub, action] : commands) {
+    if (!sub->parsed()) continue;
+    try {
+      return action(out, err);
+    } catch (const std::exception& e) {
+      err << "llsfsim " << sub->get_name() << ": " << e.what() << "\n";
+      return kExitBadInput;
+    }
+  }
+  return kExitBadInput;
+}
+
+}  // namespace llsf::app

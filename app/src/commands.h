@@ -1,0 +1,18 @@
+// SPDX-License-Identifier: MIT
+// The subcommands of llsfsim: each registers its options on a CLI11 subcommand and runs.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+#include <iosfwd>
+
+namespace llsf::app {
+
+/// A subcommand's action, called after parsing; returns the exit code.
+using Action = std::function<int(std::ostream& out, std::ostream& err)>;
+
+/// `llsfsim skill`: one skill string (or several, in turn) on one robot in a fresh game.
+Action add_skill_command(CLI::App& app);
+
+}  // namespace llsf::app

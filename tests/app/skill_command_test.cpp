@@ -1,0 +1,96 @@
+// SPDX-License-Identifier: MIT
+// `llsfsim skill`: status lines with time stamps, exit codes, help, bad input.
+#include <doctest/doctest.h>
+
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "llsf/app/cli.h"
+
+namespace {
+
+struct Run {
+  int code = -1;
+  std::string out;
+  std::string err;
+};
+
+Run llsfsim(std::vector<std::string> args) {
+  args.insert(args.begin(), "llsfsim");
+  std::ostringstream out;
+  std::ostringstream err;
+  Run r;
+  r.code = llsf::app::run(args, out, err);
+  r.out = out.str();
+  r.err = err.str();
+  return r;
+}
+
+bool has(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+}  // namespace
+
+TEST_CASE("llsfsim skill runs strings in turn and prints status changes with game time") {
+  const Run r = llsfsim({"skill", "--seed", "7", "get_s0{}", "finish_puck_at{place=\"M10\"}"});
+  INFO(r.out, r.err);
+  CHECK(r.code == llsf::app::kExitOk);
+  CHECK(has(r.out, "s] robot1 RUNNING  get_s0{}"));
+  CHECK(has(r.out, "s] robot1 FINAL  get_s0{}"));
+  CHECK(has(r.out, "FINAL  finish_puck_at{place=\"M10\"}  -> "));
+  CHECK(has(r.out, "s] end: "));
+  // Same seed, same output.
+  CHECK(llsfsim({"skill", "--seed", "7", "get_s0{}", "finish_puck_at{place=\"M10\"}"}).out ==
+        r.out);
+}
+
+TEST_CASE("llsfsim skill: a failing skill exits 1 with its reason; bad input exits 2") {
+  Run r = llsfsim({"skill", "drive_to{place=\"M11\"}"});
+  CHECK(r.code == llsf::app::kExitFailed);
+  CHECK(has(r.out, "FAILED  drive_to{place=\"M11\"}"));
+  CHECK(has(r.out, "unknown place 'M11'"));
+
+  r = llsfsim({"skill", "drive_to{place="});
+  CHECK(r.code == llsf::app::kExitBadInput);
+  CHECK(has(r.err, "skill string:1:"));
+
+  r = llsfsim({"skill", "--level", "magic", "park{}"});
+  CHECK(r.code == llsf::app::kExitBadInput);
+  CHECK(has(r.err, "--level"));
+
+  r = llsfsim({"skill"});
+  CHECK(r.code == llsf::app::kExitBadInput);
+  CHECK(has(r.err, "give a skill string"));
+
+  r = llsfsim({"frobnicate"});
+  CHECK(r.code == llsf::app::kExitBadInput);
+}
+
+TEST_CASE("llsfsim --help, skill --help and skill --list") {
+  Run r = llsfsim({"--help"});
+  CHECK(r.code == 0);
+  CHECK(has(r.out, "skill"));
+  r = llsfsim({"skill", "--help"});
+  CHECK(r.code == 0);
+  CHECK(has(r.out, "--level"));
+  CHECK(has(r.out, "--trace"));
+  r = llsfsim({"skill", "--list"});
+  CHECK(r.code == 0);
+  for (const char* s : {"drive_to", "motor_move", "get_s0", "get_consumed", "finish_puck_at",
+                        "deliver", "recycle", "explore_machine", "leave_puck", "park"}) {
+    CHECK(has(r.out, std::string(s) + "  ("));
+  }
+  CHECK_FALSE(has(r.out, "LOAD ERROR"));
+}
+
+TEST_CASE("llsfsim skill --trace shows the FSM states; symbolic level works the same") {
+  const Run r = llsfsim({"skill", "--trace", "--level", "symbolic", "--phase", "exploration",
+                         "explore_machine{place=\"M5\"}"});
+  INFO(r.out, r.err);
+  CHECK(r.code == 0);
+  CHECK(has(r.out, "explore_machine: GOTO"));
+  CHECK(has(r.out, "explore_machine: READ"));
+  CHECK(has(r.out, "-> M5 red="));
+}
