@@ -15,7 +15,8 @@ late-order slot), picks the nearest puck it sees there and takes it.
               number and moving on to the next spot when it sees no puck), "INS_1".."INS_5"
               (that spot only) or "LATE_ORDER" (the late-order insertion slot)
 Fails: "get_s0: already holding a puck", "get_s0: unknown place 'X'", "get_s0: no puck seen at
-INS_2" (after every spot it may try), or take_puck's/drive_to's failure after 3 attempts.
+INS_2" (after every spot it may try), or take_puck's/drive_to's failure after 4 attempts (a
+puck that could not be taken is not tried again).
 ]==]
 
 local LOOK_BACK = 0.45   -- the look position lies this far out from the pickup place
@@ -53,7 +54,11 @@ local function choose(vars)
       local rx, ry = pucks:puck(i)
       local fx, fy = x + c * rx - s * ry, y + s * rx + c * ry
       local d = math.sqrt((fx - vars.tx) ^ 2 + (fy - vars.ty) ^ 2)
-      if rx > 0.1 and d < best then best, bx, by = d, fx, fy end
+      local avoided = false
+      for _, a in ipairs(vars.avoid or {}) do
+         if (fx - a[1]) ^ 2 + (fy - a[2]) ^ 2 < 0.04 ^ 2 then avoided = true end
+      end
+      if rx > 0.1 and d < best and not avoided then best, bx, by = d, fx, fy end
    end
    if not bx then return false end
    vars.px, vars.py = bx, by
@@ -83,7 +88,7 @@ fsm:add_transitions{
    {"LOOK", "TAKE", cond=function(self, vars) return choose(vars) end, desc="puck seen"},
    {"LOOK", "FAILED", cond=no_puck, desc="no puck anywhere"},
    {"LOOK", "GOTO", cond="clock.now() >= vars.look_until", desc="next spot"},
-   {"RETRY", "FAILED", cond="vars.attempts >= 3", desc="too many attempts"},
+   {"RETRY", "FAILED", cond="vars.attempts >= 4", desc="too many attempts"},
    {"RETRY", "GOTO", cond=true, desc="again"},
 }
 
@@ -111,7 +116,10 @@ end
 
 function RETRY:init()
    local v = self.fsm.vars
-   if v.attempts >= 3 then
+   -- Do not try that puck again (it may be wedged between others).
+   v.avoid = v.avoid or {}
+   v.avoid[#v.avoid + 1] = {v.px, v.py}
+   if v.attempts >= 4 then
       self.fsm.error = "get_s0: " .. tostring(self.fsm.states.TAKE.error or "take_puck failed")
    end
 end

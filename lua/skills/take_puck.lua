@@ -15,8 +15,9 @@ sensor feels it at the body.
 @param x, y  field position of the puck (metres)
 @param ori   heading to approach it with (rad; default: from where the robot stands)
 Fails: "take_puck needs x=, y=", "take_puck: already holding a puck", drive_to's failure,
-"take_puck: the puck is gone (not seen where expected)", "take_puck: did not reach the puck
-within 6 s", "take_puck: the puck did not stay in the holder".
+"take_puck: the puck is gone (not seen where expected)", "take_puck: blocked 0.03 m before the
+puck (...)" (no progress for 1.5 s), "take_puck: did not reach the puck within 6 s (...)",
+"take_puck: the puck did not stay in the holder".
 ]==]
 
 local OFFSET = 0.2225   -- robot centre to a held puck's centre
@@ -59,8 +60,20 @@ local function touching()
 end
 
 local function creep_failed(self, vars)
+   local ex, ey = to_robot(vars.x, vars.y)
+   local left = ex - OFFSET
+   if left < vars.best_left - 0.005 then
+      vars.best_left, vars.best_at = left, clock.now()
+   elseif clock.now() - vars.best_at >= 1.5 then
+      self.fsm.error = string.format("take_puck: blocked %.2f m before the puck (neighbouring " ..
+                                     "pucks or a wall in the way?)", math.max(0, left))
+      return true
+   end
    if clock.now() - vars.creep_start < 6.0 then return false end
-   self.fsm.error = "take_puck: did not reach the puck within 6 s"
+   local ex, ey = to_robot(vars.x, vars.y)
+   self.fsm.error = string.format(
+      "take_puck: did not reach the puck within 6 s (it is %.2f m ahead, %.2f m aside; IR %.3f m)",
+      ex - OFFSET, ey, sensor:ir_distance())
    return true
 end
 
@@ -98,8 +111,10 @@ function APPROACH:init()
 end
 
 function CREEP:init()
-   self.fsm.vars.creep_start = clock.now()
-   self.fsm.vars.overshoot = false
+   local v = self.fsm.vars
+   v.creep_start = clock.now()
+   v.overshoot = false
+   v.best_left, v.best_at = math.huge, clock.now()
 end
 
 function CREEP:loop()
