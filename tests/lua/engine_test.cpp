@@ -388,3 +388,25 @@ TEST_CASE("the example skill of docs/skills.md loads and runs") {
   CHECK(engine.cycle() == SkillStatus::kFailed);
   CHECK(engine.error() == "visit_place: visit_place needs place=...");
 }
+
+TEST_CASE("skill results: fsm.result of the string's skills when it ends, cleared by exec") {
+  FakeRobot robot;
+  lua::SkillEngine engine(config(), robot);
+  REQUIRE(engine.exec("report_result{text='DONE'}"));
+  CHECK(engine.result().empty());
+  CHECK(test::run_cycles(engine, robot, 1) == SkillStatus::kFinal);
+  CHECK(engine.result() == "DONE");
+  // Also on failure; two skills in one string are joined.
+  REQUIRE(engine.exec("report_result{text='M3 red=ON', fail=true}"));
+  CHECK(test::run_cycles(engine, robot, 1) == SkillStatus::kFailed);
+  CHECK(engine.result() == "M3 red=ON");
+  CHECK(engine.error() == "report_result: asked to fail");
+  REQUIRE(engine.exec("say_hello{}"));
+  CHECK(engine.result().empty());
+  CHECK(test::run_cycles(engine, robot, 1) == SkillStatus::kFinal);
+  CHECK(engine.result().empty());  // say_hello reports nothing
+  // A restarted skill starts without its old result.
+  REQUIRE(engine.exec("report_result{}"));
+  CHECK(test::run_cycles(engine, robot, 1) == SkillStatus::kFinal);
+  CHECK(engine.result().empty());
+}
