@@ -350,7 +350,16 @@ void Game::step() {
     if (stacks_[static_cast<std::size_t>(i)]->brain() == nullptr) continue;
     RobotRadio& radio = stacks_[static_cast<std::size_t>(i)]->radio();
     for (const comm::Delivery& d : hub_->received(robot_peers_[static_cast<std::size_t>(i)])) {
-      if (auto msg = hub_->decode(d)) radio.inbox_.push_back(std::move(msg));
+      if (auto msg = hub_->decode(d)) {
+        Received r;
+        r.message = std::move(msg);
+        r.from = hub_->peer_name(d.from);
+        for (int k = 0; k < n; ++k) {
+          if (robot_peers_[static_cast<std::size_t>(k)] == d.from) r.from_id = k + 1;
+        }
+        r.at = now;
+        radio.inbox_.push_back(std::move(r));
+      }
     }
   }
 

@@ -10,8 +10,7 @@ namespace {
 lua::SkillEngineConfig with_defaults(lua::SkillEngineConfig c, const Game& game, int index) {
   if (c.skill_dirs.empty()) c.skill_dirs = skill_library_dirs(game.config().levels.skill);
   c.rate_hz = game.config().skill_rate_hz;
-  core::RandomStream seed =
-      game.rng().stream("lua/" + std::string(game.robot(index).name()));
+  core::RandomStream seed = game.rng().stream("lua/" + std::string(game.robot(index).name()));
   c.random_seed = seed.next_u64();
   return c;
 }
@@ -19,8 +18,8 @@ lua::SkillEngineConfig with_defaults(lua::SkillEngineConfig c, const Game& game,
 }  // namespace
 
 std::vector<std::string> skill_library_dirs(SkillLevel level, std::string_view library_dir) {
-  const std::string base = library_dir.empty() ? std::string(LLSF_SKILL_LIBRARY_DIR)
-                                               : std::string(library_dir);
+  const std::string base =
+      library_dir.empty() ? std::string(LLSF_SKILL_LIBRARY_DIR) : std::string(library_dir);
   std::vector<std::string> dirs{base};
   if (level == SkillLevel::kSymbolic) dirs.push_back(base + "/symbolic");
   return dirs;

@@ -390,7 +390,11 @@ class LockAgent : public sim::RobotBrain {
  public:
   void on_agent_cycle(lua::RobotApi& robot, RobotRadio& radio) override {
     for (const auto& m : radio.inbox()) {
-      if (dynamic_cast<const llsf_agent_msgs::LockMessage*>(m.get()) != nullptr) ++locks_received;
+      if (dynamic_cast<const llsf_agent_msgs::LockMessage*>(m.get()) != nullptr) {
+        ++locks_received;
+        CHECK(m.from != std::string(robot.name()));
+        CHECK((m.from == "refbox" || m.from_id > 0));
+      }
     }
     llsf_agent_msgs::LockMessage lock;
     lock.set_type(llsf_agent_msgs::LockMessage::GET);

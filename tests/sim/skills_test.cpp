@@ -132,11 +132,11 @@ struct ProductionGame {
   std::unique_ptr<SkillBrain> brain;
 };
 
-#define REQUIRE_FINAL(o)                                \
-  do {                                                  \
-    const Outcome& o_ = (o);                            \
-    INFO(o_.error);                                     \
-    REQUIRE(o_.status == lua::SkillStatus::kFinal);     \
+#define REQUIRE_FINAL(o)                            \
+  do {                                              \
+    const Outcome& o_ = (o);                        \
+    INFO(o_.error);                                 \
+    REQUIRE(o_.status == lua::SkillStatus::kFinal); \
   } while (false)
 
 }  // namespace
@@ -207,8 +207,9 @@ namespace {
 std::string expected_code(const Game& g, int i) {
   const refbox::Lights l = g.refbox().machine(core::DeviceId(i)).lights;
   auto name = [](refbox::LightState s) {
-    return s == refbox::LightState::kOn ? "ON" : s == refbox::LightState::kBlink ? "BLINKING"
-                                                                                  : "OFF";
+    return s == refbox::LightState::kOn      ? "ON"
+           : s == refbox::LightState::kBlink ? "BLINKING"
+                                             : "OFF";
   };
   return machine_name(i) + " red=" + name(l.red) + " yellow=" + name(l.yellow) +
          " green=" + name(l.green);

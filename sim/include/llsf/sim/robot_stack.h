@@ -56,11 +56,23 @@ struct SymbolicRequest {
   double radius_m = 0.0;       ///< kPick: how far from `point` a puck may be
 };
 
+/// A message a robot received, with its sender.
+struct Received {
+  std::unique_ptr<google::protobuf::Message> message;
+  std::string from;  ///< the sender's hub peer name ("refbox", "robot2", ...)
+  int from_id = 0;   ///< the sender's robot number (index + 1); 0 for the refbox and others
+  SimTime at;        ///< when it arrived
+  const google::protobuf::Message* operator->() const { return message.get(); }
+  const google::protobuf::Message* get() const { return message.get(); }
+};
+
 /// Messages a robot received and a way to send: the agent's side of the radio.
 class RobotRadio {
  public:
-  /// Messages received since the last agent cycle, in delivery order (cleared after it).
-  std::span<const std::unique_ptr<google::protobuf::Message>> inbox() const { return inbox_; }
+  /// Messages received since the last agent cycle, in delivery order (cleared after it). An
+  /// agent may move the messages out (e.g. into its CLIPS environment).
+  std::span<Received> inbox() { return inbox_; }
+  std::span<const Received> inbox() const { return inbox_; }
   /// Broadcasts `message` to the robot's channel (the team and the refbox) at the current time.
   /// Returns what the hub said (kNone = accepted). Requires the stack to be attached to a hub.
   comm::FrameError broadcast(const google::protobuf::Message& message);
@@ -71,7 +83,7 @@ class RobotRadio {
   comm::Hub* hub_ = nullptr;
   comm::PeerId peer_;
   SimTime now_;
-  std::vector<std::unique_ptr<google::protobuf::Message>> inbox_;
+  std::vector<Received> inbox_;
 };
 
 /// A robot's skills and agent, plugged into the game loop (the Lua engine and the CLIPS agent
