@@ -1,0 +1,19 @@
+; SPDX-License-Identifier: MIT
+; Built-in: skills (clips/src/skills_feature.cpp). (skill-call NAME key val ...) sends the skill
+; string and asserts (skill (status IDLE)); the host updates the fact each cycle (RUNNING, FINAL,
+; FAILED). Finished skill facts are retracted at very low salience, as in Fawkes: match
+; (skill (name ?n) (status FINAL|FAILED)) in the cycle in which it appears.
+
+(deftemplate skill
+  (slot name (type SYMBOL))
+  (slot status (type SYMBOL) (allowed-values IDLE RUNNING FINAL FAILED) (default IDLE))
+  (slot skill-string (type STRING))
+  (slot error (type STRING) (default ""))
+)
+
+(defrule skill-retract-done
+  (declare (salience -9000))
+  ?s <- (skill (status FINAL|FAILED))
+  =>
+  (retract ?s)
+)

@@ -1,0 +1,163 @@
+// SPDX-License-Identifier: MIT
+// AgentHost: one robot's CLIPS agent — a CLIPS 6.30 environment with the llsfsim features
+// (time, skills, config, protobuf, pose/identity, logging, seeded random), stepped by the caller
+// at the agent rate (default 10 Hz of simulated time). See docs/clips.md.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <initializer_list>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "llsf/clips/config_values.h"
+#include "llsf/clips/skill_runner.h"
+#include "llsf/clips/value.h"
+#include "llsf/core/geometry.h"
+#include "llsf/core/sim_time.h"
+
+namespace google::protobuf {
+class Message;
+}
+namespace llsf::comm {
+class MessageRegistry;
+}
+
+namespace llsf::clips {
+
+/// Bad agent code: a syntax or semantic error while loading. The message reads
+/// "file.clp:LINE: [ID] what (in defrule MAIN::name)", one line per error.
+class AgentLoadError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Log level of an agent's output.
+enum class LogLevel : std::uint8_t { kDebug, kInfo, kWarn, kError };
+/// "debug", "info", "warn", "error".
+const char* to_string(LogLevel level);
+
+/// One line of agent output: (printout t ...), (log-info ...), CLIPS' own warnings and errors.
+/// Views are valid during the sink call only.
+struct LogRecord {
+  core::SimTime time;  ///< simulated time of the cycle that printed it
+  LogLevel level = LogLevel::kInfo;
+  std::string_view agent;  ///< the robot's name
+  std::string_view text;   ///< without the trailing newline
+};
+using LogSink = std::function<void(const LogRecord&)>;
+
+/// Hands a message built by (pb-broadcast ?m) to the radio (sim plugs in RobotRadio::broadcast).
+/// The message is borrowed for the duration of the call.
+using BroadcastFn = std::function<void(const google::protobuf::Message&)>;
+
+/// Read-only configuration of one agent.
+struct AgentConfig {
+  std::string robot_name = "robot1";          ///< ?*ROBOT-NAME* (a symbol)
+  int robot_number = 1;                       ///< ?*ROBOT-NUMBER*
+  std::string team_name = "Carologistics";    ///< ?*TEAM-NAME* (a string)
+  std::uint64_t seed = 1;                     ///< seeds CLIPS' (random)
+  std::int64_t max_rules_per_cycle = 10'000;  ///< rule firings per cycle before the run is cut
+  ConfigEntries config;                       ///< asserted as confval facts after (reset)
+
+  /// Throws std::invalid_argument naming the bad field.
+  void validate() const;
+};
+
+/// What the agent talks to; everything is borrowed and must outlive the host. All optional:
+/// without a runner, (skill-call) fails; without a registry, (pb-create) fails; without a
+/// broadcast function, (pb-broadcast) drops the message; without a sink, output is discarded.
+struct AgentIo {
+  SkillRunner* skills = nullptr;
+  const comm::MessageRegistry* messages = nullptr;
+  BroadcastFn broadcast;
+  LogSink log;
+};
+
+/// What one cycle did.
+struct CycleResult {
+  std::int64_t rules_fired = 0;
+  bool limit_reached = false;  ///< max_rules_per_cycle fired and the agenda was not empty
+  int runtime_errors = 0;      ///< runtime errors in this cycle (also logged)
+};
+
+/// A fact copied out of the agent (tests, tools).
+struct Fact {
+  std::int64_t index = 0;
+  std::string template_name;
+  /// Slots in template order; an ordered fact (time 1 2) has one slot "" with a multifield.
+  std::vector<std::pair<std::string, Value>> slots;
+  /// The slot's value; throws std::out_of_range if the template has no such slot.
+  const Value& slot(std::string_view name) const;
+  /// The fields of an ordered fact (the multifield of slot "").
+  const std::vector<Value>& fields() const { return slot("").items; }
+};
+
+/// One robot's agent. Usage: construct, load_file()/load_string() the agent, then cycle(now) at
+/// the agent rate; feed set_pose() and receive() between cycles. Not copyable; movable. Not
+/// thread-safe (one host per robot; different hosts may run in different threads).
+class AgentHost {
+ public:
+  /// Creates the environment and loads the built-in code (clips/clp/*.clp).
+  AgentHost(AgentConfig config, AgentIo io);
+  ~AgentHost();
+  AgentHost(AgentHost&&) noexcept;
+  AgentHost& operator=(AgentHost&&) noexcept;
+  AgentHost(const AgentHost&) = delete;
+  AgentHost& operator=(const AgentHost&) = delete;
+
+  /// Loads an agent file (read in C++, parsed from a string). Throws AgentLoadError
+  /// ("path:line: ...") on bad code or if the file cannot be read.
+  void load_file(const std::string& path);
+  /// Loads code from a string; `source_name` stands for the file name in error messages.
+  void load_string(std::string_view code, std::string_view source_name);
+
+  /// (reset): deffacts, confval facts, identity; called by the first cycle() if not before.
+  /// Calling it again restarts the agent's facts (the rules stay).
+  void start(core::SimTime now);
+  /// One agent cycle at simulated time `now`: (time) fact, skill status updates, pose, received
+  /// messages; run to quiescence (at most max_rules_per_cycle firings); clean-up. Runtime errors
+  /// are logged with the rule's name and counted; the agent keeps going.
+  CycleResult cycle(core::SimTime now);
+
+  /// The robot's pose for the (pose (x) (y) (ori)) fact, updated at the next cycle if changed.
+  void set_pose(const core::Pose2D& pose);
+  /// A message received from peer `from` (name and id) at `at`; it becomes a protobuf-msg fact
+  /// at the next cycle. The host takes ownership.
+  void receive(std::unique_ptr<google::protobuf::Message> message, std::string_view from,
+               int from_id, core::SimTime at);
+
+  // ---- inspection (tests, tools; slow paths) ----
+  /// Facts of a template (all facts if empty).
+  std::vector<Fact> facts(std::string_view template_name = {}) const;
+  /// Facts of a template whose slots equal the given values, e.g.
+  /// find_facts("skill", {{"status", Value::symbol("FINAL")}}).
+  std::vector<Fact> find_facts(
+      std::string_view template_name,
+      std::initializer_list<std::pair<std::string_view, Value>> where) const;
+  /// Asserts a fact from text, e.g. "(machine (name M1))"; throws std::invalid_argument if CLIPS
+  /// cannot parse it.
+  void assert_fact(std::string_view fact);
+  /// Evaluates an expression, e.g. "(now)" or "(+ 1 2)" (void on error).
+  Value eval(std::string_view expression);
+
+  /// Runtime errors since construction.
+  int runtime_errors() const;
+  /// Cycles whose run was cut by max_rules_per_cycle.
+  int limit_hits() const;
+  /// Rule firings since construction.
+  std::int64_t rules_fired() const;
+  /// Protobuf messages alive in the pool (pb-create'd and not destroyed, received this cycle).
+  int live_messages() const;
+  const AgentConfig& config() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace llsf::clips

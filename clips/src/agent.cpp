@@ -1,0 +1,306 @@
+// SPDX-License-Identifier: MIT
+// AgentHost: the cycle (assert what is new, run to quiescence within the firing limit, clean up),
+// loading with file:line errors, output routing to the log sink, runtime-error containment.
+#include "llsf/clips/agent.h"
+
+#include <fstream>
+#include <sstream>
+
+#include "feature.h"
+
+namespace llsf::clips {
+
+const char* to_string(SkillStatus status) {
+  switch (status) {
+    case SkillStatus::kIdle:
+      return "IDLE";
+    case SkillStatus::kRunning:
+      return "RUNNING";
+    case SkillStatus::kFinal:
+      return "FINAL";
+    case SkillStatus::kFailed:
+      return "FAILED";
+  }
+  return "IDLE";
+}
+
+const char* to_string(LogLevel level) {
+  switch (level) {
+    case LogLevel::kDebug:
+      return "debug";
+    case LogLevel::kInfo:
+      return "info";
+    case LogLevel::kWarn:
+      return "warn";
+    case LogLevel::kError:
+      return "error";
+  }
+  return "info";
+}
+
+void AgentConfig::validate() const {
+  if (robot_name.empty() || robot_name.find_first_of(" \t\n()\"&|<~;?$") != std::string::npos)
+    throw std::invalid_argument("AgentConfig.robot_name must be a CLIPS symbol, got \"" +
+                                robot_name + "\"");
+  if (robot_number < 0) throw std::invalid_argument("AgentConfig.robot_number must be >= 0");
+  if (max_rules_per_cycle <= 0)
+    throw std::invalid_argument("AgentConfig.max_rules_per_cycle must be > 0");
+}
+
+const Value& Fact::slot(std::string_view name) const {
+  for (const auto& [n, v] : slots)
+    if (n == name) return v;
+  throw std::out_of_range("fact of " + template_name + " has no slot " + std::string(name));
+}
+
+namespace {
+
+// Collapses whitespace runs (CLIPS error messages span several lines).
+std::string one_line(std::string_view s) {
+  std::string out;
+  bool space = false;
+  for (char c : s) {
+    if (c == ' ' || c == '\n' || c == '\r' || c == '\t') {
+      space = !out.empty();
+      continue;
+    }
+    if (space) out += ' ';
+    space = false;
+    out += c;
+  }
+  return out;
+}
+
+LogLevel level_of(std::string_view logical_name) {
+  if (logical_name == "debug" || logical_name == "wtrace") return LogLevel::kDebug;
+  if (logical_name == "warn" || logical_name == "wwarning") return LogLevel::kWarn;
+  if (logical_name == "error") return LogLevel::kError;
+  return LogLevel::kInfo;
+}
+
+}  // namespace
+
+struct AgentHost::Impl {
+  detail::HostState state;
+  detail::Environment env;  // before the features: they hold handles into it
+  std::vector<std::unique_ptr<detail::Feature>> features;
+  bool started = false;
+  int runtime_errors = 0;
+  int limit_hits = 0;
+  std::int64_t rules_fired = 0;
+  std::string werror;    // CLIPS error output not yet reported
+  std::string lines[4];  // partial output lines per level
+
+  Impl(AgentConfig config, AgentIo io) {
+    config.validate();
+    state.config = std::move(config);
+    state.io = std::move(io);
+    state.log = [this](LogLevel level, std::string_view text) { emit(level, text); };
+    env.set_output_handler(
+        [this](std::string_view name, std::string_view text) { on_output(name, text); });
+    // Fixed order: functions first (the built-in code may call them), then the code, then the
+    // template look-ups.
+    features.push_back(detail::make_log_feature(state));
+    features.push_back(detail::make_random_feature(state));
+    features.push_back(detail::make_robot_feature(state));
+    features.push_back(detail::make_time_feature(state));
+    features.push_back(detail::make_config_feature(state));
+    features.push_back(detail::make_skills_feature(state));
+    features.push_back(detail::make_protobuf_feature(state));
+    for (auto& f : features) f->define(env);
+    for (int i = 0; i < detail::kBuiltinCodeCount; ++i)
+      load(detail::kBuiltinCode[i].text, detail::kBuiltinCode[i].name);
+    for (auto& f : features) f->bind(env);
+  }
+
+  void emit(LogLevel level, std::string_view text) {
+    if (!state.io.log) return;
+    state.io.log(LogRecord{state.now, level, state.config.robot_name, text});
+  }
+
+  // Output arrives in pieces; complete lines go to the sink, werror is collected as an error.
+  void on_output(std::string_view name, std::string_view text) {
+    if (name == "werror") {
+      werror.append(text);
+      return;
+    }
+    const LogLevel level = level_of(name);
+    std::string& buf = lines[static_cast<int>(level)];
+    buf.append(text);
+    std::size_t pos = 0;
+    while ((pos = buf.find('\n')) != std::string::npos) {
+      emit(level, std::string_view(buf).substr(0, pos));
+      buf.erase(0, pos + 1);
+    }
+  }
+
+  void flush_output() {
+    for (int i = 0; i < 4; ++i) {
+      if (lines[i].empty()) continue;
+      emit(static_cast<LogLevel>(i), lines[i]);
+      lines[i].clear();
+    }
+    report_errors();
+  }
+
+  // Logs collected error output as one runtime error, naming the rule CLIPS stopped.
+  int report_errors() {
+    if (werror.empty()) return 0;
+    std::string rule;
+    std::string_view text = werror;
+    if (auto p = text.rfind("[PRCCODE4]"); p != std::string_view::npos) {
+      const std::string_view halted = text.substr(p);
+      if (auto q = halted.rfind("defrule "); q != std::string_view::npos) {
+        rule = one_line(halted.substr(q + 8));
+        while (!rule.empty() && (rule.back() == '.' || rule.back() == ' ')) rule.pop_back();
+      }
+      // Keep the cause; the "execution halted" line only names the rule.
+      if (auto first = text.find("[PRCCODE4]"); first > 0) text = text.substr(0, first);
+    }
+    const std::string msg = one_line(text);
+    emit(LogLevel::kError,
+         rule.empty() ? "runtime error: " + msg : "runtime error in rule " + rule + ": " + msg);
+    werror.clear();
+    ++runtime_errors;
+    return 1;
+  }
+
+  void load(const std::string& text, std::string_view source) {
+    const auto errors = env.load(text);
+    flush_output();
+    if (errors.empty()) return;
+    std::string msg;
+    for (const auto& e : errors) {
+      if (!msg.empty()) msg += '\n';
+      msg.append(source).append(":").append(std::to_string(e.line)).append(": ").append(e.message);
+    }
+    throw AgentLoadError(msg);
+  }
+
+  void start(core::SimTime now) {
+    state.now = now;
+    env.reset();
+    for (auto& f : features) f->after_reset(env);
+    started = true;
+    flush_output();
+  }
+
+  CycleResult cycle(core::SimTime now) {
+    if (!started) start(now);
+    state.now = now;
+    CycleResult result;
+    const int errors_before = runtime_errors;
+    for (auto& f : features) f->before_run(env);
+    report_errors();  // e.g. a (test ...) that failed while facts were asserted
+
+    // Run to quiescence; an error stops CLIPS' run, so clear it and go on with the rest.
+    std::int64_t remaining = state.config.max_rules_per_cycle;
+    while (remaining > 0) {
+      const std::int64_t fired = env.run(remaining);
+      result.rules_fired += fired;
+      remaining -= fired;
+      const bool error = env.halted() || !werror.empty();
+      if (!error) break;
+      report_errors();
+      env.clear_halt();
+      if (env.agenda_empty()) break;
+    }
+    if (remaining <= 0 && !env.agenda_empty()) {
+      result.limit_reached = true;
+      ++limit_hits;
+      emit(LogLevel::kWarn, "rule firing limit of " +
+                                std::to_string(state.config.max_rules_per_cycle) +
+                                " reached with rules still on the agenda (endless rule loop?)");
+    }
+    for (auto& f : features) f->after_run(env);
+    flush_output();
+    rules_fired += result.rules_fired;
+    result.runtime_errors = runtime_errors - errors_before;
+    return result;
+  }
+};
+
+AgentHost::AgentHost(AgentConfig config, AgentIo io)
+    : impl_(std::make_unique<Impl>(std::move(config), std::move(io))) {}
+AgentHost::~AgentHost() = default;
+AgentHost::AgentHost(AgentHost&&) noexcept = default;
+AgentHost& AgentHost::operator=(AgentHost&&) noexcept = default;
+
+void AgentHost::load_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw AgentLoadError(path + ": cannot read the file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  impl_->load(text.str(), path);
+}
+
+void AgentHost::load_string(std::string_view code, std::string_view source_name) {
+  impl_->load(std::string(code), source_name);
+}
+
+void AgentHost::start(core::SimTime now) { impl_->start(now); }
+
+CycleResult AgentHost::cycle(core::SimTime now) { return impl_->cycle(now); }
+
+void AgentHost::set_pose(const core::Pose2D& pose) {
+  auto& s = impl_->state;
+  if (s.pose && s.pose->x == pose.x && s.pose->y == pose.y && s.pose->theta == pose.theta) return;
+  s.pose = pose;
+  s.pose_dirty = true;
+}
+
+void AgentHost::receive(std::unique_ptr<google::protobuf::Message> message, std::string_view from,
+                        int from_id, core::SimTime at) {
+  if (!message) return;
+  impl_->state.inbox.push_back({std::move(message), std::string(from), from_id, at});
+}
+
+std::vector<Fact> AgentHost::facts(std::string_view template_name) const {
+  std::vector<Fact> out;
+  for (auto& f : impl_->env.facts(template_name))
+    out.push_back(Fact{f.index, std::move(f.template_name), std::move(f.slots)});
+  return out;
+}
+
+std::vector<Fact> AgentHost::find_facts(
+    std::string_view template_name,
+    std::initializer_list<std::pair<std::string_view, Value>> where) const {
+  std::vector<Fact> out;
+  for (auto& f : facts(template_name)) {
+    bool match = true;
+    for (const auto& [slot, value] : where) {
+      if (!(f.slot(slot) == value)) {
+        match = false;
+        break;
+      }
+    }
+    if (match) out.push_back(std::move(f));
+  }
+  return out;
+}
+
+void AgentHost::assert_fact(std::string_view fact) {
+  const bool ok = impl_->env.assert_string(std::string(fact));
+  if (!ok) {
+    const std::string why = one_line(impl_->werror);
+    impl_->werror.clear();
+    impl_->env.clear_halt();
+    throw std::invalid_argument("cannot assert " + std::string(fact) + ": " + why);
+  }
+  impl_->flush_output();
+}
+
+Value AgentHost::eval(std::string_view expression) {
+  Value v = impl_->env.eval(std::string(expression));
+  impl_->flush_output();
+  impl_->env.clear_halt();
+  return v;
+}
+
+int AgentHost::runtime_errors() const { return impl_->runtime_errors; }
+int AgentHost::limit_hits() const { return impl_->limit_hits; }
+std::int64_t AgentHost::rules_fired() const { return impl_->rules_fired; }
+int AgentHost::live_messages() const { return impl_->state.live_messages; }
+const AgentConfig& AgentHost::config() const { return impl_->state.config; }
+
+}  // namespace llsf::clips

@@ -1,0 +1,168 @@
+// SPDX-License-Identifier: MIT
+// Small features: logging functions, seeded random, robot identity and pose, confval facts.
+#include <array>
+
+#include "feature.h"
+#include "llsf/core/rng.h"
+
+namespace llsf::clips::detail {
+
+std::string print_form(const Value& v) {
+  switch (v.type) {
+    case Value::Type::kSymbol:
+    case Value::Type::kString:
+      return v.text;
+    case Value::Type::kMultifield: {
+      std::string out;
+      for (std::size_t i = 0; i < v.items.size(); ++i) {
+        if (i > 0) out += ' ';
+        out += print_form(v.items[i]);
+      }
+      return out;
+    }
+    default:
+      return v.to_string();
+  }
+}
+
+namespace {
+
+// ---- log: (log-debug ...), (log-info ...), (log-warn ...), (log-error ...) ------------------
+// Arguments are concatenated as str-cat does. (printout t ...) is routed by the host.
+class LogFeature final : public Feature {
+ public:
+  explicit LogFeature(HostState& s) : s_(s) {}
+  void define(Environment& env) override {
+    static constexpr std::array<std::pair<const char*, LogLevel>, 4> kLevels = {{
+        {"log-debug", LogLevel::kDebug},
+        {"log-info", LogLevel::kInfo},
+        {"log-warn", LogLevel::kWarn},
+        {"log-error", LogLevel::kError},
+    }};
+    for (const auto& [name, level] : kLevels) {
+      env.define_function(name, "1**", [this, level = level](Args& a) {
+        std::string text;
+        for (int i = 0; i < a.count(); ++i) text += print_form(a.value(i));
+        s_.log(level, text);
+        return Value{};
+      });
+    }
+  }
+
+ private:
+  HostState& s_;
+};
+
+// ---- random: (random [lo hi]) and (seed n) per environment -----------------------------------
+// CLIPS 6.30's (random) calls the C library's rand(), one process-wide sequence; we replace both
+// functions with a stream seeded from AgentConfig::seed, so agents do not disturb each other.
+class RandomFeature final : public Feature {
+ public:
+  explicit RandomFeature(HostState& s) : rng_(s.config.seed), seed_(s.config.seed) {}
+  void define(Environment& env) override {
+    env.define_function("random", "02i", [this](Args& a) {
+      std::int64_t lo = 0, hi = 2147483647;  // glibc's RAND_MAX, as (random) without arguments
+      if (a.count() == 2) {
+        a.integer(0, lo);
+        a.integer(1, hi);
+        if (hi < lo) {
+          a.env().error(a.function(), "the upper bound is below the lower bound");
+          return Value::boolean(false);
+        }
+      } else if (a.count() == 1) {
+        a.env().error(a.function(), "expects no arguments or two (lower and upper bound)");
+        return Value::boolean(false);
+      }
+      return Value::integer_value(rng_.uniform_int(lo, hi));
+    });
+    env.define_function("seed", "11i", [this](Args& a) {
+      std::int64_t s = 0;
+      a.integer(0, s);
+      rng_ = core::RandomStream(static_cast<std::uint64_t>(s));
+      return Value{};
+    });
+  }
+  // A restart of the agent starts the sequence again.
+  void after_reset(Environment&) override { rng_ = core::RandomStream(seed_); }
+
+ private:
+  core::RandomStream rng_;
+  std::uint64_t seed_;
+};
+
+// ---- robot: ?*ROBOT-NAME* etc., (robot-info ...), (pose (x) (y) (ori)) ----------------------
+class RobotFeature final : public Feature {
+ public:
+  explicit RobotFeature(HostState& s) : s_(s) {}
+  void bind(Environment& env) override {
+    info_ = env.find_template("robot-info");
+    pose_ = env.find_template("pose");
+  }
+  void after_reset(Environment& env) override {
+    env.set_global("ROBOT-NAME", Value::symbol(s_.config.robot_name));
+    env.set_global("ROBOT-NUMBER", Value::integer_value(s_.config.robot_number));
+    env.set_global("TEAM-NAME", Value::string(s_.config.team_name));
+    const Value v[] = {Value::symbol(s_.config.robot_name),
+                       Value::integer_value(s_.config.robot_number),
+                       Value::string(s_.config.team_name)};
+    FactHandle h = env.assert_fact(info_, v);
+    env.release(h);
+    env.release(pose_fact_);  // the reset retracted it
+    s_.pose_dirty = s_.pose.has_value();
+  }
+  void before_run(Environment& env) override {
+    if (!s_.pose_dirty) return;
+    s_.pose_dirty = false;
+    env.retract(pose_fact_);
+    const Value v[] = {Value::float_value(s_.pose->x), Value::float_value(s_.pose->y),
+                       Value::float_value(s_.pose->theta)};
+    pose_fact_ = env.assert_fact(pose_, v);
+  }
+
+ private:
+  HostState& s_;
+  Template info_, pose_;
+  FactHandle pose_fact_;
+};
+
+// ---- config: confval facts after each (reset) ----------------------------------------------
+class ConfigFeature final : public Feature {
+ public:
+  explicit ConfigFeature(HostState& s) : s_(s) {}
+  void bind(Environment& env) override { confval_ = env.find_template("confval"); }
+  void after_reset(Environment& env) override {
+    for (const auto& e : s_.config.config) {
+      Value v[5];
+      v[0] = Value::string(e.path);
+      v[1] = Value::symbol(to_string(e.type));
+      if (e.is_list) {
+        v[3] = Value::boolean(true);
+        v[4] = Value::multifield(e.values);
+      } else {
+        v[2] = e.values.empty() ? Value::symbol("nil") : e.values.front();
+        v[3] = Value::boolean(false);
+      }
+      FactHandle h = env.assert_fact(confval_, v);
+      env.release(h);
+    }
+  }
+
+ private:
+  HostState& s_;
+  Template confval_;
+};
+
+}  // namespace
+
+std::unique_ptr<Feature> make_log_feature(HostState& s) { return std::make_unique<LogFeature>(s); }
+std::unique_ptr<Feature> make_random_feature(HostState& s) {
+  return std::make_unique<RandomFeature>(s);
+}
+std::unique_ptr<Feature> make_robot_feature(HostState& s) {
+  return std::make_unique<RobotFeature>(s);
+}
+std::unique_ptr<Feature> make_config_feature(HostState& s) {
+  return std::make_unique<ConfigFeature>(s);
+}
+
+}  // namespace llsf::clips::detail

@@ -1,0 +1,164 @@
+// SPDX-License-Identifier: MIT
+// Environment: a thin C++ wrapper around one CLIPS 6.30 environment. It is the only code that
+// sees the CLIPS headers (environment.cpp): they are C-only, define ~230 function-like macros
+// (GetType, SetValue, ...) and a global `struct field`. Features talk to CLIPS through this.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "llsf/clips/value.h"
+
+namespace llsf::clips::detail {
+
+class Environment;
+
+/// The arguments of a call of a user-defined function (valid during the call only). Indices are
+/// 0-based. The typed accessors read without copying into a Value (cheap in LHS tests).
+class Args {
+ public:
+  Args(Environment& env, void* clips_env, std::string_view function)
+      : env_(env), clips_env_(clips_env), function_(function) {}
+  int count() const;
+  Value::Type type(int i) const;
+  /// The argument as a Value (copies text and multifields).
+  Value value(int i) const;
+  /// INTEGER or FLOAT.
+  bool number(int i, double& out) const;
+  /// INTEGER (or a FLOAT with an integral value).
+  bool integer(int i, std::int64_t& out) const;
+  /// SYMBOL or STRING; the view points into CLIPS' symbol table (valid during the call).
+  bool text(int i, std::string_view& out) const;
+  /// EXTERNAL-ADDRESS.
+  bool address(int i, void*& out) const;
+  /// A time: a multifield (sec usec) as in (time sec usec) facts, or a number of seconds.
+  bool time(int i, double& seconds) const;
+  /// The function's name (for error messages).
+  std::string_view function() const { return function_; }
+  Environment& env() const { return env_; }
+
+ private:
+  Environment& env_;
+  void* clips_env_;
+  std::string_view function_;
+};
+
+/// A fact kept alive for later retraction (CLIPS' fact count is incremented while held).
+class FactHandle {
+ public:
+  bool empty() const { return fact_ == nullptr; }
+
+ private:
+  friend class Environment;
+  void* fact_ = nullptr;
+};
+
+/// A deftemplate looked up once; assert_fact() takes values in `slots` order.
+struct Template {
+  void* ptr = nullptr;
+  std::string name;
+  std::vector<std::string> slots;  ///< empty for ordered (implied) facts
+  bool implied = false;
+  /// Index of `slot` in `slots`; throws std::logic_error if absent.
+  int slot_index(std::string_view slot) const;
+};
+
+/// A fact copied out of the environment (for queries).
+struct FactCopy {
+  std::int64_t index = 0;
+  std::string template_name;
+  /// Slot name and value; an ordered fact has one entry with an empty name holding a multifield.
+  std::vector<std::pair<std::string, Value>> slots;
+};
+
+/// One syntax/semantic error found while loading constructs.
+struct LoadError {
+  int line = 0;         ///< 1-based line of the source text where CLIPS noticed the error
+  std::string message;  ///< e.g. "[PRNTUTIL2] Syntax Error: ... (in defrule MAIN::foo)"
+};
+
+/// One CLIPS environment. Not copyable or movable (CLIPS keeps pointers to it). Not thread-safe.
+class Environment {
+ public:
+  /// Called with complete output text per logical name ("t", "werror", "warn", ...).
+  using OutputHandler = std::function<void(std::string_view logical_name, std::string_view text)>;
+  /// A user-defined function; return Value{} for no result. Report bad arguments with error().
+  using Function = std::function<Value(Args&)>;
+
+  Environment();
+  ~Environment();
+  Environment(const Environment&) = delete;
+  Environment& operator=(const Environment&) = delete;
+
+  /// Output of printout and of CLIPS' own messages (except werror while loading, see load()).
+  void set_output_handler(OutputHandler handler) { output_ = std::move(handler); }
+
+  /// Defines (or replaces, e.g. `random`) a function. `restrictions` is CLIPS' argument
+  /// restriction string ("22n": exactly two numbers, "1**": at least one of any type).
+  void define_function(const std::string& name, const std::string& restrictions, Function fn);
+  /// Reports a bad call: prints "[LLSF1] name: message" to werror and sets CLIPS' evaluation
+  /// error, which stops the rule's actions (the host then logs it as a runtime error).
+  void error(std::string_view function, std::string_view message);
+
+  /// Loads constructs from `text`; returns the errors (empty on success). Lines count from 1.
+  std::vector<LoadError> load(const std::string& text);
+  /// Builds one construct (for built-in code that needs no line numbers); throws on error.
+  void build(const std::string& construct);
+
+  /// Looks up a deftemplate; throws std::logic_error if it does not exist.
+  Template find_template(const std::string& name);
+  /// Asserts a fact of `t` with `values` in slot order (kVoid keeps the slot's default); for an
+  /// ordered template, `values` are the fields. The handle keeps the fact for retract().
+  FactHandle assert_fact(const Template& t, std::span<const Value> values);
+  /// True if the handle's fact is still in the fact list.
+  bool exists(const FactHandle& h) const;
+  /// Retracts the fact if it still exists and releases the handle.
+  void retract(FactHandle& h);
+  /// Releases the handle without retracting.
+  void release(FactHandle& h);
+  /// Asserts a fact from text (tests and tools; slow path). Returns false on a parse error.
+  bool assert_string(const std::string& fact);
+
+  /// Runs at most `limit` rule firings; returns the number fired.
+  std::int64_t run(std::int64_t limit);
+  /// True if the current focus has activations left.
+  bool agenda_empty() const;
+  /// True after an error stopped execution (CLIPS' halt flag); clear_halt() resets it.
+  bool halted() const;
+  void clear_halt();
+  /// (reset): facts cleared, deffacts asserted, globals reset.
+  void reset();
+
+  /// Sets a defglobal (name without ?* *).
+  void set_global(const std::string& name, const Value& v);
+  /// Evaluates an expression (slow path, tests and tools).
+  Value eval(const std::string& expression);
+  /// All facts of `template_name` (all facts if empty), in fact-list order.
+  std::vector<FactCopy> facts(std::string_view template_name) const;
+
+ private:
+  struct FunctionEntry {
+    Environment* self;
+    std::string name;
+    std::string restrictions;
+    Function fn;
+  };
+  friend struct RouterAccess;
+  void on_print(std::string_view logical_name, std::string_view text);
+
+  void* env_ = nullptr;
+  OutputHandler output_;
+  std::deque<FunctionEntry> functions_;  // stable addresses: CLIPS holds pointers to them
+  // Error capture while loading: werror text and where each message started.
+  bool loading_ = false;
+  std::string load_errors_;
+  std::vector<std::pair<std::size_t, int>> error_starts_;  // (offset in load_errors_, line)
+};
+
+}  // namespace llsf::clips::detail

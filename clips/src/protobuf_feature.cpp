@@ -1,0 +1,417 @@
+// SPDX-License-Identifier: MIT
+// Protobuf feature: received messages as protobuf-msg facts and the pb-* functions over protobuf
+// reflection, for every message type of the comm::MessageRegistry. Messages reach CLIPS as
+// EXTERNAL-ADDRESS values that point into an owned pool; every function checks that a pointer is
+// in the pool, so a stale pointer is a runtime error and never a crash.
+//
+// Lifetimes: (pb-create) messages live until (pb-destroy); received messages until the end of the
+// cycle in which their protobuf-msg fact was asserted; nested-message pointers (from
+// pb-field-value / pb-field-list) until the end of the cycle or until their root is destroyed.
+#include <google/protobuf/descriptor.h>
+#include <google/protobuf/message.h>
+
+#include <unordered_map>
+
+#include "feature.h"
+#include "llsf/comm/registry.h"
+
+namespace llsf::clips::detail {
+namespace {
+
+using google::protobuf::Descriptor;
+using google::protobuf::FieldDescriptor;
+using google::protobuf::Message;
+using google::protobuf::Reflection;
+
+constexpr std::int64_t kNsPerSec = 1'000'000'000;
+
+class ProtobufFeature final : public Feature {
+ public:
+  explicit ProtobufFeature(HostState& s) : s_(s) {}
+  ~ProtobufFeature() override { s_.live_messages = 0; }
+
+  void define(Environment& env) override {
+    env.define_function("pb-create", "11k", [this](Args& a) { return create(a); });
+    env.define_function("pb-destroy", "11a", [this](Args& a) {
+      Entry* e = lookup(a, 0);
+      if (e != nullptr && e->kind != Kind::kView) destroy(e->root);
+      return Value{};
+    });
+    env.define_function("pb-set-field", "33*", [this](Args& a) { return set(a, false); });
+    env.define_function("pb-add-list", "33*", [this](Args& a) { return set(a, true); });
+    env.define_function("pb-field-value", "22*", [this](Args& a) {
+      Message* m = nullptr;
+      const FieldDescriptor* f = field(a, m);
+      if (f == nullptr) return Value::boolean(false);
+      if (f->is_repeated()) {
+        a.env().error(a.function(), f->name() + " is repeated: use pb-field-list");
+        return Value::boolean(false);
+      }
+      return get(*m, f, -1);
+    });
+    env.define_function("pb-field-list", "22*", [this](Args& a) {
+      Message* m = nullptr;
+      const FieldDescriptor* f = field(a, m);
+      if (f == nullptr) return Value::multifield({});
+      std::vector<Value> items;
+      if (f->is_repeated()) {
+        const int n = m->GetReflection()->FieldSize(*m, f);
+        items.reserve(static_cast<std::size_t>(n));
+        for (int i = 0; i < n; ++i) items.push_back(get(*m, f, i));
+      } else if (m->GetReflection()->HasField(*m, f)) {
+        items.push_back(get(*m, f, -1));
+      }
+      return Value::multifield(std::move(items));
+    });
+    env.define_function("pb-has-field", "22*", [this](Args& a) {
+      Message* m = nullptr;
+      const FieldDescriptor* f = field(a, m);
+      if (f == nullptr) return Value::boolean(false);
+      const Reflection* r = m->GetReflection();
+      return Value::boolean(f->is_repeated() ? r->FieldSize(*m, f) > 0 : r->HasField(*m, f));
+    });
+    env.define_function("pb-field-is-list", "22*", [this](Args& a) {
+      Message* m = nullptr;
+      const FieldDescriptor* f = field(a, m);
+      return Value::boolean(f != nullptr && f->is_repeated());
+    });
+    env.define_function("pb-field-names", "11a", [this](Args& a) {
+      Entry* e = lookup(a, 0);
+      std::vector<Value> names;
+      if (e != nullptr) {
+        const Descriptor* d = e->message->GetDescriptor();
+        for (int i = 0; i < d->field_count(); ++i)
+          names.push_back(Value::string(d->field(i)->name()));
+      }
+      return Value::multifield(std::move(names));
+    });
+    env.define_function("pb-tostring", "11a", [this](Args& a) {
+      Entry* e = lookup(a, 0);
+      return e == nullptr ? Value::boolean(false) : Value::string(e->message->ShortDebugString());
+    });
+    env.define_function("pb-broadcast", "11a", [this](Args& a) {
+      Entry* e = lookup(a, 0);
+      if (e == nullptr) return Value{};
+      if (!e->message->IsInitialized()) {
+        a.env().error(a.function(), e->message->GetTypeName() + " lacks required fields: " +
+                                        e->message->InitializationErrorString());
+        return Value{};
+      }
+      if (s_.io.broadcast) s_.io.broadcast(*e->message);
+      return Value{};
+    });
+  }
+
+  void bind(Environment& env) override {
+    msg_ = env.find_template("protobuf-msg");
+    slot_type_ = msg_.slot_index("type");
+    slot_comp_ = msg_.slot_index("comp-id");
+    slot_msg_type_ = msg_.slot_index("msg-type");
+    slot_from_ = msg_.slot_index("rcvd-from");
+    slot_at_ = msg_.slot_index("rcvd-at");
+    slot_client_id_ = msg_.slot_index("client-id");
+    slot_ptr_ = msg_.slot_index("ptr");
+    values_.resize(msg_.slots.size());
+  }
+
+  void after_reset(Environment& env) override {
+    for (auto& h : facts_) env.release(h);
+    facts_.clear();
+  }
+
+  void before_run(Environment& env) override {
+    for (auto& r : s_.inbox) {
+      Message* m = r.message.get();
+      add(std::move(r.message), Kind::kReceived, m);
+      for (auto& v : values_) v = Value{};
+      values_[static_cast<std::size_t>(slot_type_)] = Value::string(m->GetTypeName());
+      if (s_.io.messages != nullptr) {
+        if (auto key = s_.io.messages->key_of(*m)) {
+          values_[static_cast<std::size_t>(slot_comp_)] = Value::integer_value(key->component_id);
+          values_[static_cast<std::size_t>(slot_msg_type_)] = Value::integer_value(key->msg_type);
+        }
+      }
+      values_[static_cast<std::size_t>(slot_from_)] =
+          Value::multifield({Value::string(std::move(r.from)), Value::integer_value(r.from_id)});
+      values_[static_cast<std::size_t>(slot_at_)] =
+          Value::multifield({Value::integer_value(r.at.ns() / kNsPerSec),
+                             Value::integer_value((r.at.ns() % kNsPerSec) / 1000)});
+      values_[static_cast<std::size_t>(slot_client_id_)] = Value::integer_value(r.from_id);
+      values_[static_cast<std::size_t>(slot_ptr_)] = Value::external(m);
+      facts_.push_back(env.assert_fact(msg_, values_));
+    }
+    s_.inbox.clear();
+  }
+
+  // Unconsumed protobuf-msg facts go, their messages are freed, nested pointers expire.
+  void after_run(Environment& env) override {
+    for (auto& h : facts_) env.retract(h);
+    facts_.clear();
+    for (auto it = entries_.begin(); it != entries_.end();) {
+      if (it->second.kind == Kind::kCreated)
+        ++it;
+      else
+        it = entries_.erase(it);
+    }
+    s_.live_messages = static_cast<int>(entries_.size());
+  }
+
+ private:
+  enum class Kind : std::uint8_t { kCreated, kReceived, kView };
+  struct Entry {
+    Kind kind;
+    Message* message;
+    const Message* root;             // the owning top-level message
+    bool read_only;                  // a default instance (unset nested field)
+    std::unique_ptr<Message> owned;  // for kCreated and kReceived
+  };
+
+  void add(std::unique_ptr<Message> m, Kind kind, Message* raw) {
+    Entry e{kind, raw, raw, false, std::move(m)};
+    entries_.emplace(raw, std::move(e));
+    s_.live_messages = static_cast<int>(entries_.size());
+  }
+
+  void destroy(const Message* root) {
+    for (auto it = entries_.begin(); it != entries_.end();) {
+      if (it->second.root == root && it->second.kind == Kind::kView)
+        it = entries_.erase(it);
+      else
+        ++it;
+    }
+    entries_.erase(root);
+    s_.live_messages = static_cast<int>(entries_.size());
+  }
+
+  Entry* lookup(Args& a, int i) {
+    void* p = nullptr;
+    if (!a.address(i, p)) {
+      a.env().error(a.function(), "argument " + std::to_string(i + 1) + " must be a message");
+      return nullptr;
+    }
+    auto it = entries_.find(p);
+    if (it == entries_.end()) {
+      a.env().error(a.function(),
+                    "not a live message (destroyed, or received in an earlier cycle)");
+      return nullptr;
+    }
+    return &it->second;
+  }
+
+  // The message (argument 1) and its field (argument 2, a string or symbol).
+  const FieldDescriptor* field(Args& a, Message*& m) {
+    Entry* e = lookup(a, 0);
+    if (e == nullptr) return nullptr;
+    std::string_view name;
+    if (!a.text(1, name)) {
+      a.env().error(a.function(), "the field name must be a string or symbol");
+      return nullptr;
+    }
+    m = e->message;
+    const FieldDescriptor* f = m->GetDescriptor()->FindFieldByName(std::string(name));
+    if (f == nullptr)
+      a.env().error(a.function(), m->GetTypeName() + " has no field " + std::string(name));
+    return f;
+  }
+
+  Value create(Args& a) {
+    std::string_view type;
+    a.text(0, type);
+    if (s_.io.messages == nullptr) {
+      a.env().error(a.function(), "this agent has no message registry");
+      return Value::boolean(false);
+    }
+    const Message* proto = prototype(type);
+    if (proto == nullptr) {
+      a.env().error(a.function(), "message type " + std::string(type) + " is not registered");
+      return Value::boolean(false);
+    }
+    std::unique_ptr<Message> m(proto->New());
+    Message* raw = m.get();
+    add(std::move(m), Kind::kCreated, raw);
+    return Value::external(raw);
+  }
+
+  const Message* prototype(std::string_view type) {
+    const comm::MessageRegistry& reg = *s_.io.messages;
+    if (static_cast<int>(by_name_.size()) - nested_types_ != reg.size()) {
+      nested_types_ = 0;
+      by_name_.clear();
+      for (int i = 0; i < reg.size(); ++i) by_name_[reg.name_at(i)] = reg.prototype(reg.key_at(i));
+    }
+    const std::string name(type);
+    if (auto it = by_name_.find(name); it != by_name_.end()) return it->second;
+    // Types used inside registered messages (e.g. llsf_agent_msgs.MachineState) are not in the
+    // registry: take them from protobuf's generated pool, once a registered type is loaded.
+    const Descriptor* d =
+        google::protobuf::DescriptorPool::generated_pool()->FindMessageTypeByName(name);
+    if (d == nullptr) return nullptr;
+    const Message* proto = google::protobuf::MessageFactory::generated_factory()->GetPrototype(d);
+    by_name_[name] = proto;
+    nested_types_ += 1;
+    return proto;
+  }
+
+  Value get(Message& m, const FieldDescriptor* f, int index) {
+    const Reflection* r = m.GetReflection();
+    const bool rep = index >= 0;
+    switch (f->cpp_type()) {
+      case FieldDescriptor::CPPTYPE_INT32:
+        return Value::integer_value(rep ? r->GetRepeatedInt32(m, f, index) : r->GetInt32(m, f));
+      case FieldDescriptor::CPPTYPE_INT64:
+        return Value::integer_value(rep ? r->GetRepeatedInt64(m, f, index) : r->GetInt64(m, f));
+      case FieldDescriptor::CPPTYPE_UINT32:
+        return Value::integer_value(rep ? r->GetRepeatedUInt32(m, f, index) : r->GetUInt32(m, f));
+      case FieldDescriptor::CPPTYPE_UINT64:
+        return Value::integer_value(static_cast<std::int64_t>(
+            rep ? r->GetRepeatedUInt64(m, f, index) : r->GetUInt64(m, f)));
+      case FieldDescriptor::CPPTYPE_DOUBLE:
+        return Value::float_value(rep ? r->GetRepeatedDouble(m, f, index) : r->GetDouble(m, f));
+      case FieldDescriptor::CPPTYPE_FLOAT:
+        return Value::float_value(rep ? r->GetRepeatedFloat(m, f, index) : r->GetFloat(m, f));
+      case FieldDescriptor::CPPTYPE_BOOL:
+        return Value::boolean(rep ? r->GetRepeatedBool(m, f, index) : r->GetBool(m, f));
+      case FieldDescriptor::CPPTYPE_ENUM:
+        return Value::symbol((rep ? r->GetRepeatedEnum(m, f, index) : r->GetEnum(m, f))->name());
+      case FieldDescriptor::CPPTYPE_STRING:
+        return Value::string(rep ? r->GetRepeatedString(m, f, index) : r->GetString(m, f));
+      case FieldDescriptor::CPPTYPE_MESSAGE: {
+        Message* sub = nullptr;
+        bool read_only = false;
+        if (rep) {
+          sub = r->MutableRepeatedMessage(&m, f, index);
+        } else if (r->HasField(m, f)) {
+          sub = r->MutableMessage(&m, f);
+        } else {  // the default instance: readable, never writable
+          sub = const_cast<Message*>(&r->GetMessage(m, f));
+          read_only = true;
+        }
+        auto root_it = entries_.find(&m);
+        const Message* root = root_it != entries_.end() ? root_it->second.root : &m;
+        auto [it, inserted] =
+            entries_.try_emplace(sub, Entry{Kind::kView, sub, root, read_only, {}});
+        if (!inserted && it->second.kind == Kind::kView) it->second.root = root;
+        s_.live_messages = static_cast<int>(entries_.size());
+        return Value::external(sub);
+      }
+    }
+    return {};
+  }
+
+  Value set(Args& a, bool add_to_list) {
+    Message* m = nullptr;
+    const FieldDescriptor* f = field(a, m);
+    if (f == nullptr) return Value{};
+    if (entries_.at(m).read_only) {
+      a.env().error(a.function(), "cannot modify the default instance of an unset field");
+      return Value{};
+    }
+    if (f->is_repeated() != add_to_list) {
+      a.env().error(a.function(), f->name() + (add_to_list ? " is not repeated: use pb-set-field"
+                                                           : " is repeated: use pb-add-list"));
+      return Value{};
+    }
+    const Reflection* r = m->GetReflection();
+    const Value v = a.value(2);
+    auto fail = [&](const char* expected) {
+      a.env().error(a.function(), f->full_name() + " expects " + expected + ", got " +
+                                      (v.to_string().empty() ? "nothing" : v.to_string()));
+      return Value{};
+    };
+    switch (f->cpp_type()) {
+      case FieldDescriptor::CPPTYPE_INT32:
+      case FieldDescriptor::CPPTYPE_INT64:
+      case FieldDescriptor::CPPTYPE_UINT32:
+      case FieldDescriptor::CPPTYPE_UINT64: {
+        if (!v.is_number()) return fail("an integer");
+        const auto i =
+            v.type == Value::Type::kInteger ? v.integer : static_cast<std::int64_t>(v.real);
+        switch (f->cpp_type()) {
+          case FieldDescriptor::CPPTYPE_INT32:
+            add_to_list ? r->AddInt32(m, f, static_cast<std::int32_t>(i))
+                        : r->SetInt32(m, f, static_cast<std::int32_t>(i));
+            break;
+          case FieldDescriptor::CPPTYPE_INT64:
+            add_to_list ? r->AddInt64(m, f, i) : r->SetInt64(m, f, i);
+            break;
+          case FieldDescriptor::CPPTYPE_UINT32:
+            if (i < 0) return fail("a non-negative integer");
+            add_to_list ? r->AddUInt32(m, f, static_cast<std::uint32_t>(i))
+                        : r->SetUInt32(m, f, static_cast<std::uint32_t>(i));
+            break;
+          default:
+            if (i < 0) return fail("a non-negative integer");
+            add_to_list ? r->AddUInt64(m, f, static_cast<std::uint64_t>(i))
+                        : r->SetUInt64(m, f, static_cast<std::uint64_t>(i));
+        }
+        return Value{};
+      }
+      case FieldDescriptor::CPPTYPE_DOUBLE:
+        if (!v.is_number()) return fail("a number");
+        add_to_list ? r->AddDouble(m, f, v.number()) : r->SetDouble(m, f, v.number());
+        return Value{};
+      case FieldDescriptor::CPPTYPE_FLOAT:
+        if (!v.is_number()) return fail("a number");
+        add_to_list ? r->AddFloat(m, f, static_cast<float>(v.number()))
+                    : r->SetFloat(m, f, static_cast<float>(v.number()));
+        return Value{};
+      case FieldDescriptor::CPPTYPE_BOOL: {
+        bool b = false;
+        if (v.is_symbol("TRUE") || v.is_symbol("true"))
+          b = true;
+        else if (v.is_symbol("FALSE") || v.is_symbol("false"))
+          b = false;
+        else if (v.type == Value::Type::kInteger)
+          b = v.integer != 0;
+        else
+          return fail("TRUE or FALSE");
+        add_to_list ? r->AddBool(m, f, b) : r->SetBool(m, f, b);
+        return Value{};
+      }
+      case FieldDescriptor::CPPTYPE_ENUM: {
+        const google::protobuf::EnumValueDescriptor* ev = nullptr;
+        if (v.type == Value::Type::kSymbol || v.type == Value::Type::kString)
+          ev = f->enum_type()->FindValueByName(v.text);
+        else if (v.type == Value::Type::kInteger)
+          ev = f->enum_type()->FindValueByNumber(static_cast<int>(v.integer));
+        if (ev == nullptr) return fail(("a value of " + f->enum_type()->full_name()).c_str());
+        add_to_list ? r->AddEnum(m, f, ev) : r->SetEnum(m, f, ev);
+        return Value{};
+      }
+      case FieldDescriptor::CPPTYPE_STRING:
+        if (v.type != Value::Type::kString && v.type != Value::Type::kSymbol)
+          return fail("a string");
+        add_to_list ? r->AddString(m, f, v.text) : r->SetString(m, f, v.text);
+        return Value{};
+      case FieldDescriptor::CPPTYPE_MESSAGE: {
+        if (v.type != Value::Type::kAddress) return fail("a message");
+        auto it = entries_.find(v.address);
+        if (it == entries_.end()) return fail("a live message");
+        const Message& src = *it->second.message;
+        if (src.GetDescriptor() != f->message_type())
+          return fail(f->message_type()->full_name().c_str());
+        (add_to_list ? r->AddMessage(m, f) : r->MutableMessage(m, f))->CopyFrom(src);
+        return Value{};
+      }
+    }
+    return Value{};
+  }
+
+  HostState& s_;
+  Template msg_;
+  int slot_type_ = 0, slot_comp_ = 0, slot_msg_type_ = 0, slot_from_ = 0, slot_at_ = 0,
+      slot_client_id_ = 0, slot_ptr_ = 0;
+  std::vector<Value> values_;
+  std::vector<FactHandle> facts_;
+  std::unordered_map<const void*, Entry> entries_;
+  std::unordered_map<std::string, const Message*> by_name_;
+  int nested_types_ = 0;  // entries of by_name_ that are not registry types
+};
+
+}  // namespace
+
+std::unique_ptr<Feature> make_protobuf_feature(HostState& s) {
+  return std::make_unique<ProtobufFeature>(s);
+}
+
+}  // namespace llsf::clips::detail

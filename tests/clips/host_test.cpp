@@ -1,0 +1,285 @@
+// SPDX-License-Identifier: MIT
+// Agent host: loading (file:line errors), the cycle (firing limit, runtime errors), output
+// routing, identity, pose, config facts, seeded random, the test fixture itself.
+#include <doctest/doctest.h>
+
+#include <cstdio>
+#include <fstream>
+
+#include "llsf/clips/agent.h"
+#include "llsf/clips/testing.h"
+#include "llsf/core/config.h"
+
+using namespace llsf;
+using namespace llsf::clips;
+
+namespace {
+
+std::string load_error(AgentFixture& f, std::string_view code, std::string_view name) {
+  try {
+    f.load(code, name);
+  } catch (const AgentLoadError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST_CASE("a syntax error names the file and line") {
+  AgentFixture f;
+  const std::string err = load_error(f,
+                                     "(defrule ok (a) => (assert (b)))\n"
+                                     "\n"
+                                     "(deftemplate machine (slot name))\n"
+                                     "(defrule bad\n"
+                                     "  (machine (nmae M1))\n"
+                                     "  =>\n"
+                                     "  (assert (c)))\n",
+                                     "agents/demo.clp");
+  CHECK(err.find("agents/demo.clp:5: ") == 0);
+  CHECK(err.find("nmae") != std::string::npos);
+  CHECK(err.find("defrule MAIN::bad") != std::string::npos);
+}
+
+TEST_CASE("every error is listed, one line each") {
+  AgentFixture f;
+  const std::string err = load_error(f,
+                                     "(defrule a (x) => (no-such-function))\n"
+                                     "(defrule b (y) =>\n"
+                                     "  (also-missing 1))\n",
+                                     "two.clp");
+  CHECK(err.find("two.clp:1: ") == 0);
+  CHECK(err.find("\ntwo.clp:3: ") != std::string::npos);
+  CHECK(err.find("no-such-function") != std::string::npos);
+}
+
+TEST_CASE("unbalanced parentheses and garbage fail to load") {
+  AgentFixture f;
+  CHECK(load_error(f, "(defrule a (x) => (assert (y))\n", "open.clp").find("open.clp:") == 0);
+  CHECK(load_error(f, "hello\n", "junk.clp").find("junk.clp:1:") == 0);
+}
+
+TEST_CASE("load_file reads the file and reports its path") {
+  const std::string path = "llsf_clips_test_agent.clp";
+  {
+    std::ofstream out(path);
+    out << "; comment\n(defrule r (go) => (assert (went)))\n(defrule s =>\n  (bogus))\n";
+  }
+  AgentFixture f;
+  try {
+    f.load_file(path);
+    FAIL("no error");
+  } catch (const AgentLoadError& e) {
+    CHECK(std::string(e.what()).find(path + ":4: ") == 0);
+  }
+  std::remove(path.c_str());
+  CHECK_THROWS_AS(f.load_file("/nonexistent/agent.clp"), AgentLoadError);
+}
+
+TEST_CASE("a cycle runs to quiescence") {
+  AgentFixture f;
+  f.load(
+      "(defrule count (counter ?n&:(< ?n 5)) ?c <- (counter ?n) => (retract ?c) (assert (counter "
+      "(+ "
+      "?n 1))))");
+  f.step();
+  f.assert_fact("(counter 0)");
+  const CycleResult r = f.step();
+  CHECK(r.rules_fired == 5 + 1);  // + the built-in time-retract rule
+  CHECK_FALSE(r.limit_reached);
+  CHECK(f.has("(counter 5)"));
+}
+
+TEST_CASE("an endless rule loop is cut at the firing limit and reported") {
+  AgentConfig cfg;
+  cfg.max_rules_per_cycle = 50;
+  AgentFixture f(cfg);
+  f.load("(defrule spin ?f <- (spin ?n) => (retract ?f) (assert (spin (+ ?n 1))))");
+  f.step();
+  f.assert_fact("(spin 0)");
+  const CycleResult r = f.step();
+  CHECK(r.limit_reached);
+  CHECK(r.rules_fired == 50);
+  CHECK(f.agent().limit_hits() == 1);
+  CHECK(f.logged("rule firing limit of 50"));
+  // The next cycle gets a fresh budget and still works.
+  CHECK(f.step().rules_fired == 50);
+}
+
+TEST_CASE("a runtime error is logged with the rule name and the agent keeps going") {
+  AgentFixture f;
+  f.load(
+      "(defrule bad (value ?v) => (assert (sum (+ 1 ?v))))\n"
+      "(defrule good (declare (salience -1)) (value ?) => (assert (still-running)))\n");
+  f.step();
+  f.assert_fact("(value abc)");
+  const CycleResult r = f.step();
+  CHECK(r.runtime_errors == 1);
+  CHECK(f.agent().runtime_errors() == 1);
+  CHECK(f.logged("runtime error in rule bad"));
+  CHECK(f.has("(still-running)"));
+  // Wrong arguments to one of our functions: same path.
+  f.load("(defrule bad-call (call-it) => (skill-call drive_to place))");
+  f.assert_fact("(call-it)");
+  CHECK(f.step().runtime_errors == 1);
+  CHECK(f.logged("runtime error in rule bad-call: [LLSF1] skill-call: arguments must come in key"));
+  CHECK(f.agent().runtime_errors() == 2);
+}
+
+TEST_CASE("printout and log functions reach the sink with the simulated time") {
+  AgentFixture f;
+  f.load(
+      "(defrule hello (time $?) (not (said)) => (assert (said))\n"
+      "  (printout t \"hello \" ?*ROBOT-NAME* crlf)\n"
+      "  (printout warn \"careful\" crlf)\n"
+      "  (log-error \"bad \" 42 \" \" 1.5))\n");
+  f.steps(3);
+  REQUIRE(f.log().size() >= 3);
+  const auto& hello = f.log()[0];
+  CHECK(hello.text == "hello robot1");
+  CHECK(hello.level == LogLevel::kInfo);
+  CHECK(hello.time == core::SimTime::from_ms(100));
+  CHECK(f.log()[1].level == LogLevel::kWarn);
+  CHECK(f.log()[2].text == "bad 42 1.5");
+  CHECK(f.log()[2].level == LogLevel::kError);
+}
+
+TEST_CASE("identity globals and robot-info") {
+  AgentConfig cfg;
+  cfg.robot_name = "robot3";
+  cfg.robot_number = 3;
+  cfg.team_name = "Team Test";
+  AgentFixture f(cfg);
+  f.step();
+  CHECK(f.agent().eval("?*ROBOT-NAME*") == Value::symbol("robot3"));
+  CHECK(f.agent().eval("?*ROBOT-NUMBER*") == Value::integer_value(3));
+  CHECK(f.agent().eval("?*TEAM-NAME*") == Value::string("Team Test"));
+  const auto info = f.facts("robot-info");
+  REQUIRE(info.size() == 1);
+  CHECK(info[0].slot("name") == Value::symbol("robot3"));
+  CHECK(info[0].slot("team") == Value::string("Team Test"));
+}
+
+TEST_CASE("bad configs are refused") {
+  AgentConfig cfg;
+  cfg.robot_name = "robot 1";
+  CHECK_THROWS_AS(AgentFixture{cfg}, std::invalid_argument);
+  cfg = {};
+  cfg.max_rules_per_cycle = 0;
+  CHECK_THROWS_AS(AgentFixture{cfg}, std::invalid_argument);
+}
+
+TEST_CASE("the pose fact follows set_pose and changes only when the pose does") {
+  AgentFixture f;
+  f.step();
+  CHECK(f.facts("pose").empty());
+  f.agent().set_pose({1.5, 2.0, 0.25});
+  f.step();
+  auto p = f.facts("pose");
+  REQUIRE(p.size() == 1);
+  CHECK(p[0].slot("x") == Value::float_value(1.5));
+  CHECK(p[0].slot("ori") == Value::float_value(0.25));
+  const auto index = p[0].index;
+  f.agent().set_pose({1.5, 2.0, 0.25});
+  f.step();
+  CHECK(f.facts("pose")[0].index == index);
+  f.agent().set_pose({1.6, 2.0, 0.25});
+  f.step();
+  p = f.facts("pose");
+  REQUIRE(p.size() == 1);
+  CHECK(p[0].slot("x") == Value::float_value(1.6));
+}
+
+TEST_CASE("confval facts from entries and from YAML") {
+  AgentConfig cfg;
+  cfg.config.push_back(ConfigEntry::of("/clips-agent/llsf2013/team-name", "Carologistics"));
+  cfg.config.push_back(ConfigEntry::of("/clips-agent/llsf2013/lock-timeout", 0.5));
+  cfg.config.push_back(ConfigEntry::of("/clips-agent/llsf2013/enable-sim", true));
+  cfg.config.push_back(
+      ConfigEntry::list("/clips-agent/llsf2013/machines", std::vector<std::string>{"M1", "M2"}));
+  const auto node = core::ConfigNode::parse(
+      "llsf2013:\n  robot-timeout: 30\n  offset: -2\n  role: P3\n  ratios: [0.5, 1.5]\n",
+      "agent.yaml");
+  for (auto& e : config_from_node(node, "/clips-agent")) cfg.config.push_back(e);
+  AgentFixture f(cfg);
+  f.load(
+      "(defrule team (confval (path \"/clips-agent/llsf2013/team-name\") (value ?t))\n"
+      "  => (assert (team ?t)))");
+  f.step();
+  CHECK(f.has("(team \"Carologistics\")"));
+  auto c = f.find("confval", {{"path", Value::string("/clips-agent/llsf2013/lock-timeout")}});
+  REQUIRE(c.size() == 1);
+  CHECK(c[0].slot("type") == Value::symbol("FLOAT"));
+  CHECK(c[0].slot("value") == Value::float_value(0.5));
+  c = f.find("confval", {{"path", Value::string("/clips-agent/llsf2013/enable-sim")}});
+  CHECK(c[0].slot("value") == Value::symbol("TRUE"));
+  c = f.find("confval", {{"path", Value::string("/clips-agent/llsf2013/machines")}});
+  CHECK(c[0].slot("is-list") == Value::symbol("TRUE"));
+  CHECK(c[0].slot("list-value").items.size() == 2);
+  c = f.find("confval", {{"path", Value::string("/clips-agent/llsf2013/robot-timeout")}});
+  REQUIRE(c.size() == 1);
+  CHECK(c[0].slot("type") == Value::symbol("UINT"));
+  CHECK(c[0].slot("value") == Value::integer_value(30));
+  c = f.find("confval", {{"path", Value::string("/clips-agent/llsf2013/offset")}});
+  CHECK(c[0].slot("type") == Value::symbol("INT"));
+  c = f.find("confval", {{"path", Value::string("/clips-agent/llsf2013/role")}});
+  CHECK(c[0].slot("value") == Value::string("P3"));
+  c = f.find("confval", {{"path", Value::string("/clips-agent/llsf2013/ratios")}});
+  CHECK(c[0].slot("type") == Value::symbol("FLOAT"));
+  CHECK(c[0].slot("list-value") ==
+        Value::multifield({Value::float_value(0.5), Value::float_value(1.5)}));
+}
+
+TEST_CASE("random is seeded per agent and repeats") {
+  auto draws = [](std::uint64_t seed) {
+    AgentConfig cfg;
+    cfg.seed = seed;
+    AgentFixture f(cfg);
+    f.step();
+    std::vector<std::int64_t> out;
+    for (int i = 0; i < 5; ++i) out.push_back(f.agent().eval("(random 1 1000)").integer);
+    return out;
+  };
+  CHECK(draws(7) == draws(7));
+  CHECK(draws(7) != draws(8));
+  AgentFixture f;
+  f.step();
+  for (int i = 0; i < 20; ++i) {
+    const auto v = f.agent().eval("(random 3 5)").integer;
+    CHECK(v >= 3);
+    CHECK(v <= 5);
+  }
+  f.agent().eval("(seed 99)");
+  const auto a = f.agent().eval("(random)").integer;
+  f.agent().eval("(seed 99)");
+  CHECK(f.agent().eval("(random)").integer == a);
+}
+
+TEST_CASE("start() restarts the facts, the rules stay") {
+  AgentFixture f;
+  f.load(
+      "(deffacts init (state IDLE)) (defrule go ?s <- (state IDLE) (go) => (retract ?s) (assert "
+      "(state BUSY)))");
+  f.step();
+  CHECK(f.has("(state IDLE)"));
+  f.assert_fact("(go)");
+  f.step();
+  CHECK(f.has("(state BUSY)"));
+  f.agent().start(f.now());
+  CHECK(f.has("(state IDLE)"));
+  CHECK_FALSE(f.has("(go)"));
+}
+
+TEST_CASE("fixture helpers: bad facts and queries") {
+  AgentFixture f;
+  f.load("(deftemplate machine (slot name) (slot mtype))");
+  f.step();
+  CHECK_THROWS_AS(f.assert_fact("(machine (nope 1))"), std::invalid_argument);
+  f.assert_fact("(machine (name M1) (mtype T1))");
+  f.assert_fact("(machine (name M2) (mtype T2))");
+  CHECK(f.facts("machine").size() == 2);
+  CHECK(f.find("machine", {{"mtype", Value::symbol("T2")}}).size() == 1);
+  CHECK(f.find("machine", {{"mtype", Value::symbol("T3")}}).empty());
+  CHECK(f.agent().runtime_errors() == 0);
+}

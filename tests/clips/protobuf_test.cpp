@@ -1,0 +1,161 @@
+// SPDX-License-Identifier: MIT
+// Protobuf feature: protobuf-msg facts, the pb-* functions over reflection (scalars, enums,
+// nested and repeated fields), broadcast, and the message pool's lifetimes.
+#include <doctest/doctest.h>
+#include <llsf_agent_msgs/LockMessage.pb.h>
+#include <llsf_agent_msgs/Worldmodel.pb.h>
+
+#include "llsf/clips/testing.h"
+#include "llsf/comm/registry.h"
+
+using namespace llsf;
+using namespace llsf::clips;
+
+namespace {
+
+comm::MessageRegistry agent_registry() {
+  comm::MessageRegistry r;
+  comm::add_agent_messages(r);
+  return r;
+}
+
+std::unique_ptr<llsf_agent_msgs::LockMessage> lock(const char* agent, const char* resource) {
+  auto m = std::make_unique<llsf_agent_msgs::LockMessage>();
+  m->set_type(llsf_agent_msgs::LockMessage::GET);
+  m->set_agent(agent);
+  m->set_resource(resource);
+  return m;
+}
+
+}  // namespace
+
+TEST_CASE("a received message becomes a protobuf-msg fact for one cycle") {
+  const auto reg = agent_registry();
+  AgentFixture f({}, &reg);
+  f.load(
+      "(defrule lock-get\n"
+      "  ?pf <- (protobuf-msg (type \"llsf_agent_msgs.LockMessage\") (ptr ?p) (rcvd-from ?from "
+      "?id)\n"
+      "                       (comp-id ?c) (msg-type ?t) (rcvd-at ?s ?u))\n"
+      "  =>\n"
+      "  (retract ?pf)\n"
+      "  (assert (lock (pb-field-value ?p \"type\") (pb-field-value ?p \"agent\")\n"
+      "                (pb-field-value ?p \"resource\") ?from ?id ?c ?t ?s ?u)))\n");
+  f.step();
+  f.agent().receive(lock("robot2", "M1"), "robot2", 2, core::SimTime::from_ms(1050));
+  CHECK(f.agent().live_messages() == 0);
+  f.step();
+  CHECK(f.has("(lock GET \"robot2\" \"M1\" \"robot2\" 2 2100 1 1 50000)"));
+  CHECK(f.agent().live_messages() == 0);  // freed at the end of the cycle
+  CHECK(f.facts("protobuf-msg").empty());
+}
+
+TEST_CASE("unconsumed protobuf-msg facts are cleaned up and their messages freed") {
+  const auto reg = agent_registry();
+  AgentFixture f({}, &reg);
+  f.load(
+      "(defrule keep-ptr (protobuf-msg (ptr ?p)) => (assert (kept ?p)))\n"
+      "(defrule use-later ?k <- (kept ?p) (later) => (retract ?k) (pb-field-value ?p agent))\n");
+  f.step();
+  f.agent().receive(lock("robot2", "M1"), "robot2", 2, f.now());
+  f.agent().receive(lock("robot3", "M2"), "robot3", 3, f.now());
+  f.step();
+  CHECK(f.facts("protobuf-msg").empty());
+  CHECK(f.agent().live_messages() == 0);
+  // A pointer kept past its cycle is refused (runtime error), not dereferenced.
+  f.assert_fact("(later)");
+  const CycleResult r = f.step();
+  CHECK(r.runtime_errors == 2);
+  CHECK(f.logged("not a live message"));
+}
+
+TEST_CASE("pb-create, set, add-list, nested messages and broadcast") {
+  const auto reg = agent_registry();
+  AgentFixture f({}, &reg);
+  f.load(
+      "(defrule send (send) =>\n"
+      "  (bind ?w (pb-create \"llsf_agent_msgs.Worldmodel\"))\n"
+      "  (pb-set-field ?w \"sender\" ?*ROBOT-NAME*)\n"
+      "  (pb-set-field ?w \"seq\" 7)\n"
+      "  (bind ?m (pb-create \"llsf_agent_msgs.MachineState\"))\n"
+      "  (pb-set-field ?m \"name\" \"M1\")\n"
+      "  (pb-add-list ?m \"loaded_with\" S1)\n"
+      "  (pb-add-list ?m \"loaded_with\" P3)\n"
+      "  (pb-set-field ?m \"produce_blocked\" TRUE)\n"
+      "  (pb-set-field ?m \"prod_finished_time\" 12)\n"
+      "  (pb-add-list ?w \"machines\" ?m)\n"
+      "  (pb-destroy ?m)\n"
+      "  (pb-broadcast ?w)\n"
+      "  (assert (sent ?w)))\n");
+  f.step();
+  f.assert_fact("(send)");
+  CHECK(f.step().runtime_errors == 0);
+  REQUIRE(f.sent().size() == 1);
+  const auto* w = dynamic_cast<const llsf_agent_msgs::Worldmodel*>(f.sent()[0].get());
+  REQUIRE(w != nullptr);
+  CHECK(w->sender() == "robot1");
+  CHECK(w->seq() == 7);
+  REQUIRE(w->machines_size() == 1);
+  CHECK(w->machines(0).name() == "M1");
+  REQUIRE(w->machines(0).loaded_with_size() == 2);
+  CHECK(w->machines(0).loaded_with(1) == llsf_agent_msgs::P3);
+  CHECK(w->machines(0).produce_blocked());
+  CHECK(w->machines(0).prod_finished_time() == 12.0);
+  CHECK(f.agent().live_messages() == 1);  // ?w lives until pb-destroy
+
+  // Reading back: nested messages as pointers, repeated fields as multifields.
+  auto& a = f.agent();
+  f.load("(defglobal ?*w* = nil)");
+  a.eval("(do-for-fact ((?s sent)) TRUE (bind ?*w* (nth$ 1 ?s:implied)))");
+  CHECK(a.eval("(pb-field-value ?*w* \"seq\")") == Value::integer_value(7));
+  CHECK(a.eval("(length$ (pb-field-list ?*w* \"machines\"))") == Value::integer_value(1));
+  CHECK(a.eval("(pb-field-list (nth$ 1 (pb-field-list ?*w* \"machines\")) \"loaded_with\")") ==
+        Value::multifield({Value::symbol("S1"), Value::symbol("P3")}));
+  CHECK(a.eval("(pb-field-value (nth$ 1 (pb-field-list ?*w* machines)) produce_blocked)")
+            .is_symbol("TRUE"));
+  CHECK(a.eval("(pb-has-field ?*w* \"storage\")").is_symbol("FALSE"));
+  CHECK(a.eval("(pb-has-field ?*w* \"machines\")").is_symbol("TRUE"));
+  CHECK(a.eval("(pb-field-is-list ?*w* \"machines\")").is_symbol("TRUE"));
+  CHECK(a.eval("(nth$ 1 (pb-field-names ?*w*))") == Value::string("sender"));
+  CHECK(a.runtime_errors() == 0);
+  a.eval("(pb-destroy ?*w*)");
+  f.step();
+  CHECK(f.agent().live_messages() == 0);
+}
+
+TEST_CASE("pb-* errors are runtime errors") {
+  const auto reg = agent_registry();
+  AgentFixture f({}, &reg);
+  f.step();
+  auto& a = f.agent();
+  f.load("(defglobal ?*m* = (pb-create \"llsf_agent_msgs.LockMessage\"))");
+  int errors = a.runtime_errors();
+  auto expect_error = [&](const char* expr, const char* text) {
+    a.eval(expr);
+    CHECK_MESSAGE(a.runtime_errors() == errors + 1, expr);
+    CHECK_MESSAGE(f.logged(text), expr);
+    errors = a.runtime_errors();
+  };
+  expect_error("(pb-create \"llsf_msgs.Nope\")", "is not registered");
+  expect_error("(pb-set-field ?*m* \"nope\" 1)", "has no field nope");
+  expect_error("(pb-set-field ?*m* \"type\" MAYBE)", "expects a value of llsf_agent_msgs");
+  expect_error("(pb-set-field ?*m* \"agent\" 3)", "expects a string");
+  expect_error("(pb-add-list ?*m* \"agent\" \"x\")", "is not repeated");
+  expect_error("(pb-broadcast ?*m*)", "lacks required fields");
+  a.eval("(pb-set-field ?*m* \"type\" 3)");  // enums also by number
+  CHECK(a.eval("(pb-field-value ?*m* \"type\")").is_symbol("ACCEPT"));
+  CHECK(a.runtime_errors() == errors);
+}
+
+TEST_CASE("an unset nested message reads as its defaults and cannot be written") {
+  const auto reg = agent_registry();
+  AgentFixture f({}, &reg);
+  f.step();
+  auto& a = f.agent();
+  f.load("(defglobal ?*c* = (pb-create \"llsf_agent_msgs.WorldmodelChange\"))");
+  CHECK(a.eval("(pb-field-value (pb-field-value ?*c* incoming) action)") == Value::string(""));
+  const int errors = a.runtime_errors();
+  a.eval("(pb-set-field (pb-field-value ?*c* incoming) action \"x\")");
+  CHECK(a.runtime_errors() == errors + 1);
+  CHECK(llsf_agent_msgs::Incoming::default_instance().action().empty());
+}
