@@ -107,6 +107,7 @@ class SkillsFeature final : public Feature {
       skill_string_ = sks;
       status_ = SkillStatus::kIdle;
       error_.clear();
+      result_.clear();
       write_fact(env);
       return Value{};
     });
@@ -134,6 +135,8 @@ class SkillsFeature final : public Feature {
     }
     const SkillStatus st = r.status();
     if (st == SkillStatus::kIdle || st == status_) return;
+    result_ =
+        (st == SkillStatus::kFinal || st == SkillStatus::kFailed) ? r.result() : std::string();
     set_status(env, st, st == SkillStatus::kFailed ? r.error() : std::string());
   }
 
@@ -152,7 +155,7 @@ class SkillsFeature final : public Feature {
   void write_fact(Environment& env) {
     env.retract(fact_);
     const Value v[] = {Value::symbol(name_), Value::symbol(to_string(status_)),
-                       Value::string(skill_string_), Value::string(error_)};
+                       Value::string(skill_string_), Value::string(error_), Value::string(result_)};
     fact_ = env.assert_fact(skill_, v);
   }
 
@@ -160,7 +163,7 @@ class SkillsFeature final : public Feature {
   Template skill_;
   FactHandle fact_;
   bool active_ = false;
-  std::string name_, skill_string_, error_;
+  std::string name_, skill_string_, error_, result_;
   SkillStatus status_ = SkillStatus::kIdle;
 };
 

@@ -11,6 +11,7 @@ void FakeSkillRunner::exec(std::string_view skill_string) {
   calls_.push_back(current_);
   status_ = SkillStatus::kRunning;
   error_.clear();
+  result_.clear();
 }
 
 void FakeSkillRunner::stop() {

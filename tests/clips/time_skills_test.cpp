@@ -118,3 +118,18 @@ TEST_CASE("skill-call without a runner is a runtime error") {
   host.eval("(skill-call drive_to place M1)");
   CHECK(host.runtime_errors() == 1);
 }
+
+TEST_CASE("a finished skill fact carries the runner's result") {
+  AgentFixture f;
+  f.load(
+      "(defrule start (start) => (skill-call explore_machine place M3))\n"
+      "(defrule done (skill (name explore_machine) (status FINAL) (result ?r))\n"
+      "  => (assert (code ?r)))\n");
+  f.step();
+  f.assert_fact("(start)");
+  f.steps(2);
+  f.skills().set_result("M3 red=ON yellow=OFF green=BLINKING");
+  f.skills().set_status(SkillStatus::kFinal);
+  f.step();
+  CHECK(f.has("(code \"M3 red=ON yellow=OFF green=BLINKING\")"));
+}

@@ -29,6 +29,9 @@ class SkillRunner {
   virtual SkillStatus status() const = 0;
   /// Error text of a FAILED string (empty otherwise).
   virtual std::string error() const = 0;
+  /// What the skills reported when the string ended (the Lua engine's result(), e.g. "DONE");
+  /// empty while running or if none did.
+  virtual std::string result() const { return {}; }
   /// The skill string being (or last) executed; the host uses it to tell whether the runner
   /// still works on the string this agent sent.
   virtual std::string skill_string() const = 0;

@@ -20,16 +20,19 @@ class FakeSkillRunner final : public SkillRunner {
   SkillStatus status() const override { return status_; }
   std::string error() const override { return error_; }
   std::string skill_string() const override { return current_; }
+  std::string result() const override { return result_; }
 
   /// Sets what status() and error() report from now on.
   void set_status(SkillStatus status, std::string error = {});
+  /// Sets what result() reports from now on (e.g. "DONE").
+  void set_result(std::string result) { result_ = std::move(result); }
   /// Every skill string passed to exec(), in order.
   const std::vector<std::string>& calls() const { return calls_; }
   int stops() const { return stops_; }
 
  private:
   SkillStatus status_ = SkillStatus::kIdle;
-  std::string error_, current_;
+  std::string error_, current_, result_;
   std::vector<std::string> calls_;
   int stops_ = 0;
 };
