@@ -103,6 +103,8 @@ class Game {
   comm::Hub& hub() { return *hub_; }
   const comm::Hub& hub() const { return *hub_; }
   comm::PeerId refbox_peer() const { return refbox_peer_; }
+  /// The messages the radio knows (refbox and agent messages).
+  const comm::MessageRegistry& registry() const { return registry_; }
   planner::Planner& planner() { return *planner_; }
 
   int robot_count() const { return static_cast<int>(stacks_.size()); }

@@ -1,0 +1,91 @@
+; SPDX-License-Identifier: MIT
+; LLSF 2013 team agent -- what the refbox tells the robots (GameState, ExplorationInfo,
+; MachineReportInfo, MachineInfo, OrderInfo). Messages are consumed in the cycle they arrive.
+
+(defrule refbox-game-state
+  (declare (salience ?*PRIORITY-REFBOX*))
+  ?pf <- (protobuf-msg (type "llsf_msgs.GameState") (ptr ?p))
+  ?g <- (game)
+  =>
+  (retract ?pf)
+  (bind ?t (pb-field-value ?p "game_time"))
+  (bind ?secs (+ (pb-field-value ?t "sec") (/ (pb-field-value ?t "nsec") 1000000000.0)))
+  (modify ?g (phase (pb-field-value ?p "phase")) (state (pb-field-value ?p "state"))
+             (time ?secs))
+)
+
+(deffunction light-state-name (?s)
+  (if (eq ?s BLINK) then (return BLINKING))
+  (return ?s)
+)
+
+(defrule refbox-exploration-info
+  (declare (salience ?*PRIORITY-REFBOX*))
+  ?pf <- (protobuf-msg (type "llsf_msgs.ExplorationInfo") (ptr ?p))
+  (not (signal))
+  =>
+  (retract ?pf)
+  (foreach ?s (pb-field-list ?p "signals")
+    (bind ?red OFF) (bind ?yellow OFF) (bind ?green OFF)
+    (foreach ?l (pb-field-list ?s "lights")
+      (bind ?st (light-state-name (pb-field-value ?l "state")))
+      (switch (pb-field-value ?l "color")
+        (case RED then (bind ?red ?st))
+        (case YELLOW then (bind ?yellow ?st))
+        (case GREEN then (bind ?green ?st))))
+    (assert (signal (type (sym-cat (pb-field-value ?s "type")))
+                    (code (str-cat "red=" ?red " yellow=" ?yellow " green=" ?green)))))
+)
+
+(defrule refbox-exploration-info-known
+  (declare (salience ?*PRIORITY-REFBOX*))
+  ?pf <- (protobuf-msg (type "llsf_msgs.ExplorationInfo"))
+  (signal)
+  =>
+  (retract ?pf)
+)
+
+(defrule refbox-machine-report-info
+  (declare (salience ?*PRIORITY-REFBOX*))
+  ?pf <- (protobuf-msg (type "llsf_msgs.MachineReportInfo") (ptr ?p))
+  =>
+  (retract ?pf)
+  (foreach ?n (pb-field-list ?p "reported_machines")
+    (do-for-fact ((?m machine)) (and (eq ?m:name (sym-cat ?n)) (eq ?m:explored FALSE))
+      (modify ?m (explored TRUE))))
+)
+
+(defrule refbox-machine-info
+  (declare (salience ?*PRIORITY-REFBOX*))
+  ?pf <- (protobuf-msg (type "llsf_msgs.MachineInfo") (ptr ?p))
+  =>
+  (retract ?pf)
+  (foreach ?e (pb-field-list ?p "machines")
+    (if (pb-has-field ?e "type") then
+      (bind ?type (sym-cat (pb-field-value ?e "type")))
+      (bind ?name (sym-cat (pb-field-value ?e "name")))
+      (if (member$ ?type (create$ T1 T2 T3 T4 T5)) then
+        (do-for-fact ((?m machine)) (and (eq ?m:name ?name) (neq ?m:mtype ?type))
+          (modify ?m (mtype ?type))))))
+)
+
+(defrule refbox-order-info
+  (declare (salience ?*PRIORITY-REFBOX*))
+  ?pf <- (protobuf-msg (type "llsf_msgs.OrderInfo") (ptr ?p))
+  =>
+  (retract ?pf)
+  (foreach ?o (pb-field-list ?p "orders")
+    (bind ?id (pb-field-value ?o "id"))
+    (bind ?product (pb-field-value ?o "product"))
+    (bind ?req (pb-field-value ?o "quantity_requested"))
+    (bind ?del (pb-field-value ?o "quantity_delivered"))
+    (bind ?b (pb-field-value ?o "delivery_period_begin"))
+    (bind ?e (pb-field-value ?o "delivery_period_end"))
+    (if (any-factp ((?x order)) (eq ?x:id ?id))
+     then
+      (do-for-fact ((?x order)) (and (eq ?x:id ?id) (neq ?x:delivered ?del))
+        (modify ?x (delivered ?del)))
+     else
+      (assert (order (id ?id) (product ?product) (requested ?req) (delivered ?del)
+                     (begin ?b) (end ?e)))))
+)

@@ -1,0 +1,134 @@
+; SPDX-License-Identifier: MIT
+; LLSF 2013 team agent -- the task engine. The decision rules (exploration, production) assert
+; one (task) at a time; this file takes it through
+;   NEW -> LOCKING (if it needs a resource) -> START -> RUNNING -> DONE | FAILED
+; by requesting the lock, calling the task's skill and reading the skill's outcome. Whoever
+; asserted the task consumes DONE/FAILED (and then calls task-finished).
+;
+; Locks: (lock-request ?r) asks for a resource, (lock-granted (resource ?r)) / (lock-denied ?r) answer,
+; (lock-release ?r) gives it back. 45_locks.clp maps these onto the lock protocol, or grants
+; everything at once when locks are off.
+
+(deffunction task-skill (?kind)
+  (switch ?kind
+    (case EXPLORE then explore_machine)
+    (case GET_S0 then get_s0)
+    (case GET_CONSUMED then get_consumed)
+    (case FINISH then finish_puck_at)
+    (case DELIVER then deliver)
+    (case LEAVE then leave_puck)
+    (case PARK then park)
+    (default NONE))
+)
+
+(defrule task-needs-lock
+  (declare (salience ?*PRIORITY-TASK*))
+  ?t <- (task (state NEW) (lock ?r&~NONE))
+  =>
+  (assert (lock-request (resource ?r)))
+  (modify ?t (state LOCKING) (since (now)))
+)
+
+(defrule task-no-lock
+  (declare (salience ?*PRIORITY-TASK*))
+  ?t <- (task (state NEW) (lock NONE))
+  =>
+  (modify ?t (state START))
+)
+
+(defrule task-lock-granted
+  (declare (salience ?*PRIORITY-TASK*))
+  ?t <- (task (state LOCKING) (lock ?r))
+  (lock-granted (resource ?r))
+  =>
+  (modify ?t (state START))
+)
+
+(defrule task-lock-denied
+  (declare (salience ?*PRIORITY-TASK*))
+  ?t <- (task (state LOCKING) (lock ?r) (attempts ?a))
+  ?d <- (lock-denied (resource ?r))
+  =>
+  (retract ?d)
+  (modify ?t (state LOCK_WAIT) (since (now)) (attempts (+ ?a 1)))
+)
+
+; Ask again after a second (the decision rules may drop the task instead: see task-abandon).
+(defrule task-lock-retry
+  (declare (salience ?*PRIORITY-TASK*))
+  (time $?)
+  ?t <- (task (state LOCK_WAIT) (lock ?r) (since ?s&:(> (- (now) ?s) 1.0)))
+  =>
+  (assert (lock-request (resource ?r)))
+  (modify ?t (state LOCKING) (since (now)))
+)
+
+(defrule task-start
+  (declare (salience ?*PRIORITY-TASK*))
+  ?t <- (task (state START) (kind ?k&~WAIT) (place ?p))
+  =>
+  (bind ?skill (task-skill ?k))
+  (if (eq ?p NONE)
+   then (skill-call ?skill)
+   else (skill-call ?skill place ?p))
+  (modify ?t (state RUNNING) (since (now)))
+)
+
+(defrule task-start-wait
+  (declare (salience ?*PRIORITY-TASK*))
+  ?t <- (task (state START) (kind WAIT))
+  =>
+  (modify ?t (state RUNNING) (since (now)))
+)
+
+(defrule task-wait-over
+  (declare (salience ?*PRIORITY-TASK*))
+  (time $?)
+  ?t <- (task (state RUNNING) (kind WAIT) (since ?s&:(> (- (now) ?s) 3.0)))
+  =>
+  (modify ?t (state DONE))
+)
+
+(defrule task-skill-final
+  (declare (salience ?*PRIORITY-TASK*))
+  ?t <- (task (state RUNNING) (kind ?k))
+  ?s <- (skill (name ?n&:(eq ?n (task-skill ?k))) (status FINAL) (result ?r))
+  =>
+  (retract ?s)
+  (modify ?t (state DONE) (result ?r))
+)
+
+(defrule task-skill-failed
+  (declare (salience ?*PRIORITY-TASK*))
+  ?t <- (task (state RUNNING) (kind ?k))
+  ?s <- (skill (name ?n&:(eq ?n (task-skill ?k))) (status FAILED) (error ?e) (result ?r))
+  =>
+  (retract ?s)
+  (log-warn "task " ?k " failed: " ?e)
+  (modify ?t (state FAILED) (error ?e) (result ?r))
+)
+
+; Called by the consumer of a DONE/FAILED task: releases its lock, counts, retracts it.
+(deffunction task-finished (?t ?ok)
+  (bind ?r (fact-slot-value ?t lock))
+  (if (neq ?r NONE) then (assert (lock-release (resource ?r))))
+  (do-for-fact ((?rec record)) TRUE
+    (if ?ok
+     then (modify ?rec (tasks-done (+ ?rec:tasks-done 1)) (failures-in-a-row 0))
+     else (modify ?rec (tasks-failed (+ ?rec:tasks-failed 1))
+                       (failures-in-a-row (+ ?rec:failures-in-a-row 1)))))
+  (retract ?t)
+)
+
+; A phase change ends whatever the robot was doing (exploration tasks in production, ...).
+(defrule task-phase-changed
+  (declare (salience ?*PRIORITY-TASK*))
+  (game (phase ?ph))
+  ?t <- (task (kind EXPLORE) (state ?st))
+  (test (neq ?ph EXPLORATION))
+  =>
+  (if (eq ?st RUNNING) then (skill-stop))
+  (bind ?r (fact-slot-value ?t lock))
+  (if (neq ?r NONE) then (assert (lock-release (resource ?r))))
+  (retract ?t)
+)

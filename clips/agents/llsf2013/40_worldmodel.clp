@@ -1,0 +1,57 @@
+; SPDX-License-Identifier: MIT
+; LLSF 2013 team agent -- sharing the world model with the team. Every second each robot
+; broadcasts its view of the machines (intermediate inputs lying beside them, consumed pucks,
+; down times) in a Worldmodel message; receivers keep, per machine, the newest entry
+; (updated_at), so a lost message is repaired by the next one.
+
+(deffacts worldmodel-timer
+  (timer (name worldmodel) (time 0 0) (seq 0))
+)
+
+(deffunction puck-kind (?p) (return ?p))   ; our symbols are the PuckKind names
+
+(defrule wm-broadcast
+  (declare (salience ?*PRIORITY-WM*))
+  (time $?now)
+  (game (phase EXPLORATION|PRODUCTION))
+  ?t <- (timer (name worldmodel) (time $?last&:(timeout ?now ?last 1.0)) (seq ?seq))
+  =>
+  (modify ?t (time ?now) (seq (+ ?seq 1)))
+  (bind ?wm (pb-create "llsf_agent_msgs.Worldmodel"))
+  (pb-set-field ?wm "sender" (str-cat ?*ROBOT-NAME*))
+  (pb-set-field ?wm "seq" (+ ?seq 1))
+  (do-for-all-facts ((?m machine)) (> ?m:updated-at 0.0)
+    (bind ?ms (pb-create "llsf_agent_msgs.MachineState"))
+    (pb-set-field ?ms "name" (str-cat ?m:name))
+    (foreach ?l ?m:loaded-with (pb-add-list ?ms "loaded_with" ?l))
+    (pb-set-field ?ms "junk" ?m:consumed)
+    (pb-set-field ?ms "out_of_order_until" ?m:down-until)
+    (pb-set-field ?ms "updated_at" ?m:updated-at)
+    (pb-add-list ?wm "machines" ?ms)
+    (pb-destroy ?ms))
+  (pb-broadcast ?wm)
+  (pb-destroy ?wm)
+)
+
+(defrule wm-receive
+  (declare (salience ?*PRIORITY-WM*))
+  ?pf <- (protobuf-msg (type "llsf_agent_msgs.Worldmodel") (ptr ?p))
+  =>
+  (retract ?pf)
+  (foreach ?ms (pb-field-list ?p "machines")
+    (bind ?name (sym-cat (pb-field-value ?ms "name")))
+    (bind ?at (pb-field-value ?ms "updated_at"))
+    (do-for-fact ((?m machine)) (and (eq ?m:name ?name) (> ?at ?m:updated-at))
+      (modify ?m (loaded-with (pb-field-list ?ms "loaded_with"))
+                 (consumed (pb-field-value ?ms "junk"))
+                 (down-until (pb-field-value ?ms "out_of_order_until"))
+                 (updated-at ?at))))
+)
+
+; Messages of the team this agent does not use.
+(defrule wm-ignore-other-agent-msgs
+  (declare (salience ?*PRIORITY-LOW*))
+  ?pf <- (protobuf-msg (type "llsf_agent_msgs.WorldmodelChange"))
+  =>
+  (retract ?pf)
+)

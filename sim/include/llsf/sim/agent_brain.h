@@ -1,0 +1,72 @@
+// SPDX-License-Identifier: MIT
+// AgentBrain: a robot's whole brain in the game loop -- a CLIPS agent (clips::AgentHost) on top
+// of the robot's skill engine (SkillBrain). The agent cycles at the game's agent rate with the
+// robot's pose estimate and the messages its radio received; its skill-calls run on the skill
+// engine; its pb-broadcasts go out on the robot's radio.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "llsf/clips/agent.h"
+#include "llsf/clips/config_values.h"
+#include "llsf/clips/skill_runner.h"
+#include "llsf/lua/skill_engine.h"
+#include "llsf/sim/game.h"
+#include "llsf/sim/skill_brain.h"
+
+namespace llsf::sim {
+
+/// What an agent brain is built from.
+struct AgentBrainConfig {
+  /// CLIPS files, loaded in order (a load error throws clips::AgentLoadError, file:line); a
+  /// directory stands for its *.clp files in name order (e.g. clips/agents/llsf2013).
+  std::vector<std::string> agent_files;
+  /// confval facts (e.g. clips::config_from_node(yaml, "/clips-agent")).
+  clips::ConfigEntries config;
+  /// The skill engine (empty skill_dirs: the library of the game's skill level).
+  lua::SkillEngineConfig skills;
+  /// Rule firings per agent cycle before the run is cut.
+  std::int64_t max_rules_per_cycle = 10'000;
+  /// Team name for ?*TEAM-NAME* (empty: the game's team or the refbox's).
+  std::string team;
+};
+
+/// `entries` with every directory replaced by its *.clp files in name order.
+std::vector<std::string> agent_files(const std::vector<std::string>& entries);
+
+/// Plugs itself into robot `index` of `game` (which must outlive it) on construction.
+class AgentBrain final : public RobotBrain, private clips::SkillRunner {
+ public:
+  /// Loads the agent files; throws clips::AgentLoadError for bad agent code and
+  /// core::ConfigError for a bad skill-engine config. `log` receives the agent's output.
+  AgentBrain(Game& game, int index, AgentBrainConfig config, clips::LogSink log = {});
+  ~AgentBrain() override;
+  AgentBrain(const AgentBrain&) = delete;
+  AgentBrain& operator=(const AgentBrain&) = delete;
+
+  clips::AgentHost& agent() { return *agent_; }
+  const clips::AgentHost& agent() const { return *agent_; }
+  SkillBrain& skills() { return *skills_; }
+
+  void on_skill_cycle(lua::RobotApi& robot) override;
+  void on_agent_cycle(lua::RobotApi& robot, RobotRadio& radio) override;
+
+ private:
+  // clips::SkillRunner over the skill engine.
+  void exec(std::string_view skill_string) override;
+  void stop() override;
+  clips::SkillStatus status() const override;
+  std::string error() const override;
+  std::string skill_string() const override;
+  std::string result() const override;
+
+  Game& game_;
+  int index_;
+  std::unique_ptr<SkillBrain> skills_;
+  std::unique_ptr<clips::AgentHost> agent_;
+};
+
+}  // namespace llsf::sim
