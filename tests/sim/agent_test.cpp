@@ -3,6 +3,7 @@
 #include <doctest/doctest.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <string>
 #include <vector>
@@ -26,6 +27,9 @@ struct AgentGame {
       brains.push_back(std::make_unique<AgentBrain>(
           game, i, c, [this, print](const clips::LogRecord& r) {
             if (r.level >= clips::LogLevel::kWarn) ++warnings;
+            const std::string_view text = r.text;
+            if (text.find("role change") != std::string_view::npos) ++role_changes;
+            if (text.find("took a consumed puck") != std::string_view::npos) ++consumed_taken;
             if (print || r.level == clips::LogLevel::kError) {
               std::printf("%8.2f %s %s: %.*s\n", r.time.seconds(), std::string(r.agent).c_str(),
                           clips::to_string(r.level), static_cast<int>(r.text.size()),
@@ -46,6 +50,8 @@ struct AgentGame {
   Game game;
   std::vector<std::unique_ptr<AgentBrain>> brains;
   int warnings = 0;
+  int role_changes = 0;
+  int consumed_taken = 0;
 };
 
 }  // namespace
@@ -61,11 +67,51 @@ TEST_CASE("the LLSF 2013 agent explores with three robots and reports the machin
 }
 
 TEST_CASE("the LLSF 2013 agent produces and delivers with three robots") {
-  AgentGame g(3, 7, {});
+  AgentGame g(3, 7, {}, std::getenv("LLSF_AGENT_LOG") != nullptr);
   test::start_phase(g.game, refbox::GamePhase::kProduction);
   g.game.run_until(SimTime::from_sec(900));
   const GameSummary s = g.game.summary();
   MESSAGE("production points: ", s.production_points);
   CHECK(g.runtime_errors() == 0);
   CHECK(s.production_points >= 20);
+}
+
+TEST_CASE("the thesis' configurations are configuration: P3-P3, P1P2-P3-R, P1-P2-P3-RD") {
+  struct Variant {
+    const char* name;
+    int robots;
+    std::vector<std::string> roles;
+    std::string recycle;
+    bool role_change;
+  };
+  const Variant variants[] = {
+      {"P3-P3", 2, {"P3", "P3"}, "never", false},
+      {"P1P2-P3-R", 2, {"P1P2", "P3"}, "ifpossible", false},
+      {"P1-P2-P3-RD", 3, {"P1", "P2", "P3"}, "afterdeliver", true},
+  };
+  for (const Variant& v : variants) {
+    CAPTURE(v.name);
+    clips::ConfigEntries cfg{clips::ConfigEntry::list("/clips-agent/llsf2013/roles", v.roles),
+                             clips::ConfigEntry::of("/clips-agent/llsf2013/recycle", v.recycle)};
+    if (v.role_change) {
+      cfg.push_back(
+          clips::ConfigEntry::of("/clips-agent/llsf2013/role-change/after-complex-delivery", true));
+      cfg.push_back(clips::ConfigEntry::of("/clips-agent/llsf2013/role-change/time-left", 300));
+    }
+    AgentGame g(v.robots, 11, cfg);
+    test::start_phase(g.game, refbox::GamePhase::kProduction);
+    g.game.run_until(SimTime::from_sec(900));
+    const GameSummary s = g.game.summary();
+    MESSAGE(std::string(v.name), ": ", s.production_points, " production points, ",
+            g.consumed_taken, " consumed pucks taken, ", g.role_changes, " role changes");
+    if (v.recycle != "never") CHECK(g.consumed_taken > 0);
+    if (v.role_change) CHECK(g.role_changes > 0);
+    CHECK(g.runtime_errors() == 0);
+    CHECK(s.production_points > 0);
+    // Every robot took the configured role.
+    for (std::size_t i = 0; i < g.brains.size(); ++i) {
+      const auto roles = g.brains[i]->agent().facts("role");
+      REQUIRE(roles.size() == 1);
+    }
+  }
 }

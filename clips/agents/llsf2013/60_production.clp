@@ -240,6 +240,7 @@
   ?t <- (task (kind GET_CONSUMED) (state DONE) (place ?m))
   =>
   (set-holding CONSUMED)
+  (log-info "production: took a consumed puck at " ?m)
   (machine-update ?m consumed-add -1)
   (task-finished ?t TRUE)
 )
