@@ -57,7 +57,8 @@
 (defrule task-lock-retry
   (declare (salience ?*PRIORITY-TASK*))
   (time $?)
-  ?t <- (task (state LOCK_WAIT) (lock ?r) (since ?s&:(> (- (now) ?s) 1.0)))
+  ?t <- (task (state LOCK_WAIT) (lock ?r) (since ?s))
+  (test (> (- (now) ?s) 1.0))   ; a test CE: evaluated again with every new (time) fact
   =>
   (assert (lock-request (resource ?r)))
   (modify ?t (state LOCKING) (since (now)))
@@ -84,7 +85,8 @@
 (defrule task-wait-over
   (declare (salience ?*PRIORITY-TASK*))
   (time $?)
-  ?t <- (task (state RUNNING) (kind WAIT) (since ?s&:(> (- (now) ?s) 3.0)))
+  ?t <- (task (state RUNNING) (kind WAIT) (since ?s))
+  (test (> (- (now) ?s) 3.0))
   =>
   (modify ?t (state DONE))
 )
