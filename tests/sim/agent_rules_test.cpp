@@ -19,7 +19,8 @@ namespace {
 
 struct Rules {
   Rules() : f(config(), &registry_for_tests()) {
-    for (const std::string& file : sim::agent_files({LLSF_SOURCE_DIR "/clips/agents/llsf2013"})) {
+    for (const std::string& file : sim::agent_files(
+             {LLSF_SOURCE_DIR "/clips/agents/common", LLSF_SOURCE_DIR "/clips/agents/llsf2013"})) {
       f.load_file(file);
     }
     f.load(

@@ -22,10 +22,10 @@ struct AgentGame {
       : game(make_config(robots, seed)) {
     for (int i = 0; i < robots; ++i) {
       AgentBrainConfig c;
-      c.agent_files = {LLSF_SOURCE_DIR "/clips/agents/llsf2013"};
+      c.agent_files = {LLSF_SOURCE_DIR "/clips/agents/common", LLSF_SOURCE_DIR "/clips/agents/llsf2013"};
       c.config = config;
-      brains.push_back(std::make_unique<AgentBrain>(
-          game, i, c, [this, print](const clips::LogRecord& r) {
+      brains.push_back(
+          std::make_unique<AgentBrain>(game, i, c, [this, print](const clips::LogRecord& r) {
             if (r.level >= clips::LogLevel::kWarn) ++warnings;
             const std::string_view text = r.text;
             if (text.find("role change") != std::string_view::npos) ++role_changes;
@@ -91,12 +91,12 @@ TEST_CASE("the thesis' configurations are configuration: P3-P3, P1P2-P3-R, P1-P2
   };
   for (const Variant& v : variants) {
     CAPTURE(v.name);
-    clips::ConfigEntries cfg{clips::ConfigEntry::list("/clips-agent/llsf2013/roles", v.roles),
-                             clips::ConfigEntry::of("/clips-agent/llsf2013/recycle", v.recycle)};
+    clips::ConfigEntries cfg{clips::ConfigEntry::list("/clips-agent/roles", v.roles),
+                             clips::ConfigEntry::of("/clips-agent/recycle", v.recycle)};
     if (v.role_change) {
       cfg.push_back(
-          clips::ConfigEntry::of("/clips-agent/llsf2013/role-change/after-complex-delivery", true));
-      cfg.push_back(clips::ConfigEntry::of("/clips-agent/llsf2013/role-change/time-left", 300));
+          clips::ConfigEntry::of("/clips-agent/role-change/after-complex-delivery", true));
+      cfg.push_back(clips::ConfigEntry::of("/clips-agent/role-change/time-left", 300));
     }
     AgentGame g(v.robots, 11, cfg);
     test::start_phase(g.game, refbox::GamePhase::kProduction);

@@ -5,7 +5,7 @@
 ;   holding S0/S1/S2 -> the machine this puck should go to for the role's product
 ;   holding a product -> deliver;  holding a consumed puck -> the nearer recycler
 ; Roles: P3 (S0 -> T5 -> deliver), P1 (T3), P2 (T4), P1P2 (T3 or T4, whichever lies farther
-; from the T5). Configuration (confval, /clips-agent/llsf2013/...): roles (list by robot
+; from the T5). Configuration (confval, /clips-agent/...): roles (list by robot
 ; number), recycle (never | ifpossible | afterdeliver), role-change/after-complex-delivery,
 ; role-change/time-left (s), role-change/failures (in a row). See docs/agent-llsf2013.md.
 
@@ -96,7 +96,7 @@
   (bind ?x (robot-x)) (bind ?y (robot-y))
   (switch ?h
     (case NONE then
-      (bind ?mode (cfg "/clips-agent/llsf2013/recycle" "never"))
+      (bind ?mode (cfg "/clips-agent/recycle" "never"))
       (if (or (eq ?mode "ifpossible")
               (and (eq ?mode "afterdeliver") (any-factp ((?rp recycle-pending)) TRUE))) then
         (bind ?cm (nearest-consumed ?x ?y))
@@ -147,7 +147,7 @@
   (machine (mtype T3))
   (machine (mtype T4))
   =>
-  (bind ?roles (cfg-list "/clips-agent/llsf2013/roles" "P1P2" "P3" "P3"))
+  (bind ?roles (cfg-list "/clips-agent/roles" "P1P2" "P3" "P3"))
   (bind ?n (+ (mod (- ?*ROBOT-NUMBER* 1) (length$ ?roles)) 1))
   (bind ?role (sym-cat (nth$ ?n ?roles)))
   (bind ?target (if (eq ?role P3) then NONE else (complex-target ?role)))
@@ -164,7 +164,7 @@
   (declare (salience ?*PRIORITY-DECIDE*))
   ?r <- (role (name ~P3))
   (record (complex-delivered ?n&:(> ?n 0)))
-  (test (eq (cfg "/clips-agent/llsf2013/role-change/after-complex-delivery" FALSE) TRUE))
+  (test (eq (cfg "/clips-agent/role-change/after-complex-delivery" FALSE) TRUE))
   =>
   (change-role ?r "a complex product was delivered")
 )
@@ -174,8 +174,8 @@
   (game (phase PRODUCTION) (time ?gt))
   ?r <- (role (name ~P3))
   (holding (puck NONE|S0))
-  (test (> (cfg "/clips-agent/llsf2013/role-change/time-left" 0) 0))
-  (test (> ?gt (- ?*PRODUCTION-TIME* (cfg "/clips-agent/llsf2013/role-change/time-left" 0))))
+  (test (> (cfg "/clips-agent/role-change/time-left" 0) 0))
+  (test (> ?gt (- ?*PRODUCTION-TIME* (cfg "/clips-agent/role-change/time-left" 0))))
   =>
   (change-role ?r "too little time left for a complex product")
 )
@@ -184,8 +184,8 @@
   (declare (salience ?*PRIORITY-DECIDE*))
   ?r <- (role (name ~P3))
   (record (failures-in-a-row ?f))
-  (test (> (cfg "/clips-agent/llsf2013/role-change/failures" 0) 0))
-  (test (>= ?f (cfg "/clips-agent/llsf2013/role-change/failures" 0)))
+  (test (> (cfg "/clips-agent/role-change/failures" 0) 0))
+  (test (>= ?f (cfg "/clips-agent/role-change/failures" 0)))
   =>
   (change-role ?r (str-cat ?f " failures in a row"))
 )
@@ -272,7 +272,7 @@
   (set-holding NONE)
   (if (member$ ?h (create$ P1 P2)) then
     (modify ?rec (complex-delivered (+ ?n 1)))
-    (if (eq (cfg "/clips-agent/llsf2013/recycle" "never") "afterdeliver") then
+    (if (eq (cfg "/clips-agent/recycle" "never") "afterdeliver") then
       (assert (recycle-pending))))
   (task-finished ?t TRUE)
 )

@@ -1,5 +1,5 @@
 ; SPDX-License-Identifier: MIT
-; LLSF 2013 team agent -- templates and the static field.
+; Team agents, common part (used by llsf2013 and auction) -- templates and the static field.
 
 ; A device of the field and what this robot believes about it.
 (deftemplate machine

@@ -1,6 +1,7 @@
 ; SPDX-License-Identifier: MIT
-; LLSF 2013 team agent (thesis: incremental task-level reasoning with roles) -- globals.
-; Files of this directory are loaded in name order (00_ ... 90_). See docs/agent-llsf2013.md.
+; Team agents, common part (used by llsf2013 and auction) -- globals.
+; A directory of agent files is loaded in name order (00_ ... 90_); an agent is this directory
+; followed by its own (clips/agents/llsf2013, clips/agents/auction). See docs/agents.md.
 
 (defglobal
   ; salience bands (as in the Carologistics agents)

@@ -1,6 +1,6 @@
 ; SPDX-License-Identifier: MIT
-; LLSF 2013 team agent -- exploration. The machines lie on a ring (10_facts.clp); each robot
-; starts at its own machine (confval /clips-agent/llsf2013/exploration/start, one per robot
+; Team agents, common part (used by llsf2013 and auction) -- exploration. The machines lie on a ring (10_facts.clp); each robot
+; starts at its own machine (confval /clips-agent/exploration/start, one per robot
 ; number; default M8 M2 M10) and explores the next machine along the ring that nobody has
 ; reported and that is not locked by another robot (a refused lock = pass it). The light code
 ; explore_machine reads is matched against the refbox's ExplorationInfo signals and reported
@@ -18,7 +18,7 @@
   (game (phase EXPLORATION))
   (not (explore-pos))
   =>
-  (bind ?starts (cfg-list "/clips-agent/llsf2013/exploration/start" "M8" "M2" "M10"))
+  (bind ?starts (cfg-list "/clips-agent/exploration/start" "M8" "M2" "M10"))
   (bind ?n (+ (mod (- ?*ROBOT-NUMBER* 1) (length$ ?starts)) 1))
   (assert (explore-pos (machine (sym-cat (nth$ ?n ?starts)))))
   (assert (timer (name explore-report) (time 0 0) (seq 0)))

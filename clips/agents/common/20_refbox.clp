@@ -1,5 +1,5 @@
 ; SPDX-License-Identifier: MIT
-; LLSF 2013 team agent -- what the refbox tells the robots (GameState, ExplorationInfo,
+; Team agents, common part (used by llsf2013 and auction) -- what the refbox tells the robots (GameState, ExplorationInfo,
 ; MachineReportInfo, MachineInfo, OrderInfo). Messages are consumed in the cycle they arrive.
 
 (defrule refbox-game-state

@@ -1,5 +1,5 @@
 ; SPDX-License-Identifier: MIT
-; LLSF 2013 team agent -- the task engine. The decision rules (exploration, production) assert
+; Team agents, common part (used by llsf2013 and auction) -- the task engine. The decision rules (exploration, production) assert
 ; one (task) at a time; this file takes it through
 ;   NEW -> LOCKING (if it needs a resource) -> START -> RUNNING -> DONE | FAILED
 ; by requesting the lock, calling the task's skill and reading the skill's outcome. Whoever

@@ -1,5 +1,5 @@
 ; SPDX-License-Identifier: MIT
-; LLSF 2013 team agent -- sharing the world model with the team. Every second each robot
+; Team agents, common part (used by llsf2013 and auction) -- sharing the world model with the team. Every second each robot
 ; broadcasts its view of the machines (intermediate inputs lying beside them, consumed pucks,
 ; down times) in a Worldmodel message; receivers keep, per machine, the newest entry
 ; (updated_at), so a lost message is repaired by the next one.
