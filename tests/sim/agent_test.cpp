@@ -22,7 +22,8 @@ struct AgentGame {
       : game(make_config(robots, seed)) {
     for (int i = 0; i < robots; ++i) {
       AgentBrainConfig c;
-      c.agent_files = {LLSF_SOURCE_DIR "/clips/agents/common", LLSF_SOURCE_DIR "/clips/agents/llsf2013"};
+      c.agent_files = {LLSF_SOURCE_DIR "/clips/agents/common",
+                       LLSF_SOURCE_DIR "/clips/agents/llsf2013"};
       c.config = config;
       brains.push_back(
           std::make_unique<AgentBrain>(game, i, c, [this, print](const clips::LogRecord& r) {
@@ -114,4 +115,38 @@ TEST_CASE("the thesis' configurations are configuration: P3-P3, P1P2-P3-R, P1-P2
       REQUIRE(roles.size() == 1);
     }
   }
+}
+
+TEST_CASE("protobuf round trip: CLIPS on one robot -> radio -> CLIPS on another") {
+  Game game(test::small_game(2, 3));
+  AgentBrain a(game, 0, {});
+  AgentBrain b(game, 1, {});
+  a.agent().load_string(
+      "(defrule send (time $?) (not (sent)) =>\n"
+      "  (bind ?m (pb-create \"llsf_agent_msgs.WorldmodelChange\"))\n"
+      "  (pb-set-field ?m \"id\" 7) (pb-set-field ?m \"agent\" \"robot1\")\n"
+      "  (pb-set-field ?m \"change\" ADD_LOADED_WITH) (pb-set-field ?m \"machine\" \"M3\")\n"
+      "  (pb-set-field ?m \"puck\" S1)\n"
+      "  (pb-broadcast ?m) (pb-destroy ?m) (assert (sent)))\n",
+      "sender.clp");
+  b.agent().load_string(
+      "(defrule got ?f <- (protobuf-msg (type \"llsf_agent_msgs.WorldmodelChange\") (ptr ?p)\n"
+      "                               (rcvd-from ?from ?id)) =>\n"
+      "  (retract ?f)\n"
+      "  (assert (got ?from ?id (pb-field-value ?p \"machine\") (pb-field-value ?p \"puck\")\n"
+      "               (pb-field-value ?p \"change\"))))\n",
+      "receiver.clp");
+  game.run_until(SimTime::from_sec(1));
+  CHECK(b.agent().find_facts("got", {}).size() == 1);
+  const auto got = b.agent().facts("got");
+  REQUIRE(got.size() == 1);
+  const auto& f = got[0].fields();
+  REQUIRE(f.size() == 5);
+  CHECK(f[0] == clips::Value::string("robot1"));
+  CHECK(f[1] == clips::Value::integer_value(1));
+  CHECK(f[2] == clips::Value::string("M3"));
+  CHECK(f[3] == clips::Value::symbol("S1"));
+  CHECK(f[4] == clips::Value::symbol("ADD_LOADED_WITH"));
+  CHECK(a.agent().runtime_errors() == 0);
+  CHECK(b.agent().runtime_errors() == 0);
 }
