@@ -63,7 +63,8 @@ GameResult play(std::uint64_t seed, double loss) {
   std::vector<std::unique_ptr<TimedBrain>> timed;
   for (int i = 0; i < game.robot_count(); ++i) {
     sim::AgentBrainConfig c;
-    c.agent_files = {LLSF_SOURCE_DIR "/clips/agents/common", LLSF_SOURCE_DIR "/clips/agents/llsf2013"};
+    c.agent_files = {LLSF_SOURCE_DIR "/clips/agents/common",
+                     LLSF_SOURCE_DIR "/clips/agents/llsf2013"};
     brains.push_back(std::make_unique<sim::AgentBrain>(game, i, c));
     timed.push_back(std::make_unique<TimedBrain>(*brains.back()));
     game.set_brain(i, timed.back().get());

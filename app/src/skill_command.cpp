@@ -112,8 +112,8 @@ int run_skill(const SkillOptions& o, std::ostream& out, std::ostream& err) {
   brain.engine().set_log_sink([&](lua::LogLevel level, std::string_view text) {
     if (o.quiet && level < lua::LogLevel::kWarn) return;
     static const char* const names[] = {"debug", "info", "warn", "error"};
-    out << stamp(game.time()) << " " << robot_name << " " << names[static_cast<int>(level)]
-        << ": " << text << "\n";
+    out << stamp(game.time()) << " " << robot_name << " " << names[static_cast<int>(level)] << ": "
+        << text << "\n";
   });
   brain.set_listener([&](const sim::SkillStatusChange& c) {
     out << stamp(c.time) << " " << c.robot << " " << status_name(c.status) << "  "
@@ -158,7 +158,8 @@ int run_skill(const SkillOptions& o, std::ostream& out, std::ostream& err) {
         const std::string st = brain.engine().skill_state(n);
         std::string& last = states[n];
         if (st == last) continue;
-        if (!st.empty()) out << stamp(game.time()) << " " << robot_name << "   " << n << ": " << st << "\n";
+        if (!st.empty())
+          out << stamp(game.time()) << " " << robot_name << "   " << n << ": " << st << "\n";
         last = st;
       }
     }
@@ -186,8 +187,8 @@ int run_skill(const SkillOptions& o, std::ostream& out, std::ostream& err) {
     } else {
       out << "empty";
     }
-    out << ", collisions " << (sum.collisions_robot_device + sum.collisions_robot_wall +
-                               sum.collisions_robot_robot)
+    out << ", collisions "
+        << (sum.collisions_robot_device + sum.collisions_robot_wall + sum.collisions_robot_robot)
         << "\n";
   }
   return code;

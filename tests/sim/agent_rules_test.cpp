@@ -139,7 +139,6 @@ TEST_CASE("production: products are delivered; a down machine is avoided for 30 
   r.f.steps(340);  // after the 30 s (and the 3 s wait then running) the T5 is tried again
   CHECK(r.last_call() == "finish_puck_at{place=\"M6\"}");
   CHECK(r.f.skills().calls().size() == 4);
-
 }
 
 TEST_CASE("exploration: the read code is matched to a type and reported to the refbox") {

@@ -9,9 +9,9 @@
 namespace llsf::app {
 
 /// Exit codes of every llsfsim command.
-inline constexpr int kExitOk = 0;         ///< everything held
-inline constexpr int kExitFailed = 1;     ///< a skill failed / a test case failed
-inline constexpr int kExitBadInput = 2;   ///< bad command line, config or skill file
+inline constexpr int kExitOk = 0;        ///< everything held
+inline constexpr int kExitFailed = 1;    ///< a skill failed / a test case failed
+inline constexpr int kExitBadInput = 2;  ///< bad command line, config or skill file
 
 /// Runs `llsfsim` with `args` (args[0] = program name), writing to `out` and `err`; returns the
 /// exit code. Never throws.
