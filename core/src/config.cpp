@@ -210,6 +210,34 @@ std::string ConfigNode::location() const {
   return impl_->source + ":" + std::to_string(m.line + 1) + ":" + std::to_string(m.column + 1);
 }
 
+ConfigNode& ConfigNode::set(std::string_view dotted_path, const ConfigNode& value) {
+  require_map();
+  if (!value.defined()) value.fail("nothing to set '" + std::string(dotted_path) + "' to");
+  std::vector<std::string> keys;
+  std::size_t pos = 0;
+  while (pos <= dotted_path.size()) {
+    const std::size_t dot = dotted_path.find('.', pos);
+    const std::string_view k =
+        dotted_path.substr(pos, dot == std::string_view::npos ? std::string_view::npos : dot - pos);
+    if (k.empty()) fail("bad key path '" + std::string(dotted_path) + "'");
+    keys.emplace_back(k);
+    if (dot == std::string_view::npos) break;
+    pos = dot + 1;
+  }
+  YAML::Node cur = impl_->node;  // shares the document
+  if (!cur.IsMap()) cur = YAML::Node(YAML::NodeType::Map);
+  for (std::size_t i = 0; i + 1 < keys.size(); ++i) {
+    YAML::Node next = cur[keys[i]];
+    if (!next.IsDefined() || !next.IsMap()) {
+      cur[keys[i]] = YAML::Node(YAML::NodeType::Map);
+      next = cur[keys[i]];
+    }
+    cur.reset(next);
+  }
+  cur[keys.back()] = value.impl_->node;
+  return *this;
+}
+
 void ConfigNode::fail(const std::string& message) const {
   const std::string p = impl_->path.empty() ? std::string("(top level)") : impl_->path;
   throw ConfigError(location() + ": " + p + ": " + message);

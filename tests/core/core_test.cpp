@@ -198,3 +198,32 @@ TEST_CASE("config nodes report file, line and path") {
                        doctest::Contains("cannot open"), ConfigError);
   CHECK(root["robot"].keys() == std::vector<std::string>{"radius_m", "name", "speed"});
 }
+
+TEST_CASE("ConfigNode::set replaces a value by a node that keeps its own location") {
+  using llsf::core::ConfigError;
+  using llsf::core::ConfigNode;
+  ConfigNode root = ConfigNode::parse(
+      "robots:\n"
+      "  count: 3\n"
+      "  config:\n"
+      "    roles: [P3, P3, P3]\n"
+      "matrix:\n"
+      "  two: {robots.count: 2, robots.config.roles: [P1P2, P3], radio.loss: oops}\n",
+      "s.yaml");
+  const ConfigNode two = root["matrix"]["two"];
+  root.set("robots.count", two["robots.count"]);
+  root.set("robots.config.roles", two["robots.config.roles"]);
+  root.set("radio.loss", two["radio.loss"]);  // creates the map 'radio'
+  CHECK(root["robots"]["count"].as_int() == 2);
+  CHECK(root["robots"]["config"]["roles"].size() == 2);
+  CHECK(root["robots"]["config"]["roles"].at(0).as_string() == "P1P2");
+  // An error in the replaced value points at the matrix line, with the scenario's path.
+  try {
+    static_cast<void>(root["radio"]["loss"].as_double());
+    FAIL("expected an error");
+  } catch (const ConfigError& e) {
+    CHECK(std::string(e.what()).rfind("s.yaml:6:", 0) == 0);
+    CHECK(std::string(e.what()).find("radio.loss") != std::string::npos);
+  }
+  CHECK_THROWS_AS(root.set("a..b", two), ConfigError);
+}

@@ -64,6 +64,13 @@ class ConfigNode {
   void read(std::string_view key, bool& out) const;
   void read(std::string_view key, std::string& out) const;
 
+  /// Replaces the value at `dotted_path` (map keys joined by '.', relative to this map node;
+  /// missing maps on the way are created) by `value` and returns this node. Errors about the
+  /// replaced part then name `value`'s location. This changes the parsed document that every
+  /// ConfigNode of the same parse shares: parse the text again for an unchanged copy (scenario
+  /// matrices do).
+  ConfigNode& set(std::string_view dotted_path, const ConfigNode& value);
+
   /// Dotted path from the document root, e.g. "devices.M1.x" or "robots[2].start".
   const std::string& path() const;
   /// "<source>:<line>:<column>" of this node (of its parent for an undefined key).
