@@ -3,6 +3,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <exception>
 #include <ostream>
 #include <vector>
@@ -19,6 +20,15 @@ int run(std::span<const std::string> args, std::ostream& out, std::ostream& err)
   app.require_subcommand(1);
   app.set_version_flag("--version", "llsfsim 0.1.0");
   std::vector<std::pair<CLI::App*, Action>> commands;
+  {
+    CLI::App* sub = app.add_subcommand("run", "Play one game of a scenario; print a summary");
+    commands.emplace_back(sub, add_run_command(*sub));
+  }
+  {
+    CLI::App* sub = app.add_subcommand(
+        "check", "Validate scenarios and their agent and skill files without playing");
+    commands.emplace_back(sub, add_check_command(*sub));
+  }
   {
     CLI::App* sub = app.add_subcommand(
         "skill", "Run skill strings on one robot in a fresh game; print status changes");

@@ -14,5 +14,9 @@ using Action = std::function<int(std::ostream& out, std::ostream& err)>;
 
 /// `llsfsim skill`: one skill string (or several, in turn) on one robot in a fresh game.
 Action add_skill_command(CLI::App& app);
+/// `llsfsim run`: one game of a scenario with a summary and the test-case verdicts.
+Action add_run_command(CLI::App& app);
+/// `llsfsim check`: validate scenarios and their agent/skill files without playing.
+Action add_check_command(CLI::App& app);
 
 }  // namespace llsf::app

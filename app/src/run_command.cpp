@@ -1,0 +1,183 @@
+// SPDX-License-Identifier: MIT
+// `llsfsim run` (one game of a scenario, summary, test verdicts) and `llsfsim check` (validate a
+// scenario with its agent and skill files without playing).
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <memory>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "commands.h"
+#include "llsf/app/cli.h"
+#include "llsf/clips/agent.h"
+#include "llsf/core/error.h"
+#include "llsf/sim/agent_brain.h"
+#include "llsf/sim/runner.h"
+#include "llsf/sim/scenario.h"
+
+namespace llsf::app {
+
+namespace {
+
+struct RunOptions {
+  std::string scenario;
+  std::optional<std::uint64_t> seed;
+  std::string variant;
+  bool json = false;
+  bool quiet = false;
+};
+
+const sim::Scenario* pick_variant(const sim::ScenarioFile& f, const std::string& name,
+                                  std::ostream& err) {
+  if (name.empty()) return &f.variants.front();
+  for (const sim::Scenario& s : f.variants) {
+    if (s.variant == name) return &s;
+  }
+  // A variant may also be named by its values only ("P3-P3" for "config=P3-P3").
+  for (const sim::Scenario& s : f.variants) {
+    const auto eq = s.variant.find('=');
+    if (eq != std::string::npos && s.variant.find(',') == std::string::npos &&
+        s.variant.substr(eq + 1) == name) {
+      return &s;
+    }
+  }
+  err << "llsfsim run: " << f.file << " has no variant '" << name << "'; its variants:\n";
+  for (const sim::Scenario& s : f.variants) err << "  " << s.variant << "\n";
+  return nullptr;
+}
+
+void print_summary(const sim::RunResult& r, std::ostream& out) {
+  out << fmt::format("scenario   {}{}  seed {}\n", r.scenario,
+                     r.variant.empty() ? "" : " [" + r.variant + "]", r.seed);
+  out << fmt::format("points     {:4}   exploration {:4}   production {:4}\n", r.points,
+                     r.exploration_points, r.production_points);
+  out << fmt::format("explored   {:4} machines reported, {} correct\n", r.exploration_reports,
+                     r.exploration_correct);
+  out << fmt::format("products   P1 {}  P2 {}  P3 {}   recycled {}   deliveries {}\n",
+                     r.products_p1, r.products_p2, r.products_p3, r.recycled, r.deliveries);
+  if (!r.orders.empty()) {
+    out << "orders     ";
+    for (std::size_t i = 0; i < r.orders.size(); ++i) {
+      const sim::OrderResult& o = r.orders[i];
+      out << fmt::format("{}#{} {} {}/{} [{}-{} s]", i ? "\n           " : "", o.id, o.product,
+                         o.delivered, o.requested, o.window_begin_s, o.window_end_s);
+    }
+    out << "\n";
+  }
+  out << fmt::format("robots     {} collisions, {} skill failures, {} agent runtime errors\n",
+                     r.collisions, r.skill_failures, r.agent_runtime_errors);
+  out << fmt::format("radio      {} copies sent, {} dropped\n", r.messages_sent,
+                     r.messages_dropped);
+  out << fmt::format("speed      {:.0f} s of game in {:.2f} s CPU: {:.0f}x real time\n",
+                     r.game_time_s, r.cpu_s, r.real_time_factor);
+  out << fmt::format("result     {:016x}\n", r.result_hash);
+  for (const sim::TestVerdict& t : r.tests) {
+    out << fmt::format("test       {}  {}: {}\n", t.passed ? "PASS" : "FAIL", t.name, t.detail);
+  }
+}
+
+int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
+  sim::ScenarioFile file;
+  try {
+    file = sim::load_scenario(o.scenario);
+  } catch (const core::ConfigError& e) {
+    err << "llsfsim run: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  const sim::Scenario* s = pick_variant(file, o.variant, err);
+  if (s == nullptr) return kExitBadInput;
+  const std::uint64_t seed = o.seed.value_or(s->seeds.front());
+  sim::RunHooks hooks;
+  const bool tty = isatty(STDERR_FILENO) != 0 && !o.quiet && !o.json;
+  if (tty) {
+    hooks.progress_every = core::SimTime::from_sec(10);
+    hooks.progress = [&](const sim::Game& g) {
+      std::fprintf(stderr, "\r[%5.0f/%.0f s] %s, %d points", g.time().seconds(),
+                   s->duration.seconds(), refbox::to_string(g.refbox().phase()).data(),
+                   g.refbox().points());
+      std::fflush(stderr);
+    };
+  }
+  sim::RunResult r;
+  try {
+    r = sim::run_game(*s, seed, hooks);
+  } catch (const clips::AgentLoadError& e) {
+    err << "llsfsim run: agent error:\n" << e.what() << "\n";
+    return kExitBadInput;
+  } catch (const core::ConfigError& e) {
+    err << "llsfsim run: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  if (tty) std::fprintf(stderr, "\r%60s\r", "");
+  if (o.json) {
+    out << sim::to_json(r) << "\n";
+  } else if (!o.quiet) {
+    print_summary(r, out);
+  }
+  return r.passed() ? kExitOk : kExitFailed;
+}
+
+int check(const std::vector<std::string>& files, std::ostream& out, std::ostream& err) {
+  int bad = 0;
+  for (const std::string& path : files) {
+    try {
+      const sim::ScenarioFile f = sim::load_scenario(path);
+      std::size_t seeds = 0;
+      for (const sim::Scenario& s : f.variants) {
+        seeds += s.seeds.size();
+        // Build the game and every brain: agent files are parsed, skill files loaded.
+        sim::Game game(s.game);
+        std::vector<std::unique_ptr<sim::AgentBrain>> brains;
+        for (int i = 0; i < game.robot_count(); ++i) {
+          const sim::RobotSpec& spec = s.robots.at(static_cast<std::size_t>(i));
+          if (spec.agent.empty()) continue;
+          sim::AgentBrainConfig c;
+          c.agent_files = spec.agent;
+          c.config = spec.config;
+          c.skills = s.skills;
+          brains.push_back(std::make_unique<sim::AgentBrain>(game, i, c));
+          for (const std::string& e : brains.back()->skills().engine().load_errors()) {
+            throw core::ConfigError("skill file error: " + e);
+          }
+        }
+      }
+      out << fmt::format("ok   {}: {} variant(s), {} game(s)\n", path, f.variants.size(), seeds);
+    } catch (const std::exception& e) {
+      err << "FAIL " << path << ": " << e.what() << "\n";
+      ++bad;
+    }
+  }
+  return bad == 0 ? kExitOk : kExitBadInput;
+}
+
+}  // namespace
+
+Action add_run_command(CLI::App& app) {
+  auto o = std::make_shared<RunOptions>();
+  app.add_option("scenario", o->scenario, "Scenario file (docs/scenarios.md)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  app.add_option("--seed", o->seed, "Seed to play (default: the scenario's first)");
+  app.add_option("--variant", o->variant,
+                 "Matrix variant, e.g. 'config=P3-P3' or just 'P3-P3' (default: the first)");
+  app.add_flag("--json", o->json, "Print the summary as one JSON object");
+  app.add_flag("-q,--quiet", o->quiet, "No summary, only the exit code");
+  app.footer(
+      "Plays one game headless and prints a summary and the test-case verdicts.\n"
+      "Exit code: 0 all test cases passed, 1 one failed, 2 bad scenario or agent.");
+  return [o](std::ostream& out, std::ostream& err) { return run(*o, out, err); };
+}
+
+Action add_check_command(CLI::App& app) {
+  auto files = std::make_shared<std::vector<std::string>>();
+  app.add_option("scenarios", *files, "Scenario files")->required();
+  app.footer(
+      "Validates scenarios: every key and value, every matrix variant, the agent files (CLIPS "
+      "syntax) and the skill files, without playing. Exit code 0 or 2.");
+  return [files](std::ostream& out, std::ostream& err) { return check(*files, out, err); };
+}
+
+}  // namespace llsf::app

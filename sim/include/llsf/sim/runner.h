@@ -1,0 +1,77 @@
+// SPDX-License-Identifier: MIT
+// Runner: plays one game of a scenario (one variant, one seed) and sums it up -- points by phase,
+// deliveries, products, recycling, exploration, collisions, skill failures, radio drops, agent
+// errors, the real-time factor, test-case verdicts and a result hash (same scenario + seed =
+// same hash).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "llsf/sim/game.h"
+#include "llsf/sim/scenario.h"
+
+namespace llsf::sim {
+
+/// The verdict of one test case.
+struct TestVerdict {
+  std::string name;
+  bool passed = false;
+  std::string detail;  ///< "42 points (need >= 30 by 720 s)"
+};
+
+/// One order as it ended.
+struct OrderResult {
+  int id = 0;
+  std::string product;  ///< "P1", "P2", "P3"
+  int requested = 0;
+  int delivered = 0;
+  int window_begin_s = 0;
+  int window_end_s = 0;
+};
+
+/// Everything a run reports.
+struct RunResult {
+  std::string scenario;
+  std::string variant;
+  std::uint64_t seed = 0;
+  double game_time_s = 0.0;
+  int points = 0;  ///< the refbox's total
+  int exploration_points = 0;
+  int production_points = 0;
+  int exploration_reports = 0;  ///< machines reported
+  int exploration_correct = 0;
+  int deliveries = 0;  ///< products the gates took
+  std::vector<OrderResult> orders;
+  int products_p1 = 0, products_p2 = 0, products_p3 = 0;  ///< made (machine completions)
+  int recycled = 0;
+  int collisions = 0;
+  int skill_failures = 0;
+  int agent_runtime_errors = 0;
+  std::int64_t messages_sent = 0;
+  std::int64_t messages_dropped = 0;
+  double cpu_s = 0.0;
+  double real_time_factor = 0.0;
+  std::uint64_t result_hash = 0;
+  std::vector<TestVerdict> tests;
+  bool passed() const;
+};
+
+/// Called every `progress_every` of game time with the game (for a progress line).
+struct RunHooks {
+  std::function<void(const Game&)> progress;
+  SimTime progress_every = SimTime::from_sec(30);
+  /// Called at every tick after step 9 (recorders, live viewers).
+  std::function<void(const Game&)> tick;
+};
+
+/// Plays `scenario` with `seed`. Throws clips::AgentLoadError / core::ConfigError before the
+/// first tick for bad agent or skill files.
+RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks& hooks = {});
+
+/// The summary as one JSON object (fixed key order).
+std::string to_json(const RunResult& r);
+
+}  // namespace llsf::sim

@@ -1,0 +1,79 @@
+// SPDX-License-Identifier: MIT
+// Scenario: a YAML file that says which game to play -- seeds, refbox rules and phases, robots
+// with their agents and skill level, radio, abstraction levels, rates, end, test cases -- and a
+// matrix of variants a batch expands. docs/scenarios.md documents every key.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "llsf/clips/config_values.h"
+#include "llsf/core/config.h"
+#include "llsf/core/sim_time.h"
+#include "llsf/lua/skill_engine.h"
+#include "llsf/sim/game_config.h"
+
+namespace llsf::sim {
+
+/// One robot's brain: its agent files and configuration (empty agent: no brain, it stands).
+struct RobotSpec {
+  std::vector<std::string> agent;  ///< files or directories, resolved against the scenario's dir
+  clips::ConfigEntries config;     ///< confval facts (under /clips-agent)
+};
+
+/// A pass/fail condition on a finished game.
+struct TestCase {
+  enum class Kind : std::uint8_t {
+    kPointsAtLeast,             ///< total points >= value (at `by_s` if set)
+    kExplorationPointsAtLeast,  ///< exploration points >= value
+    kProductionPointsAtLeast,   ///< production points >= value
+    kDeliveriesAtLeast,         ///< products delivered >= value (at `by_s` if set)
+    kCollisionsAtMost,          ///< robot-robot + robot-wall + robot-device contacts <= value
+    kNoAgentErrors,             ///< no CLIPS runtime error in any agent
+  };
+  std::string name;
+  Kind kind = Kind::kPointsAtLeast;
+  double value = 0.0;
+  std::optional<double> by_s;  ///< game time (s since the start) at which it must hold
+};
+
+/// How the game starts: the controller's first commands at time 0.
+enum class StartMode : std::uint8_t {
+  kGame,         ///< SetGameState RUNNING in PRE_GAME: the refbox runs its phases
+  kExploration,  ///< SetGamePhase EXPLORATION + RUNNING
+  kProduction,   ///< SetGamePhase PRODUCTION + RUNNING
+};
+
+/// A fully resolved scenario variant (one matrix cell).
+struct Scenario {
+  std::string name;
+  std::string description;
+  std::string file;     ///< the YAML file
+  std::string variant;  ///< "" without a matrix, else "axis=value,axis=value"
+  std::vector<std::uint64_t> seeds{1};
+  GameConfig game;  ///< world, refbox, radio, navigation, levels, rates (seed: the first)
+  StartMode start = StartMode::kGame;
+  SimTime duration;  ///< game time to play
+  std::vector<RobotSpec> robots;
+  lua::SkillEngineConfig skills;  ///< skill_dirs empty: the library of the skill level
+  std::vector<TestCase> tests;
+};
+
+/// A scenario file: every variant of its matrix (one if it has none), in matrix order.
+struct ScenarioFile {
+  std::string file;
+  std::vector<std::string> axes;  ///< matrix axis names, in file order
+  std::vector<Scenario> variants;
+};
+
+/// Loads and validates a scenario file and expands its matrix. Throws core::ConfigError naming
+/// file:line:column and the key for unknown keys, wrong types, impossible values, missing agent
+/// files or directories.
+ScenarioFile load_scenario(const std::string& path);
+
+/// "points_at_least 30 by 720 s", for reports.
+std::string describe(const TestCase& t);
+
+}  // namespace llsf::sim

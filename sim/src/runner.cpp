@@ -1,0 +1,239 @@
+// SPDX-License-Identifier: MIT
+#include "llsf/sim/runner.h"
+
+#include <llsf_msgs/GameState.pb.h>
+
+#include <ctime>
+#include <memory>
+#include <sstream>
+
+#include "llsf/core/rng.h"
+#include "llsf/refbox/protocol.h"
+#include "llsf/sim/agent_brain.h"
+
+namespace llsf::sim {
+
+namespace {
+
+double cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);  // a measurement only, never a game input
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+void start_game(Game& g, StartMode start) {
+  if (start != StartMode::kGame) {
+    llsf_msgs::SetGamePhase p;
+    p.set_phase(start == StartMode::kExploration ? llsf_msgs::GameState::EXPLORATION
+                                                 : llsf_msgs::GameState::PRODUCTION);
+    g.controller_command(p);
+  }
+  llsf_msgs::SetGameState s;
+  s.set_state(llsf_msgs::GameState::RUNNING);
+  g.controller_command(s);
+}
+
+int deliveries_of(const refbox::Refbox& rb) {
+  int n = 0;
+  for (const auto& o : rb.orders()) n += o.quantity_delivered;
+  return n;
+}
+
+}  // namespace
+
+bool RunResult::passed() const {
+  for (const TestVerdict& t : tests) {
+    if (!t.passed) return false;
+  }
+  return true;
+}
+
+RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks& hooks) {
+  GameConfig config = scenario.game;
+  config.seed = seed;
+  Game game(config);
+  std::vector<std::unique_ptr<AgentBrain>> brains;
+  int skill_failures = 0;
+  for (int i = 0; i < game.robot_count(); ++i) {
+    const RobotSpec& spec = scenario.robots.at(static_cast<std::size_t>(i));
+    if (spec.agent.empty()) continue;
+    AgentBrainConfig c;
+    c.agent_files = spec.agent;
+    c.config = spec.config;
+    c.skills = scenario.skills;
+    brains.push_back(std::make_unique<AgentBrain>(game, i, c));
+    brains.back()->skills().set_listener([&skill_failures](const SkillStatusChange& ch) {
+      if (ch.status == lua::SkillStatus::kFailed) ++skill_failures;
+    });
+  }
+  // Test cases with a deadline are judged when the game passes it.
+  std::vector<TestVerdict> verdicts(scenario.tests.size());
+  std::vector<bool> judged(scenario.tests.size(), false);
+  auto judge = [&](std::size_t i, int points, int deliveries) {
+    const TestCase& t = scenario.tests[i];
+    TestVerdict& v = verdicts[i];
+    v.name = t.name;
+    const GameSummary s = game.summary();
+    std::ostringstream d;
+    double value = 0.0;
+    switch (t.kind) {
+      case TestCase::Kind::kPointsAtLeast:
+        value = points;
+        d << points << " points";
+        break;
+      case TestCase::Kind::kExplorationPointsAtLeast:
+        value = s.exploration_points;
+        d << value << " exploration points";
+        break;
+      case TestCase::Kind::kProductionPointsAtLeast:
+        value = s.production_points;
+        d << value << " production points";
+        break;
+      case TestCase::Kind::kDeliveriesAtLeast:
+        value = deliveries;
+        d << deliveries << " deliveries";
+        break;
+      case TestCase::Kind::kCollisionsAtMost:
+        value = s.collisions_robot_robot + s.collisions_robot_wall + s.collisions_robot_device;
+        d << value << " collisions";
+        break;
+      case TestCase::Kind::kNoAgentErrors: {
+        int errors = 0;
+        for (const auto& b : brains) errors += b->agent().runtime_errors();
+        value = errors;
+        d << errors << " agent runtime errors";
+        break;
+      }
+    }
+    v.passed = t.kind == TestCase::Kind::kCollisionsAtMost ? value <= t.value
+               : t.kind == TestCase::Kind::kNoAgentErrors  ? value == 0.0
+                                                           : value >= t.value;
+    d << " (need " << describe(t) << ")";
+    v.detail = d.str();
+    judged[i] = true;
+  };
+
+  start_game(game, scenario.start);
+  const SimTime end = scenario.duration;
+  SimTime next_progress = hooks.progress_every;
+  const double t0 = cpu_seconds();
+  while (game.time() < end) {
+    game.step();
+    if (hooks.tick) hooks.tick(game);
+    for (std::size_t i = 0; i < scenario.tests.size(); ++i) {
+      const auto& by = scenario.tests[i].by_s;
+      if (!judged[i] && by && game.time() >= SimTime::from_seconds(*by)) {
+        judge(i, game.refbox().points(), deliveries_of(game.refbox()));
+      }
+    }
+    if (hooks.progress && game.time() >= next_progress) {
+      hooks.progress(game);
+      next_progress += hooks.progress_every;
+    }
+  }
+  const double cpu = cpu_seconds() - t0;
+
+  RunResult r;
+  r.scenario = scenario.name;
+  r.variant = scenario.variant;
+  r.seed = seed;
+  r.game_time_s = game.time().seconds();
+  const GameSummary s = game.summary();
+  r.points = s.points;
+  r.exploration_points = s.exploration_points;
+  r.production_points = s.production_points;
+  const refbox::Refbox& rb = game.refbox();
+  for (const refbox::PointsAward& a : rb.awards()) {
+    switch (a.reason) {
+      case refbox::AwardReason::kExplorationCorrect:
+        ++r.exploration_reports;
+        ++r.exploration_correct;
+        break;
+      case refbox::AwardReason::kExplorationWrong:
+        ++r.exploration_reports;
+        break;
+      case refbox::AwardReason::kRecycled:
+        ++r.recycled;
+        break;
+      case refbox::AwardReason::kMachineCompleted: {
+        const auto type = rb.machine(a.device).type;
+        if (type == refbox::MachineType::kT3) ++r.products_p1;
+        if (type == refbox::MachineType::kT4) ++r.products_p2;
+        if (type == refbox::MachineType::kT5) ++r.products_p3;
+        break;
+      }
+      default:
+        break;
+    }
+  }
+  for (const auto& o : rb.orders()) {
+    if (!o.active) continue;
+    r.orders.push_back({static_cast<int>(o.id.value()), std::string(refbox::to_string(o.product)),
+                        o.quantity_requested, o.quantity_delivered, o.window_begin_s,
+                        o.window_end_s});
+  }
+  r.deliveries = static_cast<int>(rb.report().deliveries.size());
+  r.collisions = s.collisions_robot_robot + s.collisions_robot_wall + s.collisions_robot_device;
+  r.skill_failures = skill_failures;
+  for (const auto& b : brains) r.agent_runtime_errors += b->agent().runtime_errors();
+  r.messages_sent = s.comm.sent;
+  r.messages_dropped = s.comm.dropped_total();
+  r.cpu_s = cpu;
+  r.real_time_factor = cpu > 0.0 ? r.game_time_s / cpu : 0.0;
+  std::uint64_t h = core::kFnvOffset;
+  auto mix = [&h](const auto& v) { h = core::fnv1a(&v, sizeof(v), h); };
+  mix(s.world_hash);
+  mix(s.refbox_hash);
+  mix(s.comm.sent);
+  r.result_hash = h;
+  for (std::size_t i = 0; i < scenario.tests.size(); ++i) {
+    if (!judged[i]) judge(i, s.points, deliveries_of(rb));
+  }
+  r.tests = std::move(verdicts);
+  for (int i = 0; i < game.robot_count(); ++i) game.set_brain(i, nullptr);
+  return r;
+}
+
+std::string to_json(const RunResult& r) {
+  std::ostringstream o;
+  auto str = [](const std::string& s) {
+    std::string out = "\"";
+    for (const char c : s) {
+      if (c == '"' || c == '\\') out += '\\';
+      out += c;
+    }
+    return out + "\"";
+  };
+  o << "{\"scenario\": " << str(r.scenario) << ", \"variant\": " << str(r.variant)
+    << ", \"seed\": " << r.seed << ", \"game_time_s\": " << r.game_time_s
+    << ", \"points\": " << r.points << ", \"exploration_points\": " << r.exploration_points
+    << ", \"production_points\": " << r.production_points
+    << ", \"exploration_reports\": " << r.exploration_reports
+    << ", \"exploration_correct\": " << r.exploration_correct
+    << ", \"deliveries\": " << r.deliveries << ", \"orders\": [";
+  for (std::size_t i = 0; i < r.orders.size(); ++i) {
+    const OrderResult& x = r.orders[i];
+    o << (i ? ", " : "") << "{\"id\": " << x.id << ", \"product\": " << str(x.product)
+      << ", \"requested\": " << x.requested << ", \"delivered\": " << x.delivered
+      << ", \"window\": [" << x.window_begin_s << ", " << x.window_end_s << "]}";
+  }
+  o << "], \"products\": {\"P1\": " << r.products_p1 << ", \"P2\": " << r.products_p2
+    << ", \"P3\": " << r.products_p3 << "}, \"recycled\": " << r.recycled
+    << ", \"collisions\": " << r.collisions << ", \"skill_failures\": " << r.skill_failures
+    << ", \"agent_runtime_errors\": " << r.agent_runtime_errors
+    << ", \"messages_sent\": " << r.messages_sent
+    << ", \"messages_dropped\": " << r.messages_dropped << ", \"cpu_s\": " << r.cpu_s
+    << ", \"real_time_factor\": " << r.real_time_factor << ", \"result_hash\": \"" << std::hex
+    << r.result_hash << std::dec << "\", \"passed\": " << (r.passed() ? "true" : "false")
+    << ", \"tests\": [";
+  for (std::size_t i = 0; i < r.tests.size(); ++i) {
+    const TestVerdict& t = r.tests[i];
+    o << (i ? ", " : "") << "{\"name\": " << str(t.name)
+      << ", \"passed\": " << (t.passed ? "true" : "false") << ", \"detail\": " << str(t.detail)
+      << "}";
+  }
+  o << "]}";
+  return o.str();
+}
+
+}  // namespace llsf::sim

@@ -1,0 +1,120 @@
+// SPDX-License-Identifier: MIT
+// Scenario files: keys, matrix expansion, errors with file:line; running one game of a scenario
+// with test-case verdicts and a result hash.
+#include <doctest/doctest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "llsf/core/error.h"
+#include "llsf/sim/runner.h"
+#include "llsf/sim/scenario.h"
+
+using namespace llsf;
+using namespace llsf::sim;
+
+namespace {
+
+/// Writes `text` to a scenario file in a temp directory next to links to the agents.
+std::string scenario_file(const std::string& name, const std::string& text) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("llsf_scenario_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path p = dir / name;
+  std::ofstream(p) << text;
+  return p.string();
+}
+
+std::string error_of(const std::string& path) {
+  try {
+    load_scenario(path);
+  } catch (const core::ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+const std::string kAgent = "  agent: [" LLSF_SOURCE_DIR "/clips/agents/common, " LLSF_SOURCE_DIR
+                           "/clips/agents/llsf2013]\n";
+
+}  // namespace
+
+TEST_CASE("the shipped scenarios load; matrices expand in file order") {
+  const ScenarioFile d = load_scenario(LLSF_SOURCE_DIR "/scenarios/default.yaml");
+  REQUIRE(d.variants.size() == 1);
+  CHECK(d.variants[0].robots.size() == 3);
+  CHECK(d.variants[0].duration == SimTime::from_sec(1080));
+  CHECK(d.variants[0].tests.size() == 4);
+  const ScenarioFile two = load_scenario(LLSF_SOURCE_DIR "/scenarios/thesis-two-robots.yaml");
+  REQUIRE(two.variants.size() == 5);
+  CHECK(two.variants[0].variant == "config=P3-P3");
+  CHECK(two.variants[4].variant == "config=P1P2-P3-RD");
+  CHECK(two.variants[0].seeds.size() == 20);
+  // The override reached the robots' confval entries.
+  bool p3p3 = false;
+  for (const auto& e : two.variants[0].robots[0].config) {
+    if (e.path == "/clips-agent/roles") p3p3 = e.values.at(0) == clips::Value::string("P3");
+  }
+  CHECK(p3p3);
+  const ScenarioFile loss = load_scenario(LLSF_SOURCE_DIR "/scenarios/packet-loss.yaml");
+  REQUIRE(loss.variants.size() == 5);
+  CHECK(loss.variants[2].game.hub.loss_probability == doctest::Approx(0.2));
+}
+
+TEST_CASE("scenario errors name file, line and key") {
+  std::string e = error_of(scenario_file("a.yaml", "name: a\nrobotz: {}\n"));
+  CHECK(e.find("a.yaml:") != std::string::npos);
+  CHECK(e.find("robotz") != std::string::npos);
+  e = error_of(scenario_file("b.yaml", "name: b\nrobots:\n  count: 7\n"));
+  CHECK(e.find("b.yaml:3:") != std::string::npos);
+  CHECK(e.find("robots.count") != std::string::npos);
+  e = error_of(scenario_file("c.yaml", "name: c\nrobots:\n  agent: [no/such/dir]\n"));
+  CHECK(e.find("c.yaml:3:") != std::string::npos);
+  CHECK(e.find("not found") != std::string::npos);
+  e = error_of(scenario_file("d.yaml", "name: d\nlevels: {light: laser}\n"));
+  CHECK(e.find("'laser' is not one of ground_truth, vision") != std::string::npos);
+  e = error_of(scenario_file("e.yaml",
+                             "name: e\nmatrix:\n  loss:\n    bad: {radio.loss: {model: lossy}}\n"));
+  CHECK(e.find("e.yaml:4:") != std::string::npos);  // the override's line
+  e = error_of(scenario_file(
+      "f.yaml", "name: f\ntests:\n  - {points_at_least: 3, deliveries_at_least: 1}\n"));
+  CHECK(e.find("exactly one condition") != std::string::npos);
+  e = error_of(scenario_file("g.yaml", "name: g\nseed: 1\nseeds: [2]\n"));
+  CHECK(e.find("either 'seed' or 'seeds'") != std::string::npos);
+  CHECK(error_of(scenario_file("h.yaml", "name: [\n")).find("YAML syntax error") !=
+        std::string::npos);
+  CHECK(error_of("/no/such/file.yaml").find("cannot read") != std::string::npos);
+}
+
+TEST_CASE("run_game: a short production game, verdicts judged at their deadline, same hash") {
+  const std::string path =
+      scenario_file("run.yaml",
+                    "name: short\nseed: 7\nstart: production\nduration_s: 240\nrobots:\n"
+                    "  count: 2\n" +
+                        kAgent +
+                        "  config: {roles: [P3, P3]}\n"
+                        "tests:\n"
+                        "  - {name: early, points_at_least: 1000, by_s: 60}\n"
+                        "  - {deliveries_at_least: 1}\n"
+                        "  - {no_agent_errors: true}\n");
+  const ScenarioFile f = load_scenario(path);
+  const RunResult a = run_game(f.variants[0], 7);
+  CHECK(a.seed == 7);
+  CHECK(a.game_time_s == doctest::Approx(240.0));
+  REQUIRE(a.tests.size() == 3);
+  CHECK_FALSE(a.tests[0].passed);
+  CHECK(a.tests[0].detail.find("by 60 s") != std::string::npos);
+  CHECK(a.tests[1].passed);
+  CHECK(a.tests[2].passed);
+  CHECK_FALSE(a.passed());
+  CHECK(a.deliveries >= 1);
+  const RunResult b = run_game(f.variants[0], 7);
+  CHECK(a.result_hash == b.result_hash);
+  CHECK(a.points == b.points);
+  const RunResult c = run_game(f.variants[0], 8);
+  CHECK(c.result_hash != a.result_hash);
+  const std::string json = to_json(a);
+  CHECK(json.rfind("{\"scenario\": \"short\"", 0) == 0);
+  CHECK(json.find("\"passed\": false") != std::string::npos);
+}
