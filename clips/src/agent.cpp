@@ -45,6 +45,7 @@ void AgentConfig::validate() const {
   if (robot_number < 0) throw std::invalid_argument("AgentConfig.robot_number must be >= 0");
   if (max_rules_per_cycle <= 0)
     throw std::invalid_argument("AgentConfig.max_rules_per_cycle must be > 0");
+  if (locks) lock_config.validate();
 }
 
 const Value& Fact::slot(std::string_view name) const {
@@ -70,6 +71,8 @@ std::string one_line(std::string_view s) {
   }
   return out;
 }
+
+constexpr std::string_view kLocksClp = "builtin/locks.clp";
 
 LogLevel level_of(std::string_view logical_name) {
   if (logical_name == "debug" || logical_name == "wtrace") return LogLevel::kDebug;
@@ -106,10 +109,15 @@ struct AgentHost::Impl {
     features.push_back(detail::make_time_feature(state));
     features.push_back(detail::make_config_feature(state));
     features.push_back(detail::make_skills_feature(state));
+    features.push_back(detail::make_locks_feature(state));  // before protobuf: takes lock messages
     features.push_back(detail::make_protobuf_feature(state));
     for (auto& f : features) f->define(env);
-    for (int i = 0; i < detail::kBuiltinCodeCount; ++i)
+    for (int i = 0; i < detail::kBuiltinCodeCount; ++i) {
+      // Without locks the lock template stays free for the agent's own (e.g. a Fawkes lock.clp).
+      if (!state.config.locks && std::string_view(detail::kBuiltinCode[i].name) == kLocksClp)
+        continue;
       load(detail::kBuiltinCode[i].text, detail::kBuiltinCode[i].name);
+    }
     for (auto& f : features) f->bind(env);
   }
 

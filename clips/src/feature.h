@@ -74,6 +74,9 @@ std::unique_ptr<Feature> make_time_feature(HostState& state);
 std::unique_ptr<Feature> make_config_feature(HostState& state);
 std::unique_ptr<Feature> make_skills_feature(HostState& state);
 std::unique_ptr<Feature> make_protobuf_feature(HostState& state);
+/// Always registered, inactive unless AgentConfig::locks (the host then skips locks.clp). Runs
+/// before the protobuf feature: it takes the lock messages out of the inbox.
+std::unique_ptr<Feature> make_locks_feature(HostState& state);
 
 /// Formats a value as printout does: symbols and strings bare, numbers as CLIPS prints them.
 std::string print_form(const Value& v);

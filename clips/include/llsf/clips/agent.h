@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "llsf/clips/config_values.h"
+#include "llsf/clips/lock_manager.h"
 #include "llsf/clips/skill_runner.h"
 #include "llsf/clips/value.h"
 #include "llsf/core/geometry.h"
@@ -63,6 +64,10 @@ struct AgentConfig {
   std::uint64_t seed = 1;                     ///< seeds CLIPS' (random)
   std::int64_t max_rules_per_cycle = 10'000;  ///< rule firings per cycle before the run is cut
   ConfigEntries config;                       ///< asserted as confval facts after (reset)
+  /// Runs the resource-lock protocol (docs/locks.md): lock facts, lock messages consumed, the
+  /// master's announcements. Off by default, so that agents without locks stay silent.
+  bool locks = false;
+  LockConfig lock_config;  ///< timing and team size of the lock protocol (if `locks`)
 
   /// Throws std::invalid_argument naming the bad field.
   void validate() const;
