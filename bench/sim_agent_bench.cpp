@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Whole games with the LLSF 2013 team agent: 3 robots, exploration (180 s) + production
 // (900 s), ground-truth levels, physical skills; 20 seeds without and with 20 % per-link radio
-// loss (agent_games), and the CPU cost of one agent cycle in such a game (agent_cycle).
+// loss, without and with the lock protocol (agent_games), and the CPU cost of one agent cycle in
+// such a game (agent_cycle).
 // LLSF_BENCH_VERBOSE=1 prints every game.
 #include <llsf_msgs/GameState.pb.h>
 
@@ -51,7 +52,7 @@ struct GameResult {
   double agent_us_per_cycle = 0.0;
 };
 
-GameResult play(std::uint64_t seed, double loss) {
+GameResult play(std::uint64_t seed, double loss, bool locks) {
   sim::GameConfig config;
   config.seed = seed;
   if (loss > 0.0) {
@@ -65,6 +66,7 @@ GameResult play(std::uint64_t seed, double loss) {
     sim::AgentBrainConfig c;
     c.agent_files = {LLSF_SOURCE_DIR "/clips/agents/common",
                      LLSF_SOURCE_DIR "/clips/agents/llsf2013"};
+    c.locks = locks;
     brains.push_back(std::make_unique<sim::AgentBrain>(game, i, c));
     timed.push_back(std::make_unique<TimedBrain>(*brains.back()));
     game.set_brain(i, timed.back().get());
@@ -95,9 +97,9 @@ GameResult play(std::uint64_t seed, double loss) {
   for (int i = 0; i < game.robot_count(); ++i) game.set_brain(i, nullptr);
   if (std::getenv("LLSF_BENCH_VERBOSE") != nullptr) {
     std::fprintf(stderr,
-                 "seed %2llu loss %.2f: exploration %3d production %4d total %4d deliveries %2d "
+                 "seed %2llu loss %.2f locks %d: exploration %3d production %4d total %4d deliveries %2d "
                  "errors %d cpu %.2f s\n",
-                 static_cast<unsigned long long>(seed), loss, r.exploration, r.production, r.total,
+                 static_cast<unsigned long long>(seed), loss, locks ? 1 : 0, r.exploration, r.production, r.total,
                  r.deliveries, r.runtime_errors, r.wall_cpu);
   }
   return r;
@@ -109,12 +111,12 @@ double median(std::vector<double> v) {
   return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-void report_series(const std::string& name, double loss) {
+void report_series(const std::string& name, double loss, bool locks) {
   std::vector<double> expl, total, rtf;
   int no_delivery = 0;
   int errors = 0;
   for (std::uint64_t seed = 1; seed <= kSeeds; ++seed) {
-    const GameResult r = play(seed, loss);
+    const GameResult r = play(seed, loss, locks);
     expl.push_back(r.exploration);
     total.push_back(r.total);
     rtf.push_back(1080.0 / r.wall_cpu);
@@ -131,13 +133,16 @@ void report_series(const std::string& name, double loss) {
 
 }  // namespace
 
-LLSF_BENCH(agent_games, "LLSF 2013 agent, 3 robots, full games on 20 seeds, 0 % and 20 % loss") {
-  report_series("agent_games", 0.0);
-  report_series("agent_games_loss20", 0.2);
+LLSF_BENCH(agent_games,
+           "LLSF 2013 agent, 3 robots, full games on 20 seeds, 0 % / 20 % loss, without/with locks") {
+  report_series("agent_games", 0.0, false);
+  report_series("agent_games_loss20", 0.2, false);
+  report_series("agent_games_locks", 0.0, true);
+  report_series("agent_games_locks_loss20", 0.2, true);
 }
 
 LLSF_BENCH(agent_cycle, "CPU per agent cycle of the LLSF 2013 agent in a full 3-robot game") {
   std::vector<double> us;
-  for (std::uint64_t seed : {1, 2, 3}) us.push_back(play(seed, 0.0).agent_us_per_cycle);
+  for (std::uint64_t seed : {1, 2, 3}) us.push_back(play(seed, 0.0, false).agent_us_per_cycle);
   bench::report("agent_cycle", "us_per_robot_cycle", median(us), "us");
 }

@@ -23,7 +23,9 @@ the skill's result:
 Fails: "finish_puck_at: no puck in the holder", "finish_puck_at: unknown place 'X'",
 "M3 is down (red)", "M3 rejected the puck (yellow blinking: invalid input)", "M3 did not react
 (the puck is not under its RFID reader?)", "M3: no final light within 90 s", "finish_puck_at:
-lost the puck", drive_to's failure. The puck stays in the holder unless the outcome was WAITING.
+lost the puck", drive_to's failure. The puck stays in the holder unless the outcome was WAITING;
+then (and after a failure at the machine) the robot backs off 5 cm slowly (the holder keeps
+the puck below 0.02 m/s) so that it can turn away from the machine.
 ]==]
 
 local PRE = 0.30          -- the approach stops this far before the input place
@@ -72,11 +74,11 @@ local function watch(self, vars)
    if code == "YG" then vars.processing = true end
    local settled = code ~= nil and light:stable_for() >= (vars.settle or 0.5)
    if code ~= nil and string.find(code, "y") and light:stable_for() >= 0.6 then
-      self.fsm.error = vars.place .. " rejected the puck (yellow blinking: invalid input)"
+      vars.fail = vars.place .. " rejected the puck (yellow blinking: invalid input)"
       return true
    end
    if settled and code == "R" then
-      self.fsm.error = vars.place .. " is down (red)"
+      vars.fail = vars.place .. " is down (red)"
       return true
    end
    if vars.processing and settled and code == "G" then
@@ -88,11 +90,11 @@ local function watch(self, vars)
       return true
    end
    if not vars.processing and now - vars.arrived >= REACT_S then
-      self.fsm.error = vars.place .. " did not react (the puck is not under its RFID reader?)"
+      vars.fail = vars.place .. " did not react (the puck is not under its RFID reader?)"
       return true
    end
    if now - vars.arrived >= LIMIT_S then
-      self.fsm.error = string.format("%s: no final light within %.0f s", vars.place, LIMIT_S)
+      vars.fail = string.format("%s: no final light within %.0f s", vars.place, LIMIT_S)
       return true
    end
    return false
@@ -117,6 +119,10 @@ fsm:define_states{ export_to=_M,
    {"DECIDE",   JumpState},
    {"ASIDE",    SkillJumpState, skills={{motor_move}}, final_to="LEAVE", fail_to="FAILED"},
    {"LEAVE",    SkillJumpState, skills={{leave_puck}}, final_to="FINAL", fail_to="FAILED"},
+   -- Keeping the puck: back off a few cm slowly enough for the holder to keep it, so that the
+   -- robot can turn away from the machine face with the puck.
+   {"CLEAR",    SkillJumpState, skills={{motor_move}}, final_to="CLEARED", fail_to="CLEARED"},
+   {"CLEARED",  JumpState},
 }
 
 fsm:add_transitions{
@@ -126,8 +132,13 @@ fsm:add_transitions{
    {"LOOK_SIDES", "INSERT", timeout=0.3},
    {"WAIT_LIGHT", "DECIDE", cond=watch, desc="light settled"},
    {"WAIT_LIGHT", "FAILED", cond=lost, desc="puck lost"},
-   {"DECIDE", "FINAL", cond="vars.outcome == 'DONE'", desc="done"},
    {"DECIDE", "ASIDE", cond="vars.outcome == 'WAITING'", desc="waiting for more"},
+   {"DECIDE", "CLEAR", cond=true, desc="done or failed: keep the puck"},
+   {"CLEARED", "FINAL", cond="vars.outcome == 'DONE'", desc="done"},
+   {"CLEARED", "FAILED", cond=function(self, vars)
+      self.fsm.error = vars.fail
+      return true
+   end, desc="failed"},
    {"APPROACH", "FAILED", cond=lost, desc="puck lost"},
    {"INSERT", "FAILED", cond=lost, desc="puck lost"},
 }
@@ -154,10 +165,15 @@ end
 function WAIT_LIGHT:init()
    self.fsm.vars.arrived = clock.now()
    self.fsm.vars.processing = false
+   self.fsm.vars.outcome, self.fsm.vars.fail = nil, nil
 end
 
 function DECIDE:init()
-   self.fsm.result = self.fsm.vars.outcome
+   if self.fsm.vars.outcome then self.fsm.result = self.fsm.vars.outcome end
+end
+
+function CLEAR:init()
+   self.args["motor_move"] = {x = -0.05, vel_trans = 0.015, tolerance = 0.01}
 end
 
 function ASIDE:init()

@@ -49,6 +49,7 @@ void PathFollower::set_path(Path path, bool forward) {
   }
   s_ = 0.0;
   arrived_ = false;
+  face_path_to_goal_ = false;
 }
 
 double PathFollower::remaining_m() const { return cum_.empty() ? 0.0 : cum_.back() - s_; }
@@ -157,7 +158,16 @@ VelocityCommand PathFollower::update(const Pose2D& pose, double dt, double stop_
   // kFinalTurn metres -- within the rotation limits and the budget that turning while driving
   // leaves: omega * v <= turn_accel_fraction * a_max.
   double e = heading_error_;
-  if (forward_ && dir.norm() > 1e-9 && cum_.back() - s_ > kFinalTurn) {
+  if (forward_ && dir.norm() > 1e-9 && cum_.back() - s_ <= kFinalTurn && !face_path_to_goal_ &&
+      to_goal > config_.position_tolerance_m &&
+      dir.dot(core::unit(pose.theta)) < -0.2) {
+    // The goal lies behind within the final-turn zone (e.g. a short move back from a machine
+    // with a puck): turning to the goal heading first would leave only a backward move, which
+    // forward mode forbids. Face along the path until the goal is reached.
+    face_path_to_goal_ = true;
+  }
+  if (face_path_to_goal_ && to_goal <= config_.position_tolerance_m) face_path_to_goal_ = false;
+  if (forward_ && dir.norm() > 1e-9 && (cum_.back() - s_ > kFinalTurn || face_path_to_goal_)) {
     // Face along the path; never backwards (an assisted holder lets its puck go): turn on
     // the spot first, then drive with the forward share of the direction only. In the last
     // kFinalTurn metres the robot turns to the goal heading and output() only cuts any

@@ -39,6 +39,14 @@ AgentBrain::AgentBrain(Game& game, int index, AgentBrainConfig config, clips::Lo
   ac.seed = seed.next_u64();
   ac.max_rules_per_cycle = config.max_rules_per_cycle;
   ac.config = std::move(config.config);
+  if (config.locks) {
+    ac.locks = true;
+    ac.lock_config.team_size =
+        config.lock_team_size > 0 ? config.lock_team_size : game.robot_count();
+    std::erase_if(ac.config,
+                  [](const clips::ConfigEntry& e) { return e.path == "/clips-agent/use-locks"; });
+    ac.config.push_back(clips::ConfigEntry::of("/clips-agent/use-locks", true));
+  }
   clips::AgentIo io;
   io.skills = this;
   io.messages = &game.registry();

@@ -18,13 +18,15 @@ using namespace llsf::sim;
 namespace {
 
 struct AgentGame {
-  AgentGame(int robots, std::uint64_t seed, clips::ConfigEntries config, bool print = false)
+  AgentGame(int robots, std::uint64_t seed, clips::ConfigEntries config, bool print = false,
+            bool locks = false)
       : game(make_config(robots, seed)) {
     for (int i = 0; i < robots; ++i) {
       AgentBrainConfig c;
       c.agent_files = {LLSF_SOURCE_DIR "/clips/agents/common",
                        LLSF_SOURCE_DIR "/clips/agents/llsf2013"};
       c.config = config;
+      c.locks = locks;
       brains.push_back(
           std::make_unique<AgentBrain>(game, i, c, [this, print](const clips::LogRecord& r) {
             if (r.level >= clips::LogLevel::kWarn) ++warnings;
@@ -149,4 +151,30 @@ TEST_CASE("protobuf round trip: CLIPS on one robot -> radio -> CLIPS on another"
   CHECK(f[4] == clips::Value::symbol("ADD_LOADED_WITH"));
   CHECK(a.agent().runtime_errors() == 0);
   CHECK(b.agent().runtime_errors() == 0);
+}
+
+TEST_CASE("with the lock protocol the robots share machines, storage and gates") {
+  AgentGame free_for_all(3, 7, {});
+  AgentGame locked(3, 7, {}, std::getenv("LLSF_AGENT_LOG") != nullptr, true);
+  for (AgentGame* g : {&free_for_all, &locked}) {
+    test::start_phase(g->game, refbox::GamePhase::kProduction);
+    g->game.run_until(SimTime::from_sec(900));
+  }
+  const GameSummary a = free_for_all.game.summary();
+  const GameSummary b = locked.game.summary();
+  const int ca = a.collisions_robot_robot + a.collisions_robot_device;
+  const int cb = b.collisions_robot_robot + b.collisions_robot_device;
+  MESSAGE("without locks: ", a.production_points, " points, ", ca, " collisions; with locks: ",
+          b.production_points, " points, ", cb, " collisions");
+  CHECK(locked.runtime_errors() == 0);
+  CHECK(b.production_points >= 20);
+  // One robot is the master.
+  int masters = 0;
+  for (const auto& br : locked.brains) {
+    masters += static_cast<int>(br->agent().find_facts("lock-role", {}).size() > 0 &&
+                                !br->agent().facts("lock-role").empty() &&
+                                br->agent().facts("lock-role")[0].fields().at(0) ==
+                                    clips::Value::symbol("MASTER"));
+  }
+  CHECK(masters == 1);
 }

@@ -60,7 +60,8 @@
   (slot prio (type INTEGER) (default 0)) (slot auctioneer (type SYMBOL)))
 (deftemplate au-ack-in (slot auction (type INTEGER)) (slot bidder (type SYMBOL))
   (slot accepted (type SYMBOL)))
-(deftemplate au-start (slot at (type FLOAT)))   ; when this robot first saw PRODUCTION
+(deftemplate au-start (slot at (type FLOAT)))
+(deftemplate au-configured)   ; when this robot first saw PRODUCTION
 (deftemplate au-hold (slot puck (type SYMBOL)) (slot until (type FLOAT)))
 (deftemplate au-stats (slot auctions (type INTEGER) (default 0)) (slot awards (type INTEGER) (default 0))
   (slot resends (type INTEGER) (default 0)) (slot reauctions (type INTEGER) (default 0))
@@ -74,21 +75,76 @@
 )
 
 ; --- configuration (/clips-agent/auction/...) --------------------------------------------------
+; Read once into globals (au-configure, at the start and after every (reset)): rule conditions
+; test some of them every cycle.
 (deffunction au-cfg (?name ?default) (cfg (str-cat "/clips-agent/auction/" ?name) ?default))
-(deffunction au-bid-window () (au-cfg "bid-window" 1.0))          ; s
-(deffunction au-award-resend () (au-cfg "award-resend" 0.5))      ; s between award resends
-(deffunction au-award-timeout () (au-cfg "award-timeout" 3.0))    ; s without ack: re-auction
-(deffunction au-silence-timeout () (au-cfg "silence-timeout" 8.0)); s without heartbeat: re-auction
-(deffunction au-alive-timeout () (au-cfg "alive-timeout" 5.0))    ; s: a peer counts as alive
-(deffunction au-retry-delay () (au-cfg "retry-delay" 2.0))        ; s after an auction without bids
-(deffunction au-done-cooldown () (au-cfg "done-cooldown" 4.0))    ; s a finished task is not re-announced
-(deffunction au-start-grace () (au-cfg "start-grace" 2.0))        ; s to hear the peers first
-(deffunction au-busy-penalty () (au-cfg "busy-penalty" 40.0))     ; s; < 0: busy robots never bid
-(deffunction au-speed () (au-cfg "travel-speed" 0.5))             ; m/s
-(deffunction au-p3-parallel () (au-cfg "p3-parallel" 2))
-(deffunction au-complex-until () (au-cfg "complex-until" 720.0))  ; game time (s): no new complex sets after
-(deffunction au-s1-hold () (au-cfg "s1-hold" 20.0))               ; s an idle robot keeps an S1
-(deffunction au-products () (cfg-list "/clips-agent/auction/products" "P1P2" "P3"))
+(defglobal
+  ?*AU-BID-WINDOW* = 1.0        ; s
+  ?*AU-AWARD-RESEND* = 0.5      ; s between award resends
+  ?*AU-AWARD-TIMEOUT* = 3.0     ; s without acknowledgement: auction again
+  ?*AU-SILENCE-TIMEOUT* = 8.0   ; s without the winner's heartbeat claiming the task: auction again
+  ?*AU-ALIVE-TIMEOUT* = 5.0     ; s: a peer heard from this recently is alive
+  ?*AU-RETRY-DELAY* = 2.0       ; s before a task without bids / failed / declined is announced again
+  ?*AU-DONE-COOLDOWN* = 4.0     ; s a finished task is not announced again
+  ?*AU-START-GRACE* = 2.0       ; s after the production start to hear the peers first
+  ?*AU-ANNOUNCE-PERIOD* = 0.5   ; s between looks for a task to announce
+  ?*AU-BUSY-PENALTY* = 40.0     ; s; < 0: busy robots never bid
+  ?*AU-SPEED* = 0.5             ; m/s for travel estimates
+  ?*AU-H-GET* = 15.0 ?*AU-H-FINISH* = 10.0 ?*AU-H-DELIVER* = 15.0   ; s handling per step
+  ?*AU-P3-PARALLEL* = 2         ; P3 tasks per T5 at once
+  ?*AU-COMPLEX-UNTIL* = 720.0   ; game time (s) after which no complex set is started
+  ?*AU-S1-HOLD* = 20.0          ; s an idle robot keeps an S1
+  ?*AU-STEP-TIMEOUT* = 150.0    ; s a step (one skill) may run before it is stopped
+  ?*AU-RECYCLE* = TRUE
+  ?*AU-PRODUCTS* = (create$ P1P2 P3)
+  ?*AU-COMPLEX-CACHE* = (create$)   ; product target ... once the T3, T4 and T5 are known
+)
+(deffunction au-configure ()
+  (bind ?*AU-BID-WINDOW* (au-cfg "bid-window" 1.0))
+  (bind ?*AU-AWARD-RESEND* (au-cfg "award-resend" 0.5))
+  (bind ?*AU-AWARD-TIMEOUT* (au-cfg "award-timeout" 3.0))
+  (bind ?*AU-SILENCE-TIMEOUT* (au-cfg "silence-timeout" 8.0))
+  (bind ?*AU-ALIVE-TIMEOUT* (au-cfg "alive-timeout" 5.0))
+  (bind ?*AU-RETRY-DELAY* (au-cfg "retry-delay" 2.0))
+  (bind ?*AU-DONE-COOLDOWN* (au-cfg "done-cooldown" 4.0))
+  (bind ?*AU-START-GRACE* (au-cfg "start-grace" 2.0))
+  (bind ?*AU-ANNOUNCE-PERIOD* (au-cfg "announce-period" 0.5))
+  (bind ?*AU-BUSY-PENALTY* (au-cfg "busy-penalty" 40.0))
+  (bind ?*AU-SPEED* (au-cfg "travel-speed" 0.5))
+  (bind ?*AU-H-GET* (au-cfg "handling/get" 15.0))
+  (bind ?*AU-H-FINISH* (au-cfg "handling/finish" 10.0))
+  (bind ?*AU-H-DELIVER* (au-cfg "handling/deliver" 15.0))
+  (bind ?*AU-P3-PARALLEL* (au-cfg "p3-parallel" 2))
+  (bind ?*AU-COMPLEX-UNTIL* (au-cfg "complex-until" 720.0))
+  (bind ?*AU-S1-HOLD* (au-cfg "s1-hold" 20.0))
+  (bind ?*AU-STEP-TIMEOUT* (au-cfg "step-timeout" 150.0))
+  (bind ?*AU-RECYCLE* (au-cfg "recycle" TRUE))
+  (bind ?*AU-PRODUCTS* (create$))
+  (foreach ?p (cfg-list "/clips-agent/auction/products" "P1P2" "P3")
+    (bind ?*AU-PRODUCTS* (create$ ?*AU-PRODUCTS* (sym-cat ?p))))
+  (bind ?*AU-COMPLEX-CACHE* (create$))
+)
+(defrule au-configure
+  (declare (salience 1000))
+  (not (au-configured))
+  =>
+  (au-configure)
+  (assert (au-configured))
+)
+(deffunction au-bid-window () ?*AU-BID-WINDOW*)
+(deffunction au-award-resend () ?*AU-AWARD-RESEND*)
+(deffunction au-award-timeout () ?*AU-AWARD-TIMEOUT*)
+(deffunction au-silence-timeout () ?*AU-SILENCE-TIMEOUT*)
+(deffunction au-alive-timeout () ?*AU-ALIVE-TIMEOUT*)
+(deffunction au-retry-delay () ?*AU-RETRY-DELAY*)
+(deffunction au-done-cooldown () ?*AU-DONE-COOLDOWN*)
+(deffunction au-start-grace () ?*AU-START-GRACE*)
+(deffunction au-busy-penalty () ?*AU-BUSY-PENALTY*)
+(deffunction au-speed () ?*AU-SPEED*)
+(deffunction au-p3-parallel () ?*AU-P3-PARALLEL*)
+(deffunction au-complex-until () ?*AU-COMPLEX-UNTIL*)
+(deffunction au-s1-hold () ?*AU-S1-HOLD*)
+(deffunction au-products () ?*AU-PRODUCTS*)
 
 ; --- the world model ---------------------------------------------------------------------------
 (deffunction au-x () (bind ?p (find-fact ((?f pose)) TRUE))
@@ -135,7 +191,7 @@
   (if (= (length$ ?f) 0) then (return NONE)) (return (fact-slot-value (nth$ 1 ?f) name)))
 
 ; The complex target of a product (P1: the T3, P2: the T4, P1P2: the one farther from the T5).
-(deffunction au-complex-target (?product)
+(deffunction au-complex-target-of (?product)
   (bind ?t3 (au-first-of-type T3)) (bind ?t4 (au-first-of-type T4))
   (if (eq ?product P1) then (return ?t3))
   (if (eq ?product P2) then (return ?t4))
@@ -144,10 +200,17 @@
   (if (eq ?t4 NONE) then (return ?t3))
   (if (> (au-dist (au-mslot ?t5 x) (au-mslot ?t5 y) ?t3) (au-dist (au-mslot ?t5 x) (au-mslot ?t5 y) ?t4))
    then (return ?t3) else (return ?t4)))
+(deffunction au-complex-target (?product)
+  (bind ?i (member$ ?product ?*AU-COMPLEX-CACHE*))
+  (if ?i then (return (nth$ (+ ?i 1) ?*AU-COMPLEX-CACHE*)))
+  (bind ?c (au-complex-target-of ?product))
+  (if (and (neq (au-first-of-type T3) NONE) (neq (au-first-of-type T4) NONE)
+           (neq (au-first-of-type T5) NONE)) then
+    (bind ?*AU-COMPLEX-CACHE* (create$ ?*AU-COMPLEX-CACHE* ?product ?c)))
+  (return ?c))
 (deffunction au-complex-targets ()
   (bind ?r (create$))
-  (foreach ?p (au-products)
-    (bind ?ps (sym-cat ?p))
+  (foreach ?ps (au-products)
     (if (neq ?ps P3) then
       (bind ?c (au-complex-target ?ps))
       (if (and (neq ?c NONE) (not (member$ ?c ?r))) then (bind ?r (create$ ?r ?c)))))
@@ -189,8 +252,7 @@
 (deffunction au-world-tasks ()
   (bind ?hi (create$)) (bind ?mid (create$)) (bind ?lo (create$))
   (bind ?gt (fact-slot-value (nth$ 1 (find-fact ((?g game)) TRUE)) time))
-  (foreach ?p (au-products)
-    (bind ?ps (sym-cat ?p))
+  (foreach ?ps (au-products)
     (if (eq ?ps P3)
      then
       (do-for-all-facts ((?m machine)) (and (eq ?m:mtype T5) (<= ?m:down-until (now)))
@@ -208,7 +270,7 @@
             (foreach ?x (au-needs ?b)
               (bind ?key (str-cat "FEED " ?b " " ?x))
               (if (not (member$ ?key ?hi)) then (bind ?hi (create$ ?hi ?key)))))))))
-  (if (eq (au-cfg "recycle" TRUE) TRUE) then
+  (if (eq ?*AU-RECYCLE* TRUE) then
     (do-for-all-facts ((?m machine)) (> ?m:consumed 0)
       (bind ?lo (create$ ?lo (str-cat "RECYCLE " ?m:name)))))
   (return (create$ ?hi ?mid ?lo)))
@@ -231,8 +293,7 @@
 ; Estimated seconds for this robot, holding ?h at (?x, ?y), to do ?key; -1: not capable.
 (deffunction au-task-cost (?key ?h ?x ?y)
   (bind ?kind (au-key-kind ?key)) (bind ?m (au-key-machine ?key)) (bind ?in (au-key-input ?key))
-  (bind ?hget (au-cfg "handling/get" 15.0)) (bind ?hfin (au-cfg "handling/finish" 10.0))
-  (bind ?hdel (au-cfg "handling/deliver" 15.0))
+  (bind ?hget ?*AU-H-GET*) (bind ?hfin ?*AU-H-FINISH*) (bind ?hdel ?*AU-H-DELIVER*)
   (if (eq (au-mslot ?m x) nil) then (return -1.0))
   (bind ?ok (or (eq ?h NONE) (and (eq ?h S0) (neq ?kind RECYCLE))
                 (and (eq ?h S1) (eq ?kind FEED) (eq ?in S1))))

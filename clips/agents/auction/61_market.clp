@@ -131,30 +131,34 @@
 
 ; This robot's bid for ?key (priority ?prio): the cost, or -1 (not capable, or busy).
 (deffunction au-my-bid (?key ?prio)
-  (bind ?h (au-holding))
-  (bind ?c (au-task-cost ?key ?h (au-x) (au-y)))
-  (if (< ?c 0.0) then (return -1.0))
+  (bind ?penalty 0.0)
   (bind ?jobs (find-fact ((?j au-job)) TRUE))
-  (if (= (length$ ?jobs) 0) then
+  (if (= (length$ ?jobs) 0)
+   then
     ; idle, unless a step of its own (delivering a held product, ...) runs
     (if (any-factp ((?t task)) (neq ?t:kind WAIT)) then (return -1.0))
-    (return ?c))
-  (bind ?j (nth$ 1 ?jobs))
-  (if (or (< (au-busy-penalty) 0.0) (>= (fact-slot-value ?j prio) ?prio)) then (return -1.0))
-  (if (any-factp ((?t task)) (and (eq ?t:kind FINISH) (eq ?t:state RUNNING))) then (return -1.0))
-  (return (+ ?c (au-busy-penalty)))
+   else
+    (bind ?penalty (au-busy-penalty))
+    (if (or (< ?penalty 0.0) (>= (fact-slot-value (nth$ 1 ?jobs) prio) ?prio)) then (return -1.0))
+    ; dropping it must not lose a puck: only while fetching an S0 or between steps
+    (if (any-factp ((?t task)) (and (neq ?t:kind GET_S0) (eq ?t:state RUNNING))) then
+      (return -1.0)))
+  (bind ?c (au-task-cost ?key (au-holding) (au-x) (au-y)))
+  (if (< ?c 0.0) then (return -1.0))
+  (return (+ ?c ?penalty))
 )
 
 ; Could anybody bid for a task of priority ?prio (this robot, or an alive peer that is idle
 ; with empty hands or an S0/S1, or busy with a task of lower priority)? If not, the auction
 ; waits: no calls that nobody can answer.
 (deffunction au-anyone-available (?key ?prio)
-  (if (>= (au-my-bid ?key ?prio) 0.0) then (return TRUE))
   (bind ?since (- (now) (au-alive-timeout)))
-  (any-factp ((?p au-peer))
-    (and (> ?p:seen ?since) (member$ ?p:holding (create$ NONE S0 S1))
-         (or (= ?p:job-id 0)
-             (and (>= (au-busy-penalty) 0.0) (< (au-key-prio ?p:job-key) ?prio)))))
+  (if (any-factp ((?p au-peer))
+        (and (> ?p:seen ?since) (member$ ?p:holding (create$ NONE S0 S1))
+             (or (= ?p:job-id 0)
+                 (and (>= (au-busy-penalty) 0.0) (< (au-key-prio ?p:job-key) ?prio)))))
+   then (return TRUE))
+  (>= (au-my-bid ?key ?prio) 0.0)
 )
 
 ; The open task to announce: the first (highest priority) one somebody can bid for.
@@ -170,7 +174,7 @@
   (game (phase PRODUCTION) (state RUNNING))
   (au-start (at ?s))
   (not (au-auction (state BIDDING)))
-  ?t <- (timer (name au-announce) (time $?last&:(timeout ?now ?last (au-cfg "announce-period" 0.3))))
+  ?t <- (timer (name au-announce) (time $?last&:(timeout ?now ?last ?*AU-ANNOUNCE-PERIOD*)))
   (test (> (now) (+ ?s (au-start-grace))))
   (test (au-i-am-auctioneer))
   =>
@@ -218,9 +222,13 @@
   (test (> (now) ?d))
   =>
   (bind ?best NONE) (bind ?bc 0.0)
+  (bind ?prio (fact-slot-value ?a prio))
   (do-for-all-facts ((?b au-bid)) (= ?b:auction ?id)
-    (if (or (eq ?best NONE) (< ?b:cost ?bc)
-            (and (= ?b:cost ?bc) (< (str-compare ?b:bidder ?best) 0))) then
+    ; a bidder that won another of my auctions meanwhile (of no lower priority) is busy now
+    (if (and (not (any-factp ((?o au-auction))
+                    (and (neq ?o:state BIDDING) (eq ?o:winner ?b:bidder) (>= ?o:prio ?prio))))
+             (or (eq ?best NONE) (< ?b:cost ?bc)
+                 (and (= ?b:cost ?bc) (< (str-compare ?b:bidder ?best) 0)))) then
       (bind ?best ?b:bidder) (bind ?bc ?b:cost))
     (retract ?b))
   (if (eq ?best NONE)

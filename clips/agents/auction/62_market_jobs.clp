@@ -45,8 +45,7 @@
 (deffunction au-drop-job (?j)
   (do-for-all-facts ((?t task)) TRUE
     (if (eq ?t:state RUNNING) then (skill-stop))
-    (if (neq ?t:lock NONE) then (assert (lock-release (resource ?t:lock))))
-    (retract ?t))
+    (task-finished ?t FALSE))   ; releases its resource
   ; the stopped skill's FAILED fact must not end the next task that calls the same skill
   (do-for-all-facts ((?s skill)) (neq ?s:status RUNNING) (retract ?s))
   (log-info "dropping task " (fact-slot-value ?j key) " for a better one")
@@ -165,6 +164,19 @@
   (holding (puck ~S1))
   =>
   (retract ?f)
+)
+
+; A step that runs far longer than any step should (robots blocking each other at the gates,
+; ...) is stopped: the skill fails, the step and the task fail, the task is auctioned again.
+(defrule au-step-watchdog
+  (declare (salience ?*PRIORITY-DECIDE*))
+  (time $?)
+  (task (state RUNNING) (kind ?k&~WAIT&~EXPLORE) (since ?s))
+  (test (> (now) (+ ?s ?*AU-STEP-TIMEOUT*)))
+  (skill (status RUNNING|IDLE))
+  =>
+  (log-warn "step " ?k " runs for more than " ?*AU-STEP-TIMEOUT* " s: stopping it")
+  (skill-stop)
 )
 
 (defrule au-task-cooldown-expired

@@ -69,10 +69,10 @@
 (deftemplate explore-pos (slot machine (type SYMBOL)))
 (deftemplate recycle-pending)
 (deftemplate task-cooldown (slot until (type FLOAT)))
-(deftemplate lock-request (slot resource (type SYMBOL)))
-(deftemplate lock-granted (slot resource (type SYMBOL)))
-(deftemplate lock-denied (slot resource (type SYMBOL)))
-(deftemplate lock-release (slot resource (type SYMBOL)))
+(deftemplate resource-request (slot resource (type SYMBOL)))
+(deftemplate resource-granted (slot resource (type SYMBOL)))
+(deftemplate resource-denied (slot resource (type SYMBOL)))
+(deftemplate resource-release (slot resource (type SYMBOL)))
 
 (deffacts llsf2013-static
   (game)

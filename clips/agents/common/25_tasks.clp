@@ -5,9 +5,9 @@
 ; by requesting the lock, calling the task's skill and reading the skill's outcome. Whoever
 ; asserted the task consumes DONE/FAILED (and then calls task-finished).
 ;
-; Locks: (lock-request ?r) asks for a resource, (lock-granted (resource ?r)) / (lock-denied ?r) answer,
-; (lock-release ?r) gives it back. 45_locks.clp maps these onto the lock protocol, or grants
-; everything at once when locks are off.
+; Resources: (resource-request (resource ?r)) asks for one, (resource-granted (resource ?r)) /
+; (resource-denied (resource ?r)) answer, (resource-release (resource ?r)) gives it back;
+; 26_locks.clp maps these onto the lock protocol, or grants everything at once without it.
 
 (deffunction task-skill (?kind)
   (switch ?kind
@@ -25,7 +25,7 @@
   (declare (salience ?*PRIORITY-TASK*))
   ?t <- (task (state NEW) (lock ?r&~NONE))
   =>
-  (assert (lock-request (resource ?r)))
+  (assert (resource-request (resource ?r)))
   (modify ?t (state LOCKING) (since (now)))
 )
 
@@ -36,18 +36,18 @@
   (modify ?t (state START))
 )
 
-(defrule task-lock-granted
+(defrule task-resource-granted
   (declare (salience ?*PRIORITY-TASK*))
   ?t <- (task (state LOCKING) (lock ?r))
-  (lock-granted (resource ?r))
+  (resource-granted (resource ?r))
   =>
   (modify ?t (state START))
 )
 
-(defrule task-lock-denied
+(defrule task-resource-denied
   (declare (salience ?*PRIORITY-TASK*))
   ?t <- (task (state LOCKING) (lock ?r) (attempts ?a))
-  ?d <- (lock-denied (resource ?r))
+  ?d <- (resource-denied (resource ?r))
   =>
   (retract ?d)
   (modify ?t (state LOCK_WAIT) (since (now)) (attempts (+ ?a 1)))
@@ -60,7 +60,7 @@
   ?t <- (task (state LOCK_WAIT) (lock ?r) (since ?s))
   (test (> (- (now) ?s) 1.0))   ; a test CE: evaluated again with every new (time) fact
   =>
-  (assert (lock-request (resource ?r)))
+  (assert (resource-request (resource ?r)))
   (modify ?t (state LOCKING) (since (now)))
 )
 
@@ -113,7 +113,7 @@
 ; Called by the consumer of a DONE/FAILED task: releases its lock, counts, retracts it.
 (deffunction task-finished (?t ?ok)
   (bind ?r (fact-slot-value ?t lock))
-  (if (neq ?r NONE) then (assert (lock-release (resource ?r))))
+  (if (neq ?r NONE) then (assert (resource-release (resource ?r))))
   (do-for-fact ((?rec record)) TRUE
     (if ?ok
      then (modify ?rec (tasks-done (+ ?rec:tasks-done 1)) (failures-in-a-row 0))
@@ -131,6 +131,6 @@
   =>
   (if (eq ?st RUNNING) then (skill-stop))
   (bind ?r (fact-slot-value ?t lock))
-  (if (neq ?r NONE) then (assert (lock-release (resource ?r))))
+  (if (neq ?r NONE) then (assert (resource-release (resource ?r))))
   (retract ?t)
 )

@@ -10,7 +10,8 @@ depends_interfaces = {
 }
 documentation      = [==[Symbolic motor_move: same arguments as the physical skill (x, y, ori,
 vel_trans, vel_rot, tolerance). Waits distance over vel_trans plus the turn over vel_rot, then
-puts the robot at the goal; moving backwards (x < 0) leaves a held puck where it was.
+puts the robot at the goal; moving backwards (x < 0) faster than 0.02 m/s leaves a held puck
+where it was (as the assisted holder does).
 ]==]
 
 local OFFSET = 0.2225
@@ -41,7 +42,8 @@ function MOVE:init()
    v.gx, v.gy, v.gth = x + c * dx - s * dy, y + s * dx + c * dy, th + dth
    v.arrive_at = clock.now() + math.sqrt(dx * dx + dy * dy) / (v.vel_trans or 0.3) +
                  math.abs(dth) / (v.vel_rot or 1.0)
-   if dx < 0 and sensor:puck_in_holder() then
+   -- The assisted holder lets go only when backing faster than 0.02 m/s.
+   if dx < 0 and (v.vel_trans or 0.3) > 0.02 and sensor:puck_in_holder() then
       v.drop_x, v.drop_y = x + c * OFFSET, y + s * OFFSET   -- the holder lets go when backing
    end
 end

@@ -72,6 +72,9 @@ class PathFollower {
   double omega_ = 0.0;
   double heading_error_ = 0.0;
   bool arrived_ = false;
+  /// Forward mode near the goal: the goal lies behind, so keep facing along the path (instead of
+  /// turning to the goal heading, which would leave only a backward move) until close to it.
+  bool face_path_to_goal_ = false;
   bool forward_ = false;
 };
 

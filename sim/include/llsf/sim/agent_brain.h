@@ -32,6 +32,12 @@ struct AgentBrainConfig {
   std::int64_t max_rules_per_cycle = 10'000;
   /// Team name for ?*TEAM-NAME* (empty: the game's team or the refbox's).
   std::string team;
+  /// The lock protocol over the radio (clips::AgentConfig::locks, docs/locks.md); also sets the
+  /// confval /clips-agent/use-locks TRUE for the team agents.
+  bool locks = false;
+  /// Robots that take part in the lock protocol (the majority is counted of these); 0: every
+  /// robot of the game.
+  int lock_team_size = 0;
 };
 
 /// `entries` with every directory replaced by its *.clp files in name order.
