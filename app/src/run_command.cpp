@@ -138,6 +138,7 @@ int check(const std::vector<std::string>& files, std::ostream& out, std::ostream
           c.agent_files = spec.agent;
           c.config = spec.config;
           c.skills = s.skills;
+          c.locks = spec.locks;
           brains.push_back(std::make_unique<sim::AgentBrain>(game, i, c));
           for (const std::string& e : brains.back()->skills().engine().load_errors()) {
             throw core::ConfigError("skill file error: " + e);

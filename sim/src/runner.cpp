@@ -61,6 +61,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
     c.agent_files = spec.agent;
     c.config = spec.config;
     c.skills = scenario.skills;
+    c.locks = spec.locks;
     brains.push_back(std::make_unique<AgentBrain>(game, i, c));
     brains.back()->skills().set_listener([&skill_failures](const SkillStatusChange& ch) {
       if (ch.status == lua::SkillStatus::kFailed) ++skill_failures;

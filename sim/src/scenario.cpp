@@ -159,7 +159,7 @@ void read_robots(const core::ConfigNode& n, const std::string& dir, Scenario& s)
   clips::ConfigEntries config;
   if (n.defined()) {
     n.require_map();
-    n.check_keys({"count", "agent", "config", "each"});
+    n.check_keys({"count", "agent", "config", "locks", "each"});
     if (n["count"].defined()) {
       const std::int64_t c = n["count"].as_int();
       if (c < 1 || c > static_cast<std::int64_t>(s.game.world.robots.size())) {
@@ -174,8 +174,10 @@ void read_robots(const core::ConfigNode& n, const std::string& dir, Scenario& s)
       config = clips::config_from_node(n["config"], "/clips-agent");
     }
   }
+  bool locks = false;
+  if (n.defined()) n.read("locks", locks);
   s.game.world.robots.resize(static_cast<std::size_t>(count));
-  s.robots.assign(static_cast<std::size_t>(count), RobotSpec{agent, config});
+  s.robots.assign(static_cast<std::size_t>(count), RobotSpec{agent, config, locks});
   const core::ConfigNode each = n.defined() ? n["each"] : core::ConfigNode();
   if (!each.defined()) return;
   if (!each.is_sequence()) each.fail("expected a list with one entry per robot");

@@ -21,6 +21,7 @@ namespace llsf::sim {
 struct RobotSpec {
   std::vector<std::string> agent;  ///< files or directories, resolved against the scenario's dir
   clips::ConfigEntries config;     ///< confval facts (under /clips-agent)
+  bool locks = false;              ///< the lock protocol (robots.locks)
 };
 
 /// A pass/fail condition on a finished game.
