@@ -164,6 +164,8 @@ void add_agent_messages(MessageRegistry& registry) {
   registry.add<llsf_agent_msgs::AuctionCall>();
   registry.add<llsf_agent_msgs::AuctionBid>();
   registry.add<llsf_agent_msgs::AuctionAward>();
+  registry.add<llsf_agent_msgs::AuctionAck>();
+  registry.add<llsf_agent_msgs::AuctionStatus>();
 }
 
 }  // namespace llsf::comm

@@ -61,7 +61,7 @@ TEST_CASE("header is big-endian component id, message type, payload size") {
 
 TEST_CASE("registry reads COMP_ID/MSG_TYPE and gives dense indices") {
   const MessageRegistry r = agent_registry();
-  CHECK(r.size() == 8);
+  CHECK(r.size() == 10);
   CHECK(r.key_of(llsf_agent_msgs::LockMessage()) == MessageKey{kAgentComponentId, 1});
   CHECK(r.key_of(llsf_agent_msgs::LockMasterAnnounce()) == MessageKey{2100, 2});
   CHECK(r.key_of(llsf_agent_msgs::Worldmodel()) == MessageKey{2100, 10});
@@ -74,14 +74,14 @@ TEST_CASE("registry reads COMP_ID/MSG_TYPE and gives dense indices") {
 
   MessageRegistry copy = r;
   copy.add<llsf_agent_msgs::LockMessage>();  // same type, same key: no-op
-  CHECK(copy.size() == 8);
+  CHECK(copy.size() == 10);
   // Another type under a taken key, or a taken type under another key, is a bug.
   CHECK_THROWS_AS(copy.add(MessageKey{2100, 1}, llsf_agent_msgs::AuctionBid::default_instance()),
                   llsf::core::AssertionError);
   CHECK_THROWS_AS(copy.add(MessageKey{2100, 77}, llsf_agent_msgs::AuctionBid::default_instance()),
                   llsf::core::AssertionError);
   copy.add(MessageKey{3000, 5}, llsf_agent_msgs::Incoming::default_instance());
-  CHECK(copy.index_of(MessageKey{3000, 5}) == 8);
+  CHECK(copy.index_of(MessageKey{3000, 5}) == 10);
 }
 
 TEST_CASE("encode/decode round trip") {

@@ -287,6 +287,21 @@ TEST_CASE("auction: a bidder answers calls with its cost and runs the task it wi
   CHECK(m.f.agent().runtime_errors() == 0);
 }
 
+TEST_CASE("auction: the next robot becomes the auctioneer when robot1 falls silent") {
+  Market m(2);
+  m.idle = {1, 3};  // robot1 is alive: robot2 only bids
+  m.run(60);
+  CHECK(m.sent<AuctionCall>().empty());
+  m.idle = {3};  // robot1 falls silent: after 5 s robot2 runs the auctions
+  m.run(40);
+  CHECK(m.sent<AuctionCall>().empty());
+  m.run(40);
+  REQUIRE_FALSE(m.sent<AuctionCall>().empty());
+  CHECK(m.sent<AuctionCall>()[0]->auctioneer() == "robot2");
+  CHECK(m.sent<AuctionCall>()[0]->auction_id() / 100000 == 2);
+  CHECK(m.f.agent().runtime_errors() == 0);
+}
+
 namespace {
 
 struct Points {

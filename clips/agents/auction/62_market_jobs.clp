@@ -72,7 +72,10 @@
    then (au-send-ack ?id ?who TRUE)   ; a resent award: answer again
    else
     (if (and (eq ?phase PRODUCTION) (>= (au-my-bid ?key ?prio) 0.0)
-             (member$ ?key (au-world-tasks)))
+             (member$ ?key (au-world-tasks))
+             ; a late award of a task meanwhile given to another robot
+             (not (any-factp ((?p au-peer))
+                    (and (eq ?p:job-key ?key) (> ?p:seen (- (now) (au-alive-timeout)))))))
      then
       (do-for-fact ((?j au-job)) TRUE (au-drop-job ?j))
       (log-info "won " ?key " (auction " ?id " of " ?who ")")

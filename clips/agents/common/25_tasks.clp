@@ -91,6 +91,15 @@
   (modify ?t (state DONE))
 )
 
+; A skill aborted by a newer skill-call reports FAILED "aborted by skill-call ..."; that is not
+; the outcome of the task's current skill (which may have the same name).
+(defrule task-skill-aborted
+  (declare (salience (+ ?*PRIORITY-TASK* 1)))
+  ?s <- (skill (status FAILED) (error ?e&:(eq (str-index "aborted by skill-call" ?e) 1)))
+  =>
+  (retract ?s)
+)
+
 (defrule task-skill-final
   (declare (salience ?*PRIORITY-TASK*))
   ?t <- (task (state RUNNING) (kind ?k))

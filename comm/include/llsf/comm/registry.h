@@ -103,7 +103,8 @@ class MessageRegistry {
 };
 
 /// Registers the agents' own messages (llsf_agent_msgs: LockMessage, LockMasterAnnounce,
-/// LockStatus, Worldmodel, WorldmodelChange, AuctionCall, AuctionBid, AuctionAward).
+/// LockStatus, Worldmodel, WorldmodelChange, AuctionCall, AuctionBid, AuctionAward, AuctionAck,
+/// AuctionStatus).
 void add_agent_messages(MessageRegistry& registry);
 
 }  // namespace llsf::comm
