@@ -2,12 +2,13 @@
 # The project's front door. `make run` and `make test` work on a fresh Debian bookworm machine.
 JOBS ?= $(shell nproc)
 
-.PHONY: all deps run test build-release build-ci bench format check-format clean help
+.PHONY: all deps run demo test build-release build-ci bench format check-format clean help
 
 all: build-release
 
 help:
-	@echo "make run          install deps, build Release, run the main job (world demo)"
+	@echo "make run          install deps, build Release, play the default scenario (llsfsim run)"
+	@echo "make demo         the kinematic world demo (three robots, no refbox)"
 	@echo "make test         install deps, build with -Werror, run the whole test suite"
 	@echo "make bench        build Release and run every benchmark (bench/run)"
 	@echo "make format       clang-format every source file"
@@ -26,6 +27,9 @@ build-ci: deps
 	@cmake --build --preset ci -j $(JOBS)
 
 run: build-release
+	./build/release/llsfsim run scenarios/default.yaml $(ARGS)
+
+demo: build-release
 	./build/release/kinematic/llsf-world-demo $(ARGS)
 
 test: build-ci
