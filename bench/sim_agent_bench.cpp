@@ -52,7 +52,13 @@ struct GameResult {
   double agent_us_per_cycle = 0.0;
 };
 
-GameResult play(std::uint64_t seed, double loss, bool locks) {
+/// Which agent plays: its second directory (after common) and its confval entries.
+struct AgentVariant {
+  const char* dir = "llsf2013";
+  clips::ConfigEntries config;
+};
+
+GameResult play(std::uint64_t seed, double loss, bool locks, const AgentVariant& agent = {}) {
   sim::GameConfig config;
   config.seed = seed;
   if (loss > 0.0) {
@@ -65,7 +71,8 @@ GameResult play(std::uint64_t seed, double loss, bool locks) {
   for (int i = 0; i < game.robot_count(); ++i) {
     sim::AgentBrainConfig c;
     c.agent_files = {LLSF_SOURCE_DIR "/clips/agents/common",
-                     LLSF_SOURCE_DIR "/clips/agents/llsf2013"};
+                     std::string(LLSF_SOURCE_DIR "/clips/agents/") + agent.dir};
+    c.config = agent.config;
     c.locks = locks;
     brains.push_back(std::make_unique<sim::AgentBrain>(game, i, c));
     timed.push_back(std::make_unique<TimedBrain>(*brains.back()));
@@ -96,11 +103,12 @@ GameResult play(std::uint64_t seed, double loss, bool locks) {
   for (const auto& b : brains) r.runtime_errors += b->agent().runtime_errors();
   for (int i = 0; i < game.robot_count(); ++i) game.set_brain(i, nullptr);
   if (std::getenv("LLSF_BENCH_VERBOSE") != nullptr) {
-    std::fprintf(stderr,
-                 "seed %2llu loss %.2f locks %d: exploration %3d production %4d total %4d deliveries %2d "
-                 "errors %d cpu %.2f s\n",
-                 static_cast<unsigned long long>(seed), loss, locks ? 1 : 0, r.exploration, r.production, r.total,
-                 r.deliveries, r.runtime_errors, r.wall_cpu);
+    std::fprintf(
+        stderr,
+        "seed %2llu loss %.2f locks %d: exploration %3d production %4d total %4d deliveries %2d "
+        "errors %d cpu %.2f s\n",
+        static_cast<unsigned long long>(seed), loss, locks ? 1 : 0, r.exploration, r.production,
+        r.total, r.deliveries, r.runtime_errors, r.wall_cpu);
   }
   return r;
 }
@@ -111,12 +119,13 @@ double median(std::vector<double> v) {
   return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-void report_series(const std::string& name, double loss, bool locks) {
+void report_series(const std::string& name, double loss, bool locks,
+                   const AgentVariant& agent = {}) {
   std::vector<double> expl, total, rtf;
   int no_delivery = 0;
   int errors = 0;
   for (std::uint64_t seed = 1; seed <= kSeeds; ++seed) {
-    const GameResult r = play(seed, loss, locks);
+    const GameResult r = play(seed, loss, locks, agent);
     expl.push_back(r.exploration);
     total.push_back(r.total);
     rtf.push_back(1080.0 / r.wall_cpu);
@@ -133,8 +142,9 @@ void report_series(const std::string& name, double loss, bool locks) {
 
 }  // namespace
 
-LLSF_BENCH(agent_games,
-           "LLSF 2013 agent, 3 robots, full games on 20 seeds, 0 % / 20 % loss, without/with locks") {
+LLSF_BENCH(
+    agent_games,
+    "LLSF 2013 agent, 3 robots, full games on 20 seeds, 0 % / 20 % loss, without/with locks") {
   report_series("agent_games", 0.0, false);
   report_series("agent_games_loss20", 0.2, false);
   report_series("agent_games_locks", 0.0, true);
@@ -145,4 +155,13 @@ LLSF_BENCH(agent_cycle, "CPU per agent cycle of the LLSF 2013 agent in a full 3-
   std::vector<double> us;
   for (std::uint64_t seed : {1, 2, 3}) us.push_back(play(seed, 0.0, false).agent_us_per_cycle);
   bench::report("agent_cycle", "us_per_robot_cycle", median(us), "us");
+}
+
+LLSF_BENCH(agent_compare,
+           "20 seeds, 3 robots, locks on: roles P1P2-P3-P3 (default), P3-P3-P3, and the auction agent") {
+  report_series("agent_compare_roles_P1P2-P3-P3", 0.0, true);
+  AgentVariant p3{"llsf2013", {clips::ConfigEntry::list("/clips-agent/roles", std::vector<std::string>{"P3", "P3", "P3"})}};
+  report_series("agent_compare_roles_P3-P3-P3", 0.0, true, p3);
+  report_series("agent_compare_auction", 0.0, true, AgentVariant{"auction", {}});
+  report_series("agent_compare_auction_loss20", 0.2, true, AgentVariant{"auction", {}});
 }
