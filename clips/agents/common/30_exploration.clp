@@ -37,6 +37,8 @@
   (return NONE)
 )
 
+(deftemplate explore-idle (slot until (type FLOAT)))
+
 (defrule explore-decide
   (declare (salience ?*PRIORITY-DECIDE*))
   (time $?)
@@ -44,10 +46,21 @@
   (signal)
   (explore-pos (machine ?pos))
   (not (task))
+  (not (explore-idle))
   =>
   (bind ?m (explore-next ?pos))
-  (if (neq ?m NONE) then
-    (assert (task (kind EXPLORE) (place ?m) (lock ?m))))
+  (if (neq ?m NONE)
+   then (assert (task (kind EXPLORE) (place ?m) (lock ?m)))
+   else (assert (explore-idle (until (+ (now) 1.0)))))   ; nothing to do: look again in 1 s
+)
+
+(defrule explore-idle-over
+  (declare (salience ?*PRIORITY-DECIDE*))
+  (time $?)
+  ?f <- (explore-idle (until ?u))
+  (test (>= (now) ?u))
+  =>
+  (retract ?f)
 )
 
 ; Another robot holds the machine: pass it (try it again later).
