@@ -157,10 +157,13 @@ LLSF_BENCH(agent_cycle, "CPU per agent cycle of the LLSF 2013 agent in a full 3-
   bench::report("agent_cycle", "us_per_robot_cycle", median(us), "us");
 }
 
-LLSF_BENCH(agent_compare,
-           "20 seeds, 3 robots, locks on: roles P1P2-P3-P3 (default), P3-P3-P3, and the auction agent") {
+LLSF_BENCH(
+    agent_compare,
+    "20 seeds, 3 robots, locks on: roles P1P2-P3-P3 (default), P3-P3-P3, and the auction agent") {
   report_series("agent_compare_roles_P1P2-P3-P3", 0.0, true);
-  AgentVariant p3{"llsf2013", {clips::ConfigEntry::list("/clips-agent/roles", std::vector<std::string>{"P3", "P3", "P3"})}};
+  AgentVariant p3{
+      "llsf2013",
+      {clips::ConfigEntry::list("/clips-agent/roles", std::vector<std::string>{"P3", "P3", "P3"})}};
   report_series("agent_compare_roles_P3-P3-P3", 0.0, true, p3);
   report_series("agent_compare_auction", 0.0, true, AgentVariant{"auction", {}});
   report_series("agent_compare_auction_loss20", 0.2, true, AgentVariant{"auction", {}});

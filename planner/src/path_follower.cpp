@@ -159,8 +159,7 @@ VelocityCommand PathFollower::update(const Pose2D& pose, double dt, double stop_
   // leaves: omega * v <= turn_accel_fraction * a_max.
   double e = heading_error_;
   if (forward_ && dir.norm() > 1e-9 && cum_.back() - s_ <= kFinalTurn && !face_path_to_goal_ &&
-      to_goal > config_.position_tolerance_m &&
-      dir.dot(core::unit(pose.theta)) < -0.2) {
+      to_goal > config_.position_tolerance_m && dir.dot(core::unit(pose.theta)) < -0.2) {
     // The goal lies behind within the final-turn zone (e.g. a short move back from a machine
     // with a puck): turning to the goal heading first would leave only a backward move, which
     // forward mode forbids. Face along the path until the goal is reached.

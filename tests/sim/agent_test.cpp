@@ -164,8 +164,8 @@ TEST_CASE("with the lock protocol the robots share machines, storage and gates")
   const GameSummary b = locked.game.summary();
   const int ca = a.collisions_robot_robot + a.collisions_robot_device;
   const int cb = b.collisions_robot_robot + b.collisions_robot_device;
-  MESSAGE("without locks: ", a.production_points, " points, ", ca, " collisions; with locks: ",
-          b.production_points, " points, ", cb, " collisions");
+  MESSAGE("without locks: ", a.production_points, " points, ", ca,
+          " collisions; with locks: ", b.production_points, " points, ", cb, " collisions");
   CHECK(locked.runtime_errors() == 0);
   CHECK(b.production_points >= 20);
   // One robot is the master.
