@@ -26,6 +26,11 @@ int run(std::span<const std::string> args, std::ostream& out, std::ostream& err)
   }
   {
     CLI::App* sub = app.add_subcommand(
+        "batch", "Play every variant x N seeds on worker threads; store and summarize the runs");
+    commands.emplace_back(sub, add_batch_command(*sub));
+  }
+  {
+    CLI::App* sub = app.add_subcommand(
         "check", "Validate scenarios and their agent and skill files without playing");
     commands.emplace_back(sub, add_check_command(*sub));
   }

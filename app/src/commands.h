@@ -16,6 +16,8 @@ using Action = std::function<int(std::ostream& out, std::ostream& err)>;
 Action add_skill_command(CLI::App& app);
 /// `llsfsim run`: one game of a scenario with a summary and the test-case verdicts.
 Action add_run_command(CLI::App& app);
+/// `llsfsim batch`: every variant x N seeds on worker threads, stored in the statistics store.
+Action add_batch_command(CLI::App& app);
 /// `llsfsim check`: validate scenarios and their agent/skill files without playing.
 Action add_check_command(CLI::App& app);
 

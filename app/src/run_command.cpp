@@ -6,6 +6,7 @@
 
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -17,6 +18,7 @@
 #include "llsf/sim/agent_brain.h"
 #include "llsf/sim/runner.h"
 #include "llsf/sim/scenario.h"
+#include "llsf/sim/stats_store.h"
 
 namespace llsf::app {
 
@@ -28,6 +30,9 @@ struct RunOptions {
   std::string variant;
   bool json = false;
   bool quiet = false;
+  std::string db{sim::StatsStore::kDefaultPath};
+  bool no_db = false;
+  std::string record;
 };
 
 const sim::Scenario* pick_variant(const sim::ScenarioFile& f, const std::string& name,
@@ -90,7 +95,25 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
   const sim::Scenario* s = pick_variant(file, o.variant, err);
   if (s == nullptr) return kExitBadInput;
   const std::uint64_t seed = o.seed.value_or(s->seeds.front());
+  // The statistics store is opened before playing so that a bad path costs no game.
+  std::optional<sim::StatsStore> store;
+  sim::BatchKey key;
+  if (!o.no_db) {
+    try {
+      store.emplace(o.db);
+      key.kind = sim::BatchKey::Kind::kRun;
+      key.scenario_file = o.scenario;
+      key.scenario_name = s->name;
+      key.scenario_hash = sim::file_content_hash(o.scenario);
+      key.variants = static_cast<int>(file.variants.size());
+      key.seeds = s->seeds;
+    } catch (const sim::StatsError& e) {
+      err << "llsfsim run: " << e.what() << "\n";
+      return kExitBadInput;
+    }
+  }
   sim::RunHooks hooks;
+  hooks.record_path = o.record;
   const bool tty = isatty(STDERR_FILENO) != 0 && !o.quiet && !o.json;
   if (tty) {
     hooks.progress_every = core::SimTime::from_sec(10);
@@ -110,8 +133,19 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
   } catch (const core::ConfigError& e) {
     err << "llsfsim run: " << e.what() << "\n";
     return kExitBadInput;
+  } catch (const std::runtime_error& e) {  // e.g. the recording cannot be written
+    err << "llsfsim run: " << e.what() << "\n";
+    return kExitBadInput;
   }
   if (tty) std::fprintf(stderr, "\r%60s\r", "");
+  if (store) {
+    try {
+      store->add_run(store->open_batch(key), r, /*replace=*/true);
+    } catch (const sim::StatsError& e) {
+      err << "llsfsim run: " << e.what() << "\n";
+      return kExitBadInput;
+    }
+  }
   if (o.json) {
     out << sim::to_json(r) << "\n";
   } else if (!o.quiet) {
@@ -166,8 +200,17 @@ Action add_run_command(CLI::App& app) {
                  "Matrix variant, e.g. 'config=P3-P3' or just 'P3-P3' (default: the first)");
   app.add_flag("--json", o->json, "Print the summary as one JSON object");
   app.add_flag("-q,--quiet", o->quiet, "No summary, only the exit code");
+  auto* db = app.add_option("--db", o->db,
+                            "Statistics store (SQLite) the run is written to (docs/statistics.md)")
+                 ->capture_default_str();
+  app.add_flag("--no-db", o->no_db, "Do not write the run to a statistics store")->excludes(db);
+  app.add_option("--record", o->record,
+                 "Write a recording of the game to FILE (gzip JSON lines, docs/recording.md; "
+                 "e.g. game.jsonl.gz)");
   app.footer(
-      "Plays one game headless and prints a summary and the test-case verdicts.\n"
+      "Plays one game headless and prints a summary and the test-case verdicts; stores the run "
+      "in the statistics store (--db, default llsfsim.db; the latest game of each variant and "
+      "seed of a scenario file's content).\n"
       "Exit code: 0 all test cases passed, 1 one failed, 2 bad scenario or agent.");
   return [o](std::ostream& out, std::ostream& err) { return run(*o, out, err); };
 }

@@ -10,6 +10,7 @@
 #include "llsf/core/rng.h"
 #include "llsf/refbox/protocol.h"
 #include "llsf/sim/agent_brain.h"
+#include "llsf/sim/recording.h"
 
 namespace llsf::sim {
 
@@ -17,7 +18,9 @@ namespace {
 
 double cpu_seconds() {
   timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);  // a measurement only, never a game input
+  // A measurement only, never a game input. The thread's clock: a game runs on one thread, and
+  // a batch plays several games at once in one process.
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
@@ -54,6 +57,11 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   Game game(config);
   std::vector<std::unique_ptr<AgentBrain>> brains;
   int skill_failures = 0;
+  std::unique_ptr<Recorder> recorder;
+  if (!hooks.record_path.empty()) {
+    recorder = std::make_unique<Recorder>(
+        hooks.record_path, game, RecordingInfo{scenario.name, scenario.variant, seed, "0.1.0"});
+  }
   for (int i = 0; i < game.robot_count(); ++i) {
     const RobotSpec& spec = scenario.robots.at(static_cast<std::size_t>(i));
     if (spec.agent.empty()) continue;
@@ -63,9 +71,12 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
     c.skills = scenario.skills;
     c.locks = spec.locks;
     brains.push_back(std::make_unique<AgentBrain>(game, i, c));
-    brains.back()->skills().set_listener([&skill_failures](const SkillStatusChange& ch) {
-      if (ch.status == lua::SkillStatus::kFailed) ++skill_failures;
-    });
+    brains.back()->skills().set_listener(
+        [&skill_failures, &hooks, &recorder](const SkillStatusChange& ch) {
+          if (recorder) recorder->skill(ch);
+          if (hooks.skill) hooks.skill(ch);
+          if (ch.status == lua::SkillStatus::kFailed) ++skill_failures;
+        });
   }
   // Test cases with a deadline are judged when the game passes it.
   std::vector<TestVerdict> verdicts(scenario.tests.size());
@@ -111,6 +122,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
                                                            : value >= t.value;
     d << " (need " << describe(t) << ")";
     v.detail = d.str();
+    v.at_s = game.time().seconds();
     judged[i] = true;
   };
 
@@ -118,9 +130,15 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   const SimTime end = scenario.duration;
   SimTime next_progress = hooks.progress_every;
   const double t0 = cpu_seconds();
+  // The refbox records awards with its phase-relative time; the run notes the game time too.
+  std::vector<double> award_times_s;
   while (game.time() < end) {
     game.step();
+    if (recorder) recorder->frame(game);
     if (hooks.tick) hooks.tick(game);
+    while (award_times_s.size() < game.refbox().awards().size()) {
+      award_times_s.push_back(game.time().seconds());
+    }
     for (std::size_t i = 0; i < scenario.tests.size(); ++i) {
       const auto& by = scenario.tests[i].by_s;
       if (!judged[i] && by && game.time() >= SimTime::from_seconds(*by)) {
@@ -144,6 +162,18 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   r.exploration_points = s.exploration_points;
   r.production_points = s.production_points;
   const refbox::Refbox& rb = game.refbox();
+  for (std::size_t i = 0; i < rb.awards().size(); ++i) {
+    const refbox::PointsAward& a = rb.awards()[i];
+    RunAward& w = r.awards.emplace_back();
+    w.time_s = i < award_times_s.size() ? award_times_s[i] : r.game_time_s;
+    w.game_time_s = a.game_time.seconds();
+    w.phase = std::string(refbox::to_string(a.phase));
+    w.points = a.points;
+    w.reason = std::string(refbox::to_string(a.reason));
+    if (refbox::is_valid_device(a.device)) w.device = std::string(refbox::device_name(a.device));
+    w.order = a.order.valid() ? static_cast<int>(a.order.value()) : -1;
+    w.puck = a.puck.valid() ? static_cast<int>(a.puck.value()) : -1;
+  }
   for (const refbox::PointsAward& a : rb.awards()) {
     switch (a.reason) {
       case refbox::AwardReason::kExplorationCorrect:
@@ -191,6 +221,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
     if (!judged[i]) judge(i, s.points, deliveries_of(rb));
   }
   r.tests = std::move(verdicts);
+  if (recorder) recorder->close();  // throws if the file could not be finished
   for (int i = 0; i < game.robot_count(); ++i) game.set_brain(i, nullptr);
   return r;
 }

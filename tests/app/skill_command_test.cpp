@@ -2,11 +2,14 @@
 // `llsfsim skill`: status lines with time stamps, exit codes, help, bad input.
 #include <doctest/doctest.h>
 
+#include <filesystem>
+#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "llsf/app/cli.h"
+#include "llsf/sim/recording.h"
 
 namespace {
 
@@ -93,4 +96,21 @@ TEST_CASE("llsfsim skill --trace shows the FSM states; symbolic level works the 
   CHECK(has(r.out, "explore_machine: GOTO"));
   CHECK(has(r.out, "explore_machine: READ"));
   CHECK(has(r.out, "-> M5 red="));
+}
+
+TEST_CASE("llsfsim run --record writes a readable recording; an unwritable path exits 2") {
+  const std::string rec = std::filesystem::temp_directory_path() / "llsf_app_test_run.jsonl.gz";
+  const std::string scenario = std::filesystem::temp_directory_path() / "llsf_app_test_run.yaml";
+  {
+    std::ofstream(scenario) << "name: rec\nstart: production\nduration_s: 30\nrobots:\n  count: 1\n"
+                               "  agent: [" LLSF_SOURCE_DIR "/clips/agents/common, " LLSF_SOURCE_DIR
+                               "/clips/agents/llsf2013]\n";
+  }
+  Run r = llsfsim({"run", scenario, "--no-db", "--record", rec, "-q"});
+  INFO(r.err);
+  CHECK(r.code == 0);
+  CHECK(llsf::sim::read_recording(rec).size() > 300);
+  r = llsfsim({"run", scenario, "--no-db", "--record", "/no/such/dir/x.jsonl.gz", "-q"});
+  CHECK(r.code == llsf::app::kExitBadInput);
+  CHECK(has(r.err, "cannot create the recording"));
 }

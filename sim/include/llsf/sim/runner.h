@@ -12,6 +12,7 @@
 
 #include "llsf/sim/game.h"
 #include "llsf/sim/scenario.h"
+#include "llsf/sim/skill_brain.h"
 
 namespace llsf::sim {
 
@@ -20,6 +21,19 @@ struct TestVerdict {
   std::string name;
   bool passed = false;
   std::string detail;  ///< "42 points (need >= 30 by 720 s)"
+  double at_s = 0.0;   ///< game time (s since the start) at which it was judged
+};
+
+/// One points award of the refbox, as the statistics store keeps it.
+struct RunAward {
+  double time_s = 0.0;       ///< game time since the start of the run (s)
+  double game_time_s = 0.0;  ///< the refbox's phase-relative game time (s)
+  std::string phase;         ///< "EXPLORATION", "PRODUCTION", ... (refbox::to_string)
+  int points = 0;            ///< may be negative (wrong report, penalty)
+  std::string reason;        ///< "EXPLORATION_CORRECT", ... (refbox::to_string(AwardReason))
+  std::string device;        ///< "M3", "D1", ...; "" if none
+  int order = -1;            ///< the order credited; -1 if none
+  int puck = -1;             ///< the puck concerned; -1 if none
 };
 
 /// One order as it ended.
@@ -56,6 +70,7 @@ struct RunResult {
   double real_time_factor = 0.0;
   std::uint64_t result_hash = 0;
   std::vector<TestVerdict> tests;
+  std::vector<RunAward> awards;  ///< every points award, in order
   bool passed() const;
 };
 
@@ -65,6 +80,10 @@ struct RunHooks {
   SimTime progress_every = SimTime::from_sec(30);
   /// Called at every tick after step 9 (recorders, live viewers).
   std::function<void(const Game&)> tick;
+  /// Called with every skill status change of every robot.
+  std::function<void(const SkillStatusChange&)> skill;
+  /// If set, the game is recorded to this file (docs/recording.md).
+  std::string record_path;
 };
 
 /// Plays `scenario` with `seed`. Throws clips::AgentLoadError / core::ConfigError before the

@@ -1,0 +1,208 @@
+// SPDX-License-Identifier: MIT
+// `llsfsim batch`: every matrix variant of scenarios x N seeds on worker threads, stored in the
+// statistics store run by run; resumable; a progress bar and a per-variant summary.
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <csignal>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "commands.h"
+#include "llsf/app/cli.h"
+#include "llsf/clips/agent.h"
+#include "llsf/core/error.h"
+#include "llsf/sim/batch.h"
+#include "llsf/sim/scenario.h"
+#include "llsf/sim/stats_store.h"
+
+namespace llsf::app {
+
+namespace {
+
+/// Exit code of a batch stopped by Ctrl-C (128 + SIGINT, the shell's convention).
+constexpr int kExitInterrupted = 130;
+
+struct BatchCommandOptions {
+  std::vector<std::string> scenarios;
+  std::optional<int> runs;
+  std::optional<int> jobs;
+  std::string db{sim::StatsStore::kDefaultPath};
+  bool quiet = false;
+};
+
+// Set by the SIGINT handler; a lock-free atomic may be written from a signal handler.
+std::atomic<bool> g_interrupted{false};
+static_assert(std::atomic<bool>::is_always_lock_free);
+
+extern "C" void on_sigint(int) { g_interrupted.store(true); }
+
+// Installs on_sigint for the batch's lifetime. SA_RESETHAND: a second Ctrl-C gets the default
+// action and ends the process at once (SQLite rolls back the run being written).
+class SigintGuard {
+ public:
+  SigintGuard() {
+    g_interrupted = false;
+    struct sigaction sa {};
+    sa.sa_handler = &on_sigint;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = SA_RESETHAND;
+    installed_ = sigaction(SIGINT, &sa, &old_) == 0;
+  }
+  ~SigintGuard() {
+    if (installed_) sigaction(SIGINT, &old_, nullptr);
+  }
+  SigintGuard(const SigintGuard&) = delete;
+  SigintGuard& operator=(const SigintGuard&) = delete;
+
+ private:
+  struct sigaction old_ {};
+  bool installed_ = false;
+};
+
+std::string duration(double s) {
+  const long t = static_cast<long>(s + 0.5);
+  if (t >= 3600) return fmt::format("{}h{:02}m", t / 3600, t / 60 % 60);
+  return fmt::format("{}m{:02}s", t / 60, t % 60);
+}
+
+struct Loaded {
+  std::string path;
+  sim::ScenarioFile file;
+  std::string hash;
+};
+
+void print_summary(const Loaded& l, const sim::BatchResult& b, const std::string& db,
+                   std::ostream& out) {
+  out << fmt::format("batch      {} ({}) #{} in {}: {} runs, {} played, {} stored before\n",
+                     l.file.variants.front().name, l.path, b.batch_id, db, b.total, b.played,
+                     b.skipped);
+  out << fmt::format("{:<32} {:>5} {:>7} {:>7} {:>7} {:>5} {:>5}\n", "variant", "runs", "passed",
+                     "mean", "median", "min", "max");
+  int runs = 0;
+  int failed = 0;
+  for (const sim::VariantSummary& v : b.variants) {
+    out << fmt::format("{:<32} {:>5} {:>7} {:>7.1f} {:>7.1f} {:>5} {:>5}\n",
+                       v.variant.empty() ? "-" : v.variant, v.runs,
+                       fmt::format("{}/{}", v.passed, v.runs), v.mean_points, v.median_points,
+                       v.min_points, v.max_points);
+    runs += v.runs;
+    failed += v.runs - v.passed;
+  }
+  if (b.interrupted) {
+    out << fmt::format(
+        "result     interrupted: {} of {} runs stored; the same command plays the rest\n", runs,
+        b.total);
+  } else if (failed == 0) {
+    out << fmt::format("result     all {} runs passed their test cases\n", runs);
+  } else {
+    out << fmt::format("result     {} of {} runs failed a test case\n", failed, runs);
+  }
+}
+
+int batch(const BatchCommandOptions& o, std::ostream& out, std::ostream& err) {
+  // Load and check everything before the first game: bad input costs no time.
+  std::vector<Loaded> loaded;
+  try {
+    for (const std::string& path : o.scenarios) {
+      Loaded l{path, sim::load_scenario(path), sim::file_content_hash(path)};
+      for (const sim::Scenario& s : l.file.variants) (void)sim::batch_seeds(s, o.runs);
+      loaded.push_back(std::move(l));
+    }
+  } catch (const std::exception& e) {
+    err << "llsfsim batch: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  std::optional<sim::StatsStore> store;
+  try {
+    store.emplace(o.db);
+  } catch (const sim::StatsError& e) {
+    err << "llsfsim batch: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+
+  // A bar on a terminal; otherwise (logs, tests) one line per stored run.
+  const bool bar = &err == &std::cerr && isatty(STDERR_FILENO) != 0 && !o.quiet;
+  const SigintGuard sigint;
+  bool all_passed = true;
+  for (const Loaded& l : loaded) {
+    sim::BatchOptions options;
+    options.runs = o.runs;
+    options.jobs = o.jobs.value_or(0);
+    sim::BatchHooks hooks;
+    hooks.stop = &g_interrupted;
+    bool told = false;
+    hooks.stored = [&](const sim::RunResult& r, const sim::BatchProgress& p) {
+      if (o.quiet) return;
+      const double eta = p.done > 0 ? p.elapsed_s / p.done * (p.to_play - p.done) : 0.0;
+      if (bar) {
+        constexpr int kWidth = 30;
+        const int filled = p.to_play > 0 ? kWidth * p.done / p.to_play : kWidth;
+        err << fmt::format("\r[{}{}] {}/{} runs, {} failed, {} elapsed, ETA {}   ",
+                           std::string(static_cast<std::size_t>(filled), '#'),
+                           std::string(static_cast<std::size_t>(kWidth - filled), '.'), p.done,
+                           p.to_play, p.failed, duration(p.elapsed_s), duration(eta));
+        if (p.done == p.to_play) err << "\n";
+      } else {
+        err << fmt::format("[{}/{}] {}{}seed {}: {} points, {}, result {:016x}, ETA {}\n", p.done,
+                           p.to_play, r.variant, r.variant.empty() ? "" : " ", r.seed, r.points,
+                           r.passed() ? "PASS" : "FAIL", r.result_hash, duration(eta));
+      }
+      if (g_interrupted && !told) {
+        err << (bar ? "\n" : "")
+            << "llsfsim batch: interrupted; storing the running games (Ctrl-C again abandons "
+               "them)\n";
+        told = true;
+      }
+      err.flush();
+    };
+    sim::BatchResult b;
+    try {
+      b = sim::run_batch(l.file, l.hash, *store, options, hooks);
+    } catch (const clips::AgentLoadError& e) {
+      err << "llsfsim batch: agent error:\n" << e.what() << "\n";
+      return kExitBadInput;
+    } catch (const core::ConfigError& e) {
+      err << "llsfsim batch: " << e.what() << "\n";
+      return kExitBadInput;
+    }
+    if (bar && b.interrupted) err << "\n";
+    if (!o.quiet) print_summary(l, b, o.db, out);
+    if (b.interrupted) return kExitInterrupted;
+    all_passed = all_passed && b.all_passed();
+  }
+  return all_passed ? kExitOk : kExitFailed;
+}
+
+}  // namespace
+
+Action add_batch_command(CLI::App& app) {
+  auto o = std::make_shared<BatchCommandOptions>();
+  app.add_option("scenarios", o->scenarios, "Scenario files (docs/scenarios.md)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  app.add_option("--runs", o->runs,
+                 "Seeds per variant: the first N of the scenario's list, or s..s+N-1 for a "
+                 "single seed s (default: the scenario's seeds)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--jobs,-j", o->jobs, "Games played at once (default: the number of cores)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--db", o->db, "Statistics store (SQLite; docs/statistics.md)")
+      ->capture_default_str();
+  app.add_flag("-q,--quiet", o->quiet, "No progress and no summary, only the exit code");
+  app.footer(
+      "Plays every matrix variant x N seeds of each scenario on worker threads and stores every "
+      "run in the statistics store. Resumable: runs the store already holds for the same "
+      "scenario file content and --runs are not played again; Ctrl-C stores the running games "
+      "and stops.\n"
+      "Exit code: 0 every run passed its test cases, 1 one failed, 2 bad input, 130 "
+      "interrupted.");
+  return [o](std::ostream& out, std::ostream& err) { return batch(*o, out, err); };
+}
+
+}  // namespace llsf::app

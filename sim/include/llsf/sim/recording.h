@@ -1,0 +1,70 @@
+// SPDX-License-Identifier: MIT
+// Recordings of games for replay (the viewer) and analysis: the poses of every robot (true and
+// believed) and puck at 10 Hz plus every event -- refbox phases and points, lamp changes, RFID,
+// collisions, skill status changes, radio drops -- in gzip-compressed JSON lines, versioned.
+// docs/recording.md documents the format.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "llsf/core/sim_time.h"
+#include "llsf/sim/game.h"
+#include "llsf/sim/skill_brain.h"
+
+namespace llsf::sim {
+
+/// Version of the recording format written by Recorder.
+inline constexpr int kRecordingVersion = 1;
+
+/// Identity of a recorded game (the header line).
+struct RecordingInfo {
+  std::string scenario;
+  std::string variant;
+  std::uint64_t seed = 0;
+  std::string llsfsim_version = "0.1.0";
+};
+
+/// Writes a recording while a game runs. Call frame() after every tick (e.g. from
+/// RunHooks::tick) and skill() from the skill brains' listeners; close() (or the destructor)
+/// finishes the file. Throws std::runtime_error if the file cannot be written.
+class Recorder {
+ public:
+  /// `pose_rate_hz`: pose frames per simulated second (default 10).
+  Recorder(const std::string& path, const Game& game, const RecordingInfo& info,
+           double pose_rate_hz = 10.0);
+  ~Recorder();
+  Recorder(const Recorder&) = delete;
+  Recorder& operator=(const Recorder&) = delete;
+
+  /// Takes the events of the last tick, and a pose frame when one is due.
+  void frame(const Game& game);
+  /// A skill status change of a robot.
+  void skill(const SkillStatusChange& change);
+  /// A free-form event from an agent or tool ({"t":..,"e":"note","robot":..,"text":..}).
+  void note(SimTime t, const std::string& robot, const std::string& text);
+  /// Flushes and closes the file (idempotent).
+  void close();
+  /// Lines written so far.
+  std::int64_t lines() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// One parsed line of a recording (tests, tools): its time, its kind ("header", "frame", or the
+/// event name) and the raw JSON text.
+struct RecordingLine {
+  double t = 0.0;
+  std::string kind;
+  std::string json;
+};
+
+/// Reads a recording (gzip or plain). Throws std::runtime_error naming the file and line for a
+/// missing file, a corrupt stream, a line that is not a JSON object, or an unknown version.
+std::vector<RecordingLine> read_recording(const std::string& path);
+
+}  // namespace llsf::sim

@@ -1,0 +1,134 @@
+// SPDX-License-Identifier: MIT
+// StatsStore: the statistics of played games in one SQLite file (default `llsfsim.db`) --
+// batches, runs, every numeric result, orders, test verdicts, points awards and events. Each run
+// is written in one transaction: an interrupted batch never leaves half a run. docs/statistics.md
+// documents the schema.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "llsf/sim/runner.h"
+
+namespace llsf::sim {
+
+/// The store could not be opened, read or written (the message names the file and SQLite's
+/// reason).
+class StatsError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// The version of llsfsim recorded with every run ("0.1.0").
+std::string_view llsfsim_version();
+
+/// What identifies a batch and what is recorded with it.
+struct BatchKey {
+  enum class Kind : std::uint8_t {
+    kBatch,  ///< `llsfsim batch`: every variant x runs_per_variant seeds
+    kRun,    ///< `llsfsim run`: single games of one scenario file, one batch per file content
+  };
+  Kind kind = Kind::kBatch;
+  std::string scenario_file;  ///< the path as given (metadata)
+  std::string scenario_name;
+  std::string scenario_hash;  ///< file_content_hash() of the scenario file (identity)
+  int runs_per_variant = 0;   ///< identity; 0 for kRun
+  int variants = 1;
+  std::vector<std::uint64_t> seeds;  ///< the first variant's seeds (metadata)
+};
+
+/// A stored batch.
+struct StoredBatch {
+  std::int64_t id = 0;
+  std::string kind;      ///< "batch" or "run"
+  std::string created;   ///< UTC, ISO 8601 (wall clock; metadata only)
+  std::string finished;  ///< when its last missing run was stored; "" while incomplete
+  std::string scenario_file;
+  std::string scenario_name;
+  std::string scenario_hash;
+  int runs_per_variant = 0;
+  int variants = 0;
+  std::string seeds;  ///< "1,2,3"
+};
+
+/// A stored run (one row of `runs`).
+struct StoredRun {
+  std::int64_t id = 0;
+  std::int64_t batch_id = 0;
+  std::string scenario;
+  std::string variant;
+  std::uint64_t seed = 0;
+  std::string llsfsim_version;
+  std::uint64_t result_hash = 0;
+  bool passed = false;
+  int points = 0;
+  double game_time_s = 0.0;
+  double cpu_s = 0.0;
+  double real_time_factor = 0.0;
+};
+
+/// The statistics database. Not thread-safe: one thread writes (a batch queues its results to
+/// the thread that owns the store). Several processes may share a file (SQLite locks it; a
+/// writer waits up to 10 s).
+class StatsStore {
+ public:
+  /// The default file, in the current directory.
+  static constexpr std::string_view kDefaultPath = "llsfsim.db";
+
+  /// Opens `path` (created if missing) and creates the schema if the file is new. Throws
+  /// StatsError if the file cannot be opened or holds another schema version.
+  explicit StatsStore(const std::string& path);
+  ~StatsStore();
+  StatsStore(const StatsStore&) = delete;
+  StatsStore& operator=(const StatsStore&) = delete;
+  StatsStore(StatsStore&&) noexcept;
+  StatsStore& operator=(StatsStore&&) noexcept;
+
+  /// The file's path.
+  const std::string& path() const;
+
+  /// The id of the batch with `key`'s identity (kind, scenario_hash, runs_per_variant), created
+  /// if there is none.
+  std::int64_t open_batch(const BatchKey& key);
+  /// Marks a batch complete (sets `finished` to now, once).
+  void finish_batch(std::int64_t batch_id);
+  /// The batch `batch_id`, if it exists.
+  std::optional<StoredBatch> batch(std::int64_t batch_id) const;
+
+  /// Writes `r` with its statistics, orders, test verdicts, awards and events in one
+  /// transaction; returns the run's id. With `replace`, an earlier run of the same (batch,
+  /// variant, seed) is deleted in the same transaction; without, such a run is an error. On
+  /// any error nothing of the run is written (StatsError).
+  std::int64_t add_run(std::int64_t batch_id, const RunResult& r, bool replace = false);
+
+  /// The runs of a batch, by id.
+  std::vector<StoredRun> runs(std::int64_t batch_id) const;
+  /// The (variant, seed) pairs of a batch's stored runs.
+  std::vector<std::pair<std::string, std::uint64_t>> run_keys(std::int64_t batch_id) const;
+  /// A run's statistics (name, value), by name.
+  std::vector<std::pair<std::string, double>> statistics(std::int64_t run_id) const;
+  /// A run's points awards, in order.
+  std::vector<RunAward> awards(std::int64_t run_id) const;
+  /// Rows in `table` (one of the schema's tables; tests and reports).
+  std::int64_t count_rows(std::string_view table) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// FNV-1a 64 of the file's bytes as 16 hex digits: a batch's identity. Throws StatsError if the
+/// file cannot be read.
+std::string file_content_hash(const std::string& path);
+
+/// The statistics of `r` by name, in the order of docs/statistics.md: every numeric field of
+/// RunResult (points, exploration_points, ..., cpu_s, real_time_factor).
+std::vector<std::pair<std::string, double>> numeric_statistics(const RunResult& r);
+
+}  // namespace llsf::sim

@@ -1,0 +1,240 @@
+// SPDX-License-Identifier: MIT
+// `llsfsim batch` and `llsfsim run --db`: runs stored, resume, --jobs 1 vs 2 give the same
+// results, interruption, bad input.
+#include <doctest/doctest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "llsf/app/cli.h"
+#include "llsf/sim/batch.h"
+#include "llsf/sim/scenario.h"
+#include "llsf/sim/stats_store.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Run {
+  int code = -1;
+  std::string out;
+  std::string err;
+};
+
+Run llsfsim(std::vector<std::string> args) {
+  args.insert(args.begin(), "llsfsim");
+  std::ostringstream out;
+  std::ostringstream err;
+  Run r;
+  r.code = llsf::app::run(args, out, err);
+  r.out = out.str();
+  r.err = err.str();
+  return r;
+}
+
+bool has(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+/// A fresh directory, removed with everything in it at the end of the test.
+struct TempDir {
+  fs::path path;
+  TempDir() {
+    static int counter = 0;
+    path = fs::temp_directory_path() /
+           ("llsf_batch_test_" + std::to_string(getpid()) + "_" + std::to_string(counter++));
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~TempDir() { fs::remove_all(path); }
+  std::string file(const std::string& name) const { return (path / name).string(); }
+};
+
+/// A tiny scenario: 120 s of production (a few points each), two robots with the 2013 team agent, 2
+/// variants x 2 seeds. `tests` is the YAML of the test cases.
+std::string write_tiny(const TempDir& dir, const std::string& tests = "  - no_agent_errors: true\n",
+                       const std::string& name = "tiny.yaml") {
+  const std::string agents = std::string(LLSF_SOURCE_DIR) + "/clips/agents";
+  std::ofstream f(dir.file(name));
+  f << "name: tiny\n"
+       "seeds: [3, 4]\n"
+       "start: production\n"
+       "duration_s: 120\n"
+       "robots:\n"
+       "  count: 2\n"
+       "  agent: ["
+    << agents << "/common, " << agents
+    << "/llsf2013]\n"
+       "  config:\n"
+       "    roles: [P1P2, P3]\n"
+       "    recycle: never\n"
+       "matrix:\n"
+       "  config:\n"
+       "    P3-P3: {robots.config.roles: [P3, P3]}\n"
+       "    P1P2-P3: {}\n"
+       "tests:\n"
+    << tests;
+  return dir.file(name);
+}
+
+using Key = std::tuple<std::string, std::uint64_t, std::uint64_t>;  // variant, seed, hash
+
+std::vector<Key> stored_runs(const std::string& db) {
+  llsf::sim::StatsStore store(db);
+  std::vector<Key> out;
+  for (std::int64_t batch = 1; batch <= 10; ++batch) {
+    for (const auto& r : store.runs(batch)) out.emplace_back(r.variant, r.seed, r.result_hash);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("llsfsim batch plays variants x seeds once, stores them, and resumes") {
+  const TempDir dir;
+  const std::string scenario = write_tiny(dir);
+  const std::string db1 = dir.file("one.db");
+  const std::string db2 = dir.file("two.db");
+
+  Run r = llsfsim({"batch", scenario, "--jobs", "2", "--db", db2});
+  INFO(r.out, r.err);
+  CHECK(r.code == llsf::app::kExitOk);
+  CHECK(has(r.out, "4 runs, 4 played, 0 stored before"));
+  CHECK(has(r.out, "config=P3-P3"));
+  CHECK(has(r.out, "config=P1P2-P3"));
+  CHECK(has(r.out, "all 4 runs passed"));
+  CHECK(has(r.err, "[4/4] "));
+  const std::vector<Key> two = stored_runs(db2);
+  REQUIRE(two.size() == 4);
+  CHECK(std::get<0>(two[0]) == "config=P1P2-P3");
+  CHECK(std::get<1>(two[0]) == 3);
+  CHECK(std::get<1>(two[1]) == 4);
+  {
+    llsf::sim::StatsStore store(db2);
+    CHECK(store.count_rows("batches") == 1);
+    CHECK(!store.batch(1)->finished.empty());
+    CHECK(store.count_rows("statistics") ==
+          4 * static_cast<std::int64_t>(llsf::sim::numeric_statistics({}).size()));
+    CHECK(store.count_rows("tests") == 4);
+    CHECK(store.count_rows("awards") > 0);  // machines completed, products delivered
+    CHECK(store.count_rows("events") == store.count_rows("awards") + 4);
+  }
+
+  // Again: nothing new is played, the summary covers the stored runs.
+  r = llsfsim({"batch", scenario, "--jobs", "2", "--db", db2});
+  CHECK(r.code == llsf::app::kExitOk);
+  CHECK(has(r.out, "4 runs, 0 played, 4 stored before"));
+  CHECK(stored_runs(db2) == two);
+
+  // One worker: the same result hashes.
+  r = llsfsim({"batch", scenario, "--jobs", "1", "--db", db1});
+  CHECK(r.code == llsf::app::kExitOk);
+  CHECK(stored_runs(db1) == two);
+
+  // --runs 1: another batch (first seed of each variant), same results for those seeds.
+  r = llsfsim({"batch", scenario, "--runs", "1", "--db", db1});
+  CHECK(r.code == llsf::app::kExitOk);
+  CHECK(has(r.out, "2 runs, 2 played, 0 stored before"));
+  CHECK(stored_runs(db1).size() == 6);
+}
+
+TEST_CASE("llsfsim batch: an interrupted batch keeps its runs and the next call plays the rest") {
+  const TempDir dir;
+  const std::string scenario = write_tiny(dir);
+  const llsf::sim::ScenarioFile file = llsf::sim::load_scenario(scenario);
+  const std::string hash = llsf::sim::file_content_hash(scenario);
+  llsf::sim::StatsStore store(dir.file("stats.db"));
+
+  std::atomic<bool> stop{false};
+  llsf::sim::BatchHooks hooks;
+  hooks.stop = &stop;
+  hooks.stored = [&](const llsf::sim::RunResult&, const llsf::sim::BatchProgress&) {
+    stop = true;  // as a Ctrl-C after the first stored run
+  };
+  llsf::sim::BatchOptions options;
+  options.jobs = 1;
+  llsf::sim::BatchResult b = llsf::sim::run_batch(file, hash, store, options, hooks);
+  CHECK(b.interrupted);
+  // The one worker may have started the next game before the first was stored; it finishes.
+  const int first = b.played;
+  CHECK(first >= 1);
+  CHECK(first <= 2);
+  CHECK(b.total == 4);
+  CHECK(store.count_rows("runs") == first);
+  CHECK(store.batch(b.batch_id)->finished.empty());
+
+  b = llsf::sim::run_batch(file, hash, store, options);
+  CHECK(!b.interrupted);
+  CHECK(b.skipped == first);
+  CHECK(b.played == 4 - first);
+  CHECK(store.count_rows("runs") == 4);
+  CHECK(!store.batch(b.batch_id)->finished.empty());
+  REQUIRE(b.variants.size() == 2);
+  CHECK(b.variants[0].variant == "config=P3-P3");  // matrix order
+  CHECK(b.variants[0].runs == 2);
+  CHECK(b.all_passed());
+}
+
+TEST_CASE("llsfsim batch: a failed test case exits 1, bad input exits 2") {
+  const TempDir dir;
+  const std::string failing = write_tiny(dir, "  - points_at_least: 1000\n", "failing.yaml");
+  Run r = llsfsim({"batch", failing, "--runs", "1", "--db", dir.file("f.db")});
+  CHECK(r.code == llsf::app::kExitFailed);
+  CHECK(has(r.out, "2 of 2 runs failed"));
+  CHECK(has(r.err, "FAIL"));
+
+  std::ofstream(dir.file("bad.yaml")) << "name: bad\nduration_s: -5\n";
+  r = llsfsim({"batch", dir.file("bad.yaml"), "--db", dir.file("b.db")});
+  CHECK(r.code == llsf::app::kExitBadInput);
+  CHECK(has(r.err, "duration_s"));
+  CHECK(!fs::exists(dir.file("b.db")));  // nothing written before the input is checked
+
+  const std::string tiny = write_tiny(dir);
+  r = llsfsim({"batch", tiny, "--runs", "3", "--db", dir.file("b.db")});
+  CHECK(r.code == llsf::app::kExitBadInput);
+  CHECK(has(r.err, "lists 2 seeds"));
+  r = llsfsim({"batch", tiny, "--jobs", "0"});
+  CHECK(r.code == llsf::app::kExitBadInput);
+  r = llsfsim({"batch", dir.file("missing.yaml")});
+  CHECK(r.code == llsf::app::kExitBadInput);
+  r = llsfsim({"batch", tiny, "--db", dir.file("no/such/dir/x.db")});
+  CHECK(r.code == llsf::app::kExitBadInput);
+  CHECK(has(r.err, "x.db"));
+}
+
+TEST_CASE("llsfsim run stores its game with --db, not with --no-db") {
+  const TempDir dir;
+  const std::string scenario = write_tiny(dir);
+  const std::string db = dir.file("run.db");
+  Run r = llsfsim({"run", scenario, "--quiet", "--db", db});
+  CHECK(r.code == llsf::app::kExitOk);
+  std::vector<Key> runs = stored_runs(db);
+  REQUIRE(runs.size() == 1);
+  CHECK(std::get<0>(runs[0]) == "config=P3-P3");
+  CHECK(std::get<1>(runs[0]) == 3);
+
+  // The same game again replaces the stored one; another seed adds one.
+  CHECK(llsfsim({"run", scenario, "--quiet", "--db", db}).code == llsf::app::kExitOk);
+  CHECK(stored_runs(db) == runs);
+  CHECK(llsfsim({"run", scenario, "--quiet", "--seed", "9", "--db", db}).code ==
+        llsf::app::kExitOk);
+  CHECK(stored_runs(db).size() == 2);
+  {
+    llsf::sim::StatsStore store(db);
+    CHECK(store.batch(1)->kind == "run");
+  }
+
+  const std::string other = dir.file("other.db");
+  CHECK(llsfsim({"run", scenario, "--quiet", "--no-db", "--db", other}).code ==
+        llsf::app::kExitBadInput);  // they exclude each other
+  CHECK(llsfsim({"run", scenario, "--quiet", "--no-db"}).code == llsf::app::kExitOk);
+  CHECK(!fs::exists(other));
+}

@@ -1,0 +1,102 @@
+// SPDX-License-Identifier: MIT
+// Recordings: a full game is recorded compactly (poses at 10 Hz, events), read back, and bad
+// files are reported with file and line.
+#include <doctest/doctest.h>
+#include <unistd.h>
+#include <zlib.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+
+#include "llsf/sim/recording.h"
+#include "llsf/sim/runner.h"
+#include "llsf/sim/scenario.h"
+
+using namespace llsf;
+using namespace llsf::sim;
+
+namespace {
+
+std::filesystem::path temp_dir() {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("llsf_recording_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+}  // namespace
+
+TEST_CASE("a full game is recorded: 10 Hz frames, events, well under 5 MB, readable") {
+  const ScenarioFile f = load_scenario(LLSF_SOURCE_DIR "/scenarios/default.yaml");
+  const std::string path = (temp_dir() / "default.jsonl.gz").string();
+  RunHooks hooks;
+  hooks.record_path = path;
+  const RunResult r = run_game(f.variants[0], 3, hooks);
+  const auto bytes = std::filesystem::file_size(path);
+  MESSAGE("recording of a 1080 s game: ", bytes, " bytes");
+  CHECK(bytes < 5u * 1024u * 1024u);
+  const std::vector<RecordingLine> lines = read_recording(path);
+  REQUIRE(lines.size() > 10000);
+  CHECK(lines[0].kind == "header");
+  CHECK(lines[0].json.find("\"robots\": [\"robot1\", \"robot2\", \"robot3\"]") !=
+        std::string::npos);
+  std::map<std::string, int> kinds;
+  double last_t = 0.0;
+  bool ordered = true;
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    ++kinds[lines[i].kind];
+    ordered = ordered && lines[i].t + 1e-9 >= last_t;
+    last_t = lines[i].t;
+  }
+  CHECK(ordered);
+  // 10 Hz over 1080 s (+ the frame at t = 0.01).
+  CHECK(kinds["frame"] >= 10800);
+  CHECK(kinds["frame"] <= 10802);
+  CHECK(kinds["game"] >= 2);  // EXPLORATION, PRODUCTION (POST_GAME comes after the last tick)
+  CHECK(kinds["plan"] == 1);
+  CHECK(kinds["lights"] > 16);
+  CHECK(kinds["rfid"] > 0);
+  CHECK(kinds["skill"] > 0);
+  CHECK(kinds["puck"] > 20);
+  CHECK(kinds["order"] > 0);
+  int award_points = 0;
+  for (const RecordingLine& l : lines) {
+    if (l.kind != "award") continue;
+    const auto p = l.json.find("\"points\": ");
+    award_points += std::stoi(l.json.substr(p + 10));
+  }
+  CHECK(award_points == r.exploration_points + r.production_points);
+}
+
+TEST_CASE("bad recordings: missing, corrupt, wrong version, not JSON") {
+  const auto dir = temp_dir();
+  CHECK_THROWS_WITH(read_recording((dir / "missing.gz").string()),
+                    doctest::Contains("cannot open"));
+  {
+    std::ofstream((dir / "v9.jsonl").string())
+        << "{\"format\": \"llsfsim-recording\", \"version\": 9}\n";
+  }
+  CHECK_THROWS_WITH(read_recording((dir / "v9.jsonl").string()),
+                    doctest::Contains("v9.jsonl:1: recording version 9"));
+  {
+    std::ofstream((dir / "garbage.jsonl").string())
+        << "{\"format\": \"llsfsim-recording\", \"version\": 1}\nhello\n";
+  }
+  CHECK_THROWS_WITH(read_recording((dir / "garbage.jsonl").string()),
+                    doctest::Contains("garbage.jsonl:2: not a JSON object"));
+  {
+    // A gzip stream cut in the middle.
+    const std::string good = (dir / "good.gz").string();
+    gzFile g = gzopen(good.c_str(), "wb");
+    std::string body = "{\"format\": \"llsfsim-recording\", \"version\": 1}\n";
+    for (int i = 0; i < 2000; ++i) body += "{\"t\": " + std::to_string(i) + ".00, \"f\": 1, \"r\": []}\n";
+    gzwrite(g, body.data(), static_cast<unsigned>(body.size()));
+    gzclose(g);
+    std::ifstream in(good, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::ofstream((dir / "cut.gz").string(), std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  }
+  CHECK_THROWS_WITH(read_recording((dir / "cut.gz").string()), doctest::Contains("cut.gz:"));
+}
