@@ -4,11 +4,13 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdio>
 #include <memory>
 #include <optional>
 #include <ostream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "commands.h"
@@ -33,6 +35,8 @@ struct RunOptions {
   std::string db{sim::StatsStore::kDefaultPath};
   bool no_db = false;
   std::string record;
+  double speed = 0.0;  ///< 0: as fast as possible; else game seconds per wall second
+  bool realtime = false;
 };
 
 const sim::Scenario* pick_variant(const sim::ScenarioFile& f, const std::string& name,
@@ -114,6 +118,17 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
   }
   sim::RunHooks hooks;
   hooks.record_path = o.record;
+  // Paced mode: sleep between ticks so that game time runs `speed` times as fast as the wall
+  // clock (the wall clock only paces; it never enters the game).
+  const double speed = o.realtime ? 1.0 : o.speed;
+  if (speed > 0.0) {
+    const auto wall_start = std::chrono::steady_clock::now();
+    hooks.tick = [speed, wall_start](const sim::Game& g) {
+      const auto due = wall_start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                        std::chrono::duration<double>(g.time().seconds() / speed));
+      std::this_thread::sleep_until(due);
+    };
+  }
   const bool tty = isatty(STDERR_FILENO) != 0 && !o.quiet && !o.json;
   if (tty) {
     hooks.progress_every = core::SimTime::from_sec(10);
@@ -204,6 +219,10 @@ Action add_run_command(CLI::App& app) {
                             "Statistics store (SQLite) the run is written to (docs/statistics.md)")
                  ->capture_default_str();
   app.add_flag("--no-db", o->no_db, "Do not write the run to a statistics store")->excludes(db);
+  auto* speed = app.add_option("--speed", o->speed,
+                               "Paced: play X game seconds per wall-clock second (e.g. 4)")
+                    ->check(CLI::PositiveNumber);
+  app.add_flag("--realtime", o->realtime, "Paced at real time (= --speed 1)")->excludes(speed);
   app.add_option("--record", o->record,
                  "Write a recording of the game to FILE (gzip JSON lines, docs/recording.md; "
                  "e.g. game.jsonl.gz)");

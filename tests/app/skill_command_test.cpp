@@ -2,6 +2,7 @@
 // `llsfsim skill`: status lines with time stamps, exit codes, help, bad input.
 #include <doctest/doctest.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -113,4 +114,26 @@ TEST_CASE("llsfsim run --record writes a readable recording; an unwritable path 
   r = llsfsim({"run", scenario, "--no-db", "--record", "/no/such/dir/x.jsonl.gz", "-q"});
   CHECK(r.code == llsf::app::kExitBadInput);
   CHECK(has(r.err, "cannot create the recording"));
+}
+
+TEST_CASE("llsfsim run --speed paces the game and gives the same result as unpaced") {
+  const std::string scenario = std::filesystem::temp_directory_path() / "llsf_app_test_speed.yaml";
+  {
+    std::ofstream(scenario)
+        << "name: speed\nstart: production\nduration_s: 10\nrobots:\n  count: 1\n"
+           "  agent: [" LLSF_SOURCE_DIR "/clips/agents/common, " LLSF_SOURCE_DIR
+           "/clips/agents/llsf2013]\n";
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  const Run paced = llsfsim({"run", scenario, "--no-db", "--json", "--speed", "40"});
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  CHECK(paced.code == 0);
+  CHECK(wall >= 0.24);  // 10 s of game at 40x: at least 0.25 s (minus a tick)
+  const Run fast = llsfsim({"run", scenario, "--no-db", "--json"});
+  auto hash = [](const std::string& json) {
+    const auto p = json.find("\"result_hash\"");
+    return json.substr(p, 40);
+  };
+  CHECK(hash(paced.out) == hash(fast.out));
+  CHECK(llsfsim({"run", scenario, "--speed", "0"}).code == llsf::app::kExitBadInput);
 }
