@@ -17,6 +17,8 @@
 #include "llsf/refbox/protocol.h"
 #include "llsf/sim/agent_brain.h"
 #include "llsf/sim/game.h"
+#include "llsf/sim/runner.h"
+#include "llsf/sim/scenario.h"
 
 using namespace llsf;
 
@@ -167,4 +169,28 @@ LLSF_BENCH(
   report_series("agent_compare_roles_P3-P3-P3", 0.0, true, p3);
   report_series("agent_compare_auction", 0.0, true, AgentVariant{"auction", {}});
   report_series("agent_compare_auction_loss20", 0.2, true, AgentVariant{"auction", {}});
+}
+
+LLSF_BENCH(full_game,
+           "scenarios/default.yaml: a whole 3-robot game (1080 s), CPU and where the tick goes") {
+  const sim::ScenarioFile f = sim::load_scenario(LLSF_SOURCE_DIR "/scenarios/default.yaml");
+  sim::RunHooks plain;
+  std::vector<sim::RunResult> runs;
+  const double cpu = bench::median_of(5, [&] {
+    runs.push_back(sim::run_game(f.variants[0], 1, plain));
+    return runs.back().cpu_s;
+  });
+  bench::report("full_game", "cpu_s", cpu, "s");
+  bench::report("full_game", "real_time_factor", 1080.0 / cpu, "x");
+  bench::report("full_game", "points", runs.back().points, "points");
+  // The split, from one profiled run (the clock reads add a little).
+  sim::RunHooks prof;
+  prof.profile = true;
+  const sim::RunResult p = sim::run_game(f.variants[0], 1, prof);
+  double total = 0.0;
+  for (const auto& [name, s] : p.time_split) total += s;
+  for (const auto& [name, s] : p.time_split) {
+    if (s <= 0.0) continue;
+    bench::report("full_game", "share_" + name, s / total, "fraction");
+  }
 }

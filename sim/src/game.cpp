@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "llsf/sim/game.h"
 
+#include <chrono>
+
 #include <llsf_log_msgs/LogMessage.pb.h>
 #include <llsf_msgs/AttentionMessage.pb.h>
 #include <llsf_msgs/BeaconSignal.pb.h>
@@ -255,6 +257,16 @@ void Game::apply_symbolic(int robot) {
 }
 
 void Game::step() {
+  // Optional profile of the tick's steps (steady clock; a measurement, never a game input).
+  std::chrono::steady_clock::time_point last;
+  if (profiling_) last = std::chrono::steady_clock::now();
+  auto mark = [&](int step) {
+    if (!profiling_) return;
+    const auto t = std::chrono::steady_clock::now();
+    profile_.ns[static_cast<std::size_t>(step)] += (t - last).count();
+    last = t;
+  };
+
   // 1. Time advances by the physics step; everything in this tick happens at `now`.
   const SimTime now = world_->time() + config_.world.physics.step;
   const int n = robot_count();
@@ -276,6 +288,8 @@ void Game::step() {
                         stacks_[static_cast<std::size_t>(i)]->actuate(now, others_));
   }
 
+  mark(1);
+
   // 3. The world steps; collisions are counted, RFID events become the refbox's.
   events_ = &world_->step();
   LLSF_ASSERT(world_->time() == now);
@@ -287,6 +301,8 @@ void Game::step() {
     // The world's and the refbox's device ids are the same indices 0..15, puck ids the same.
     rfid_.push_back({e.device, e.puck, e.kind == kinematic::RfidEventKind::kEntered});
   }
+
+  mark(2);
 
   // 4. Refbox: RFID events and the messages received last tick in; lights, referee actions and
   //    messages out.
@@ -301,6 +317,8 @@ void Game::step() {
       hub_->broadcast(refbox_peer_, *o.message, now);
     }
   }
+
+  mark(3);
 
   // 5. Comm: beacons, then deliveries whose delay has passed.
   for (int i = 0; i < n; ++i) {
@@ -363,6 +381,8 @@ void Game::step() {
     }
   }
 
+  mark(4);
+
   // 6. Sensors: what each robot perceives, at its abstraction levels.
   for (int i = 0; i < kinematic::kDeviceCount; ++i) {
     lights_[static_cast<std::size_t>(i)] = world_->lights(core::DeviceId(i));
@@ -383,6 +403,8 @@ void Game::step() {
     stacks_[static_cast<std::size_t>(i)]->sense(p);
   }
 
+  mark(5);
+
   // 7. Skills.
   if (now >= next_skill_) {
     next_skill_ += skill_period_;
@@ -390,6 +412,8 @@ void Game::step() {
       if (s->brain() != nullptr) s->brain()->on_skill_cycle(*s);
     }
   }
+
+  mark(6);
 
   // 8. Agents (their inboxes are emptied after each cycle, brain or not).
   if (now >= next_agent_) {
@@ -400,9 +424,20 @@ void Game::step() {
     }
   }
 
+  mark(7);
+
   // 9. Recorder and statistics.
   ++ticks_;
   if (tick_hook_) tick_hook_(*this);
+  mark(8);
+  if (profiling_) ++profile_.ticks;
+}
+
+const char* Game::TickProfile::step_name(int step) {
+  static const char* const names[] = {
+      "time", "actuators+navigation", "world", "refbox", "radio", "sensors", "skills", "agents",
+      "hooks"};
+  return step >= 0 && step < kSteps ? names[step] : "?";
 }
 
 // --- referee actions -------------------------------------------------------------------------

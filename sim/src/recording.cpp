@@ -113,23 +113,22 @@ Recorder::Recorder(const std::string& path, const Game& game, const RecordingInf
   m.period = SimTime::period_of_hz(pose_rate_hz);
   m.next_frame = game.time();
   const kinematic::WorldConfig& w = game.config().world;
-  std::string h = "{\"format\": \"llsfsim-recording\", \"version\": " +
-                  std::to_string(kRecordingVersion) + ", \"scenario\": " + quote(info.scenario) +
-                  ", \"variant\": " + quote(info.variant) +
-                  ", \"seed\": " + std::to_string(info.seed) +
-                  ", \"llsfsim\": " + quote(info.llsfsim_version) +
-                  ", \"pose_hz\": " + num(pose_rate_hz, 3) + ", \"field\": {\"width\": " +
-                  num(w.field.width_m, 3) + ", \"height\": " + num(w.field.height_m, 3) +
-                  "}, \"devices\": [";
+  std::string h =
+      "{\"format\": \"llsfsim-recording\", \"version\": " + std::to_string(kRecordingVersion) +
+      ", \"scenario\": " + quote(info.scenario) + ", \"variant\": " + quote(info.variant) +
+      ", \"seed\": " + std::to_string(info.seed) + ", \"llsfsim\": " + quote(info.llsfsim_version) +
+      ", \"pose_hz\": " + num(pose_rate_hz, 3) +
+      ", \"field\": {\"width\": " + num(w.field.width_m, 3) +
+      ", \"height\": " + num(w.field.height_m, 3) + "}, \"devices\": [";
   for (int i = 0; i < kinematic::kDeviceCount; ++i) {
     const kinematic::DeviceConfig& d = w.devices[static_cast<std::size_t>(i)];
     const core::OrientedBox box = d.footprint();
-    h += std::string(i ? ", " : "") + "{\"name\": " +
-         quote(kinematic::device_name(core::DeviceId(i))) + ", \"x\": " + num(d.pose.x, 3) +
-         ", \"y\": " + num(d.pose.y, 3) + ", \"ori\": " + num(d.pose.theta, 3) +
-         ", \"box\": [" + num(box.pose.x, 3) + ", " + num(box.pose.y, 3) + ", " +
-         num(2.0 * box.half_extents.x(), 3) + ", " + num(2.0 * box.half_extents.y(), 3) + ", " +
-         num(box.pose.theta, 3) + "]}";
+    h += std::string(i ? ", " : "") +
+         "{\"name\": " + quote(kinematic::device_name(core::DeviceId(i))) +
+         ", \"x\": " + num(d.pose.x, 3) + ", \"y\": " + num(d.pose.y, 3) +
+         ", \"ori\": " + num(d.pose.theta, 3) + ", \"box\": [" + num(box.pose.x, 3) + ", " +
+         num(box.pose.y, 3) + ", " + num(2.0 * box.half_extents.x(), 3) + ", " +
+         num(2.0 * box.half_extents.y(), 3) + ", " + num(box.pose.theta, 3) + "]}";
   }
   h += "], \"robots\": [";
   for (int i = 0; i < game.robot_count(); ++i) {
@@ -159,9 +158,8 @@ std::int64_t Recorder::lines() const { return impl_->lines; }
 
 void Recorder::skill(const SkillStatusChange& c) {
   Impl& m = *impl_;
-  std::string s = m.head(c.time, "skill") + ", \"robot\": " + quote(c.robot) +
-                  ", \"status\": \"" + lua::to_string(c.status) + "\", \"string\": " +
-                  quote(c.skill_string);
+  std::string s = m.head(c.time, "skill") + ", \"robot\": " + quote(c.robot) + ", \"status\": \"" +
+                  lua::to_string(c.status) + "\", \"string\": " + quote(c.skill_string);
   if (!c.result.empty()) s += ", \"result\": " + quote(c.result);
   if (!c.error.empty()) s += ", \"error\": " + quote(c.error);
   m.write(s + "}");
@@ -220,8 +218,8 @@ void Recorder::frame(const Game& game) {
   const kinematic::WorldEvents& ev = game.last_events();
   for (const kinematic::RfidEvent& e : ev.rfid) {
     m.write(m.head(t, "rfid") + ", \"d\": " + quote(kinematic::device_name(e.device)) +
-            ", \"puck\": " + std::to_string(e.puck.value()) + ", \"in\": " +
-            (e.kind == kinematic::RfidEventKind::kEntered ? "true" : "false") + "}");
+            ", \"puck\": " + std::to_string(e.puck.value()) +
+            ", \"in\": " + (e.kind == kinematic::RfidEventKind::kEntered ? "true" : "false") + "}");
   }
   for (const kinematic::CollisionEvent& c : ev.collisions) {
     std::string s = m.head(t, "collision") + ", \"kind\": \"" + collision_kind(c.kind) +
@@ -296,9 +294,8 @@ void Recorder::frame(const Game& game) {
     m.write(m.head(t, "order") + ", \"id\": " + std::to_string(o.id.value()) +
             ", \"product\": " + quote(refbox::to_string(o.product)) +
             ", \"requested\": " + std::to_string(o.quantity_requested) +
-            ", \"delivered\": " + std::to_string(o.quantity_delivered) +
-            ", \"window\": [" + std::to_string(o.window_begin_s) + ", " +
-            std::to_string(o.window_end_s) + "]}");
+            ", \"delivered\": " + std::to_string(o.quantity_delivered) + ", \"window\": [" +
+            std::to_string(o.window_begin_s) + ", " + std::to_string(o.window_end_s) + "]}");
   }
 }
 

@@ -126,6 +126,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
     judged[i] = true;
   };
 
+  game.enable_profile(hooks.profile);
   start_game(game, scenario.start);
   const SimTime end = scenario.duration;
   SimTime next_progress = hooks.progress_every;
@@ -221,6 +222,13 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
     if (!judged[i]) judge(i, s.points, deliveries_of(rb));
   }
   r.tests = std::move(verdicts);
+  if (hooks.profile) {
+    for (int i = 0; i < Game::TickProfile::kSteps; ++i) {
+      r.time_split.emplace_back(
+          Game::TickProfile::step_name(i),
+          1e-9 * static_cast<double>(game.profile().ns[static_cast<std::size_t>(i)]));
+    }
+  }
   if (recorder) recorder->close();  // throws if the file could not be finished
   for (int i = 0; i < game.robot_count(); ++i) game.set_brain(i, nullptr);
   return r;

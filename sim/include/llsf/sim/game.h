@@ -125,6 +125,18 @@ class Game {
 
   GameSummary summary() const;
 
+  /// Where a tick's time goes: steady-clock nanoseconds per tick step (1..9 of step()), summed
+  /// over the ticks since profiling was enabled. For benchmarks; costs a few clock reads a tick.
+  struct TickProfile {
+    static constexpr int kSteps = 9;
+    std::array<std::int64_t, kSteps> ns{};
+    std::int64_t ticks = 0;
+    /// "actuators+navigation", "world", "refbox", "radio", "sensors", "skills", "agents", ...
+    static const char* step_name(int step);
+  };
+  void enable_profile(bool on) { profiling_ = on; }
+  const TickProfile& profile() const { return profile_; }
+
  private:
   void apply_refbox_output(const refbox::StepOutput& out);
   /// Carries out robot `robot`'s symbolic skill requests (tick step 2).
@@ -177,6 +189,8 @@ class Game {
   std::int64_t refbox_accepted_ = 0;
   std::int64_t refbox_rejected_ = 0;
   std::int64_t controller_rejected_ = 0;
+  bool profiling_ = false;
+  TickProfile profile_;
 };
 
 /// The planner's map of a world configuration: devices with their footprints and RFID zone

@@ -70,6 +70,8 @@ struct RunResult {
   double real_time_factor = 0.0;
   std::uint64_t result_hash = 0;
   std::vector<TestVerdict> tests;
+  /// With RunHooks::profile: seconds spent per tick step (Game::TickProfile names).
+  std::vector<std::pair<std::string, double>> time_split;
   std::vector<RunAward> awards;  ///< every points award, in order
   bool passed() const;
 };
@@ -84,6 +86,8 @@ struct RunHooks {
   std::function<void(const SkillStatusChange&)> skill;
   /// If set, the game is recorded to this file (docs/recording.md).
   std::string record_path;
+  /// Measure where the tick's time goes (RunResult::time_split).
+  bool profile = false;
 };
 
 /// Plays `scenario` with `seed`. Throws clips::AgentLoadError / core::ConfigError before the
