@@ -9,6 +9,9 @@
 ; number), recycle (never | ifpossible | afterdeliver), role-change/after-complex-delivery,
 ; role-change/time-left (s), role-change/failures (in a row). See docs/agent-llsf2013.md.
 
+; The storage looked empty (get_s0 saw no puck): until then recycle or wait instead.
+(deftemplate storage-empty (slot until (type FLOAT)))
+
 (deffunction robot-x () (bind ?p (find-fact ((?f pose)) TRUE))
   (if (= (length$ ?p) 0) then (return 0.5)) (return (fact-slot-value (nth$ 1 ?p) x)))
 (deffunction robot-y () (bind ?p (find-fact ((?f pose)) TRUE))
@@ -97,10 +100,12 @@
   (switch ?h
     (case NONE then
       (bind ?mode (cfg "/clips-agent/recycle" "never"))
-      (if (or (eq ?mode "ifpossible")
+      (bind ?empty (any-factp ((?e storage-empty)) (> ?e:until (now))))
+      (if (or ?empty (eq ?mode "ifpossible")
               (and (eq ?mode "afterdeliver") (any-factp ((?rp recycle-pending)) TRUE))) then
         (bind ?cm (nearest-consumed ?x ?y))
         (if (neq ?cm NONE) then (return (create$ GET_CONSUMED ?cm ?cm))))
+      (if ?empty then (return (create$ WAIT NONE NONE)))
       (return (create$ GET_S0 NONE INS)))
     (case CONSUMED then
       (bind ?r (nearest-machine RECYCLE ?x ?y ANY))
@@ -295,6 +300,9 @@
   (if (str-index "already holding a puck" ?e) then (set-holding UNKNOWN))
   (if (str-index "rejected the puck" ?e) then (set-holding UNKNOWN))
   (if (str-index "is down (red)" ?e) then (machine-update ?m down-until (+ (now) 30.0)))
+  (if (and (eq ?k GET_S0) (str-index "no puck seen" ?e)) then
+    ; Look again in 30 s (pucks may be pushed back, late-order pucks arrive); recycle meanwhile.
+    (assert (storage-empty (until (+ (now) 30.0)))))
   (if (and (eq ?k GET_CONSUMED) (str-index "no puck beside" ?e)) then
     (machine-update ?m consumed-set 0))
   (if (and (eq ?k DELIVER) (or (str-index "refused" ?e) (str-index "no active gate" ?e))) then
