@@ -7,6 +7,7 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,21 @@ inline sim::GameConfig small_game(int robots, std::uint64_t seed = 7) {
   c.world.sensors.laser.enabled = false;
   c.world.robots.resize(static_cast<std::size_t>(robots));
   return c;
+}
+
+/// Index of a production machine of `type` whose down time (if any) starts after `after_s`.
+inline std::optional<int> machine_of_type(const refbox::Refbox& rb, refbox::MachineType type,
+                                          int after_s) {
+  const auto& params = *rb.params();
+  for (int i = 0; i < refbox::kProductionMachineCount; ++i) {
+    if (params.machine_types[static_cast<std::size_t>(i)] != type) continue;
+    bool early_down = false;
+    for (const auto& d : params.down_times) {
+      if (d.device.value() == i && d.start_s <= after_s) early_down = true;
+    }
+    if (!early_down) return i;
+  }
+  return std::nullopt;
 }
 
 /// Controller: switch the refbox to `phase` and start it.

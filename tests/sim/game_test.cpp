@@ -38,21 +38,6 @@ struct LightsMirror {
   }
 };
 
-/// Index of a production machine of `type` whose down time (if any) starts after `after_s`.
-std::optional<int> machine_of_type(const refbox::Refbox& rb, refbox::MachineType type,
-                                   int after_s) {
-  const auto& params = *rb.params();
-  for (int i = 0; i < refbox::kProductionMachineCount; ++i) {
-    if (params.machine_types[static_cast<std::size_t>(i)] != type) continue;
-    bool early_down = false;
-    for (const auto& d : params.down_times) {
-      if (d.device.value() == i && d.start_s <= after_s) early_down = true;
-    }
-    if (!early_down) return i;
-  }
-  return std::nullopt;
-}
-
 bool run_until(Game& g, double max_s, const std::function<bool()>& done) {
   const SimTime end = g.time() + SimTime::from_seconds(max_s);
   while (g.time() < end) {
@@ -74,7 +59,7 @@ void produce_s1(std::uint64_t seed) {
   g.step();
   REQUIRE(g.refbox().phase() == refbox::GamePhase::kProduction);
   REQUIRE(g.refbox().state() == refbox::GameState::kRunning);
-  const std::optional<int> t1 = machine_of_type(g.refbox(), refbox::MachineType::kT1, 120);
+  const std::optional<int> t1 = test::machine_of_type(g.refbox(), refbox::MachineType::kT1, 120);
   REQUIRE(t1.has_value());
   const std::string machine(kinematic::device_name(core::DeviceId(*t1)));
 

@@ -20,8 +20,8 @@ using namespace llsf::sim;
 namespace {
 
 std::filesystem::path temp_dir() {
-  const auto dir =
-      std::filesystem::temp_directory_path() / ("llsf_recording_test_" + std::to_string(::getpid()));
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("llsf_recording_test_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   return dir;
 }
@@ -91,7 +91,8 @@ TEST_CASE("bad recordings: missing, corrupt, wrong version, not JSON") {
     const std::string good = (dir / "good.gz").string();
     gzFile g = gzopen(good.c_str(), "wb");
     std::string body = "{\"format\": \"llsfsim-recording\", \"version\": 1}\n";
-    for (int i = 0; i < 2000; ++i) body += "{\"t\": " + std::to_string(i) + ".00, \"f\": 1, \"r\": []}\n";
+    for (int i = 0; i < 2000; ++i)
+      body += "{\"t\": " + std::to_string(i) + ".00, \"f\": 1, \"r\": []}\n";
     gzwrite(g, body.data(), static_cast<unsigned>(body.size()));
     gzclose(g);
     std::ifstream in(good, std::ios::binary);

@@ -37,21 +37,6 @@ Outcome run_skill(Game& g, SkillBrain& brain, const std::string& skill_string, d
   return o;
 }
 
-/// Index of a production machine of `type` without a down time starting before `after_s`.
-std::optional<int> machine_of_type(const refbox::Refbox& rb, refbox::MachineType type,
-                                   int after_s) {
-  const auto& params = *rb.params();
-  for (int i = 0; i < refbox::kProductionMachineCount; ++i) {
-    if (params.machine_types[static_cast<std::size_t>(i)] != type) continue;
-    bool early_down = false;
-    for (const auto& d : params.down_times) {
-      if (d.device.value() == i && d.start_s <= after_s) early_down = true;
-    }
-    if (!early_down) return i;
-  }
-  return std::nullopt;
-}
-
 std::string machine_name(int index) {
   return std::string(kinematic::device_name(core::DeviceId(index)));
 }
@@ -85,7 +70,7 @@ TEST_CASE("get_s0 then finish_puck_at a T1: the refbox makes it an S1") {
     Game g(config);
     test::start_phase(g, refbox::GamePhase::kProduction);
     g.step();
-    const auto t1 = machine_of_type(g.refbox(), refbox::MachineType::kT1, 200);
+    const auto t1 = test::machine_of_type(g.refbox(), refbox::MachineType::kT1, 200);
     REQUIRE(t1);
     SkillBrain brain(g, 0);
     Outcome o = run_skill(g, brain, "get_s0{}", 120);
@@ -123,8 +108,8 @@ struct ProductionGame {
     return o;
   }
   std::string machine(refbox::MachineType type) {
-    auto m = machine_of_type(game.refbox(), type, 150);
-    if (!m) m = machine_of_type(game.refbox(), type, 0);
+    auto m = test::machine_of_type(game.refbox(), type, 150);
+    if (!m) m = test::machine_of_type(game.refbox(), type, 0);
     REQUIRE(m);
     return machine_name(*m);
   }
