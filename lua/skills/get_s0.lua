@@ -16,7 +16,8 @@ late-order slot), picks the nearest puck it sees there and takes it.
               (that spot only) or "LATE_ORDER" (the late-order insertion slot)
 Fails: "get_s0: already holding a puck", "get_s0: unknown place 'X'", "get_s0: no puck seen at
 INS_2" (after every spot it may try), or take_puck's/drive_to's failure after 4 attempts (a
-puck that could not be taken is not tried again).
+puck that could not be taken is not tried again; a puck so deep in the storage that the robot
+would touch the wall is not tried at all -- 2013 field, 5.6 m square).
 ]==]
 
 local LOOK_BACK = 0.45   -- the look position lies this far out from the pickup place
@@ -58,7 +59,13 @@ local function choose(vars)
       for _, a in ipairs(vars.avoid or {}) do
          if (fx - a[1]) ^ 2 + (fy - a[2]) ^ 2 < 0.04 ^ 2 then avoided = true end
       end
-      if rx > 0.1 and d < best and not avoided then best, bx, by = d, fx, fy end
+      -- The robot would stand 0.2225 m before the puck: keep its body off the walls (a puck
+      -- pushed deep into the storage is left alone).
+      local dist = math.sqrt(rx * rx + ry * ry)
+      local sx = fx - (fx - x) / dist * 0.2225
+      local sy = fy - (fy - y) / dist * 0.2225
+      local clear = sx >= 0.21 and sy >= 0.21 and sx <= 5.39 and sy <= 5.39
+      if rx > 0.1 and d < best and not avoided and clear then best, bx, by = d, fx, fy end
    end
    if not bx then return false end
    vars.px, vars.py = bx, by
