@@ -31,6 +31,11 @@ int run(std::span<const std::string> args, std::ostream& out, std::ostream& err)
   }
   {
     CLI::App* sub = app.add_subcommand(
+        "report", "Statistics of a stored batch per variant and differences between variants");
+    commands.emplace_back(sub, add_report_command(*sub));
+  }
+  {
+    CLI::App* sub = app.add_subcommand(
         "check", "Validate scenarios and their agent and skill files without playing");
     commands.emplace_back(sub, add_check_command(*sub));
   }

@@ -249,6 +249,7 @@ struct StatsStore::Impl {
   std::string path;
   DbHandle db;
   // Prepared once, used for every run.
+  std::unique_ptr<Statement> list_batches;
   std::unique_ptr<Statement> find_batch, insert_batch, finish_batch, get_batch, delete_run,
       insert_run, insert_stat, insert_order, insert_test, insert_award, insert_event, select_runs,
       select_stats, select_awards;
@@ -305,6 +306,7 @@ struct StatsStore::Impl {
     get_batch = prep(
         "SELECT id, kind, created, coalesce(finished, ''), scenario_file, scenario_name, "
         "scenario_hash, runs_per_variant, variants, seeds FROM batches WHERE id = ?");
+    list_batches = prep("SELECT id FROM batches ORDER BY id");
     delete_run = prep("DELETE FROM runs WHERE batch_id = ? AND variant = ? AND seed = ?");
     insert_run = prep(
         "INSERT INTO runs (batch_id, scenario, variant, seed, llsfsim_version, result_hash, "
@@ -386,6 +388,19 @@ std::optional<StoredBatch> StatsStore::batch(std::int64_t batch_id) const {
   b.seeds = q.text(9);
   q.finish();
   return b;
+}
+
+std::vector<StoredBatch> StatsStore::batches() const {
+  std::vector<std::int64_t> ids;
+  Statement& q = *impl_->list_batches;
+  q.start();
+  while (q.step()) ids.push_back(q.int64(0));
+  q.finish();
+  std::vector<StoredBatch> out;
+  for (const std::int64_t id : ids) {
+    if (auto b = batch(id)) out.push_back(std::move(*b));
+  }
+  return out;
 }
 
 std::int64_t StatsStore::add_run(std::int64_t batch_id, const RunResult& r, bool replace) {

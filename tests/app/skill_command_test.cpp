@@ -137,3 +137,17 @@ TEST_CASE("llsfsim run --speed paces the game and gives the same result as unpac
   CHECK(hash(paced.out) == hash(fast.out));
   CHECK(llsfsim({"run", scenario, "--speed", "0"}).code == llsf::app::kExitBadInput);
 }
+
+TEST_CASE("llsfsim report: an empty store has no batch (exit 2); --list works; help") {
+  const std::string db = std::filesystem::temp_directory_path() / "llsf_app_test_report.db";
+  std::filesystem::remove(db);
+  Run r = llsfsim({"report", "--db", db});
+  CHECK(r.code == llsf::app::kExitBadInput);
+  CHECK(has(r.err, "holds no batch"));
+  r = llsfsim({"report", "--db", db, "--list"});
+  CHECK(r.code == 0);
+  r = llsfsim({"report", "--help"});
+  CHECK(r.code == 0);
+  CHECK(has(r.out, "--csv"));
+  std::filesystem::remove(db);
+}

@@ -98,6 +98,8 @@ class StatsStore {
   std::int64_t open_batch(const BatchKey& key);
   /// Marks a batch complete (sets `finished` to now, once).
   void finish_batch(std::int64_t batch_id);
+  /// Every batch (and stored single run's batch), by id.
+  std::vector<StoredBatch> batches() const;
   /// The batch `batch_id`, if it exists.
   std::optional<StoredBatch> batch(std::int64_t batch_id) const;
 

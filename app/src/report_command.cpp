@@ -1,0 +1,84 @@
+// SPDX-License-Identifier: MIT
+// `llsfsim report`: statistics of a stored batch per variant, differences between variants,
+// CSV export.
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <ostream>
+#include <string>
+
+#include "commands.h"
+#include "llsf/app/cli.h"
+#include "llsf/sim/report.h"
+#include "llsf/sim/stats_store.h"
+
+namespace llsf::app {
+
+namespace {
+
+struct ReportOptions {
+  std::optional<std::int64_t> batch;
+  std::string db{sim::StatsStore::kDefaultPath};
+  std::string csv;
+  bool list = false;
+};
+
+int report(const ReportOptions& o, std::ostream& out, std::ostream& err) {
+  try {
+    const sim::StatsStore store(o.db);
+    const std::vector<sim::StoredBatch> batches = store.batches();
+    if (o.list) {
+      for (const sim::StoredBatch& b : batches) {
+        out << b.id << "  " << b.kind << "  " << b.scenario_name << "  " << b.scenario_file
+            << "  " << b.variants << " variant(s) x " << b.runs_per_variant << " run(s)  "
+            << (b.finished.empty() ? "unfinished" : "finished " + b.finished) << "\n";
+      }
+      return kExitOk;
+    }
+    std::optional<std::int64_t> id = o.batch;
+    if (!id) {
+      // The latest batch (of `llsfsim batch`, else any).
+      for (const sim::StoredBatch& b : batches) {
+        if (b.kind == "batch") id = b.id;
+      }
+      if (!id && !batches.empty()) id = batches.back().id;
+    }
+    if (!id) {
+      err << "llsfsim report: " << o.db << " holds no batch (run llsfsim batch first)\n";
+      return kExitBadInput;
+    }
+    const sim::BatchReport r = sim::make_report(store, *id);
+    out << sim::to_text(r);
+    if (!o.csv.empty()) {
+      std::ofstream f(o.csv);
+      f << sim::to_csv(r);
+      if (!f) {
+        err << "llsfsim report: cannot write " << o.csv << "\n";
+        return kExitBadInput;
+      }
+    }
+  } catch (const sim::StatsError& e) {
+    err << "llsfsim report: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+Action add_report_command(CLI::App& app) {
+  auto o = std::make_shared<ReportOptions>();
+  app.add_option("batch", o->batch, "Batch id (default: the latest batch; see --list)");
+  app.add_option("--db", o->db, "Statistics store")->capture_default_str();
+  app.add_option("--csv", o->csv,
+                 "Also write every statistic per variant (n, mean, median, quartiles, min, max, "
+                 "pass rate) as CSV");
+  app.add_flag("--list", o->list, "List the stored batches");
+  app.footer(
+      "Per variant: runs, pass rate and the distribution of the points; then every variant's "
+      "mean points against the first variant's, with a bootstrap 95 % interval (* = the "
+      "interval excludes 0). Exit code 0, or 2 for a bad store or batch.");
+  return [o](std::ostream& out, std::ostream& err) { return report(*o, out, err); };
+}
+
+}  // namespace llsf::app

@@ -1,0 +1,86 @@
+// SPDX-License-Identifier: MIT
+// Batch reports: quantiles, per-variant summaries, bootstrap differences, CSV.
+#include <doctest/doctest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+
+#include "llsf/sim/report.h"
+#include "llsf/sim/stats_store.h"
+
+using namespace llsf;
+using namespace llsf::sim;
+
+TEST_CASE("quantiles interpolate between order statistics (R type 7)") {
+  const std::vector<double> v{1, 2, 3, 4};
+  CHECK(quantile(v, 0.0) == 1.0);
+  CHECK(quantile(v, 1.0) == 4.0);
+  CHECK(quantile(v, 0.5) == doctest::Approx(2.5));
+  CHECK(quantile(v, 0.25) == doctest::Approx(1.75));
+  CHECK(quantile({}, 0.5) == 0.0);
+  CHECK(quantile({7}, 0.9) == 7.0);
+}
+
+TEST_CASE("a report summarises each variant and bounds the difference of means") {
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("llsf_report_test_" + std::to_string(::getpid()) + ".db"))
+                               .string();
+  std::filesystem::remove(path);
+  {
+    StatsStore store(path);
+    BatchKey key;
+    key.kind = BatchKey::Kind::kBatch;
+    key.scenario_file = "x.yaml";
+    key.scenario_name = "x";
+    key.scenario_hash = "h";
+    key.runs_per_variant = 5;
+    key.variants = 2;
+    const std::int64_t b = store.open_batch(key);
+    // Variant "b" scores 100 more than "a" in every run; "a" fails one test.
+    for (int seed = 1; seed <= 5; ++seed) {
+      for (const char* v : {"b", "a"}) {
+        RunResult r;
+        r.scenario = "x";
+        r.variant = v;
+        r.seed = static_cast<std::uint64_t>(seed);
+        r.points = (std::string(v) == "a" ? 10 : 110) + seed;
+        r.tests.push_back({"t", !(std::string(v) == "a" && seed == 3), "", 0.0});
+        store.add_run(b, r);
+      }
+    }
+  }
+  const StatsStore store(path);
+  const BatchReport r = make_report(store, store.batches().front().id);
+  REQUIRE(r.variants.size() == 2);
+  CHECK(r.variants[0].variant == "a");  // name order
+  CHECK(r.variants[0].runs == 5);
+  CHECK(r.variants[0].passed == 4);
+  const StatSummary* pa = r.variants[0].find("points");
+  REQUIRE(pa != nullptr);
+  CHECK(pa->n == 5);
+  CHECK(pa->mean == doctest::Approx(13.0));
+  CHECK(pa->median == doctest::Approx(13.0));
+  CHECK(pa->min == 11.0);
+  CHECK(pa->max == 15.0);
+  bool found = false;
+  for (const Difference& d : r.differences) {
+    if (d.statistic != "points") continue;
+    found = true;
+    CHECK(d.variant == "b");
+    CHECK(d.baseline == "a");
+    CHECK(d.diff == doctest::Approx(100.0));
+    CHECK(d.ci_low > 97.0);
+    CHECK(d.ci_high < 103.0);
+    CHECK(d.ci_low <= d.diff);
+    CHECK(d.ci_high >= d.diff);
+  }
+  CHECK(found);
+  // Deterministic: the same store gives the same report.
+  CHECK(to_text(make_report(store, r.batch.id)) == to_text(r));
+  const std::string csv = to_csv(r);
+  CHECK(csv.rfind("variant,statistic,n,mean,median,q1,q3,min,max,pass_rate\n", 0) == 0);
+  CHECK(csv.find("\"a\",points,5,13,13,12,14,11,15,0.8") != std::string::npos);
+  CHECK_THROWS_AS(make_report(store, 999), StatsError);
+  std::filesystem::remove(path);
+}
