@@ -29,8 +29,8 @@ int report(const ReportOptions& o, std::ostream& out, std::ostream& err) {
     const std::vector<sim::StoredBatch> batches = store.batches();
     if (o.list) {
       for (const sim::StoredBatch& b : batches) {
-        out << b.id << "  " << b.kind << "  " << b.scenario_name << "  " << b.scenario_file
-            << "  " << b.variants << " variant(s) x " << b.runs_per_variant << " run(s)  "
+        out << b.id << "  " << b.kind << "  " << b.scenario_name << "  " << b.scenario_file << "  "
+            << b.variants << " variant(s) x " << b.runs_per_variant << " run(s)  "
             << (b.finished.empty() ? "unfinished" : "finished " + b.finished) << "\n";
       }
       return kExitOk;

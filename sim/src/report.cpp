@@ -97,10 +97,12 @@ BatchReport make_report(const StatsStore& store, std::int64_t batch_id, std::uin
       for (int k = 0; k < kResamples; ++k) {
         double sa = 0.0, sb = 0.0;
         for (std::size_t j = 0; j < a.size(); ++j) {
-          sa += a[static_cast<std::size_t>(rng.uniform_int(0, static_cast<std::int64_t>(a.size()) - 1))];
+          sa += a[static_cast<std::size_t>(
+              rng.uniform_int(0, static_cast<std::int64_t>(a.size()) - 1))];
         }
         for (std::size_t j = 0; j < b.size(); ++j) {
-          sb += b[static_cast<std::size_t>(rng.uniform_int(0, static_cast<std::int64_t>(b.size()) - 1))];
+          sb += b[static_cast<std::size_t>(
+              rng.uniform_int(0, static_cast<std::int64_t>(b.size()) - 1))];
         }
         diffs.push_back(sa / static_cast<double>(a.size()) - sb / static_cast<double>(b.size()));
       }
@@ -152,8 +154,7 @@ std::string to_text(const BatchReport& r) {
   for (const Difference& d : r.differences) {
     if (d.statistic != "points") continue;
     if (!header) {
-      out += "\npoints: difference of means against " + d.baseline +
-             " (bootstrap 95 % interval)\n";
+      out += "\npoints: difference of means against " + d.baseline + " (bootstrap 95 % interval)\n";
       header = true;
     }
     std::snprintf(line, sizeof line, "%-28s %+8.1f  [%+.1f, %+.1f]%s\n", d.variant.c_str(), d.diff,

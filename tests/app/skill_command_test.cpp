@@ -9,31 +9,15 @@
 #include <string>
 #include <vector>
 
+#include "app/cli_fixture.h"
 #include "llsf/app/cli.h"
 #include "llsf/sim/recording.h"
 
 namespace {
 
-struct Run {
-  int code = -1;
-  std::string out;
-  std::string err;
-};
-
-Run llsfsim(std::vector<std::string> args) {
-  args.insert(args.begin(), "llsfsim");
-  std::ostringstream out;
-  std::ostringstream err;
-  Run r;
-  r.code = llsf::app::run(args, out, err);
-  r.out = out.str();
-  r.err = err.str();
-  return r;
-}
-
-bool has(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
+using llsf::test::has;
+using llsf::test::llsfsim;
+using llsf::test::Run;
 
 }  // namespace
 
