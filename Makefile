@@ -2,7 +2,7 @@
 # The project's front door. `make run` and `make test` work on a fresh Debian bookworm machine.
 JOBS ?= $(shell nproc)
 
-.PHONY: all deps run demo test build-release build-ci bench format check-format clean help
+.PHONY: all deps viewer run demo test build-release build-ci bench format check-format clean help
 
 all: build-release
 
@@ -11,6 +11,7 @@ help:
 	@echo "make demo         the kinematic world demo (three robots, no refbox)"
 	@echo "make test         install deps, build with -Werror, run the whole test suite"
 	@echo "make bench        build Release and run every benchmark (bench/run)"
+	@echo "make viewer       build the browser front end (viewer/dist/report.js; scripts/build-viewer)"
 	@echo "make format       clang-format every source file"
 	@echo "make check-format fail if a source file is not clang-formatted"
 	@echo "make clean        remove build/"
@@ -18,11 +19,15 @@ help:
 deps:
 	@scripts/install-deps
 
-build-release: deps
+# The front end (npm ci from the lock, tsc, esbuild): the bundle `llsfsim report --html` inlines.
+viewer: deps
+	@scripts/build-viewer
+
+build-release: deps viewer
 	@cmake --preset release >/dev/null
 	@cmake --build --preset release -j $(JOBS)
 
-build-ci: deps
+build-ci: deps viewer
 	@cmake --preset ci >/dev/null
 	@cmake --build --preset ci -j $(JOBS)
 

@@ -5,10 +5,12 @@
 // such a game (agent_cycle).
 // LLSF_BENCH_VERBOSE=1 prints every game.
 #include <llsf_msgs/GameState.pb.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -186,7 +188,12 @@ LLSF_BENCH(full_game,
   // The split, from one profiled run (the clock reads add a little).
   sim::RunHooks prof;
   prof.profile = true;
+  const std::string rec = (std::filesystem::temp_directory_path() /
+                           ("llsf_bench_full_game_" + std::to_string(getpid()) + ".jsonl.gz"))
+                              .string();
+  prof.record_path = rec;  // recorded, as llsfsim run does
   const sim::RunResult p = sim::run_game(f.variants[0], 1, prof);
+  std::filesystem::remove(rec);
   double total = 0.0;
   for (const auto& [name, s] : p.time_split) total += s;
   for (const auto& [name, s] : p.time_split) {

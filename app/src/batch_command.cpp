@@ -33,6 +33,8 @@ struct BatchCommandOptions {
   std::optional<int> runs;
   std::optional<int> jobs;
   std::string db{sim::StatsStore::kDefaultPath};
+  std::string recordings;  ///< "" = default_recordings_dir(db)
+  bool no_record = false;
   bool quiet = false;
 };
 
@@ -78,10 +80,13 @@ struct Loaded {
 };
 
 void print_summary(const Loaded& l, const sim::BatchResult& b, const std::string& db,
-                   std::ostream& out) {
+                   const std::string& recordings, std::ostream& out) {
   out << fmt::format("batch      {} ({}) #{} in {}: {} runs, {} played, {} stored before\n",
                      l.file.variants.front().name, l.path, b.batch_id, db, b.total, b.played,
                      b.skipped);
+  if (!recordings.empty()) {
+    out << fmt::format("recordings {}/batch{}/\n", recordings, b.batch_id);
+  }
   out << fmt::format("{:<32} {:>5} {:>7} {:>7} {:>7} {:>5} {:>5}\n", "variant", "runs", "passed",
                      "mean", "median", "min", "max");
   int runs = 0;
@@ -134,6 +139,8 @@ int batch(const BatchCommandOptions& o, std::ostream& out, std::ostream& err) {
     sim::BatchOptions options;
     options.runs = o.runs;
     options.jobs = o.jobs.value_or(0);
+    if (!o.no_record)
+      options.recordings_dir = o.recordings.empty() ? default_recordings_dir(o.db) : o.recordings;
     sim::BatchHooks hooks;
     hooks.stop = &g_interrupted;
     bool told = false;
@@ -172,7 +179,7 @@ int batch(const BatchCommandOptions& o, std::ostream& out, std::ostream& err) {
       return kExitBadInput;
     }
     if (bar && b.interrupted) err << "\n";
-    if (!o.quiet) print_summary(l, b, o.db, out);
+    if (!o.quiet) print_summary(l, b, o.db, options.recordings_dir, out);
     if (b.interrupted) return kExitInterrupted;
     all_passed = all_passed && b.all_passed();
   }
@@ -194,10 +201,16 @@ Action add_batch_command(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   app.add_option("--db", o->db, "Statistics store (SQLite; docs/statistics.md)")
       ->capture_default_str();
+  auto* rec = app.add_option(
+      "--recordings", o->recordings,
+      "Directory for the games' recordings, one subdirectory per batch "
+      "(default: <db name>-recordings beside the --db file, e.g. llsfsim-recordings)");
+  app.add_flag("--no-record", o->no_record, "Do not record the games")->excludes(rec);
   app.add_flag("-q,--quiet", o->quiet, "No progress and no summary, only the exit code");
   app.footer(
       "Plays every matrix variant x N seeds of each scenario on worker threads and stores every "
-      "run in the statistics store. Resumable: runs the store already holds for the same "
+      "run in the statistics store, with a recording of every game (docs/recording.md). "
+      "Resumable: runs the store already holds for the same "
       "scenario file content and --runs are not played again; Ctrl-C stores the running games "
       "and stops.\n"
       "Exit code: 0 every run passed its test cases, 1 one failed, 2 bad input, 130 "

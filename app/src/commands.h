@@ -4,13 +4,22 @@
 
 #include <CLI/CLI.hpp>
 
+#include <filesystem>
 #include <functional>
 #include <iosfwd>
+#include <string>
 
 namespace llsf::app {
 
 /// A subcommand's action, called after parsing; returns the exit code.
 using Action = std::function<int(std::ostream& out, std::ostream& err)>;
+
+/// Where recordings go by default: "<name>-recordings" beside the statistics store `db`
+/// (llsfsim.db: llsfsim-recordings/), so that two stores never share one.
+inline std::string default_recordings_dir(const std::string& db) {
+  const std::filesystem::path p(db);
+  return (p.parent_path() / (p.stem().string() + "-recordings")).string();
+}
 
 /// `llsfsim skill`: one skill string (or several, in turn) on one robot in a fresh game.
 Action add_skill_command(CLI::App& app);

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // `llsfsim report`: statistics of a stored batch per variant, differences between variants,
-// CSV export.
+// CSV export, an HTML page with box plots.
+#include <cstdio>
 #include <fstream>
 #include <memory>
 #include <optional>
@@ -20,6 +21,7 @@ struct ReportOptions {
   std::optional<std::int64_t> batch;
   std::string db{sim::StatsStore::kDefaultPath};
   std::string csv;
+  std::string html;
   bool list = false;
 };
 
@@ -57,6 +59,23 @@ int report(const ReportOptions& o, std::ostream& out, std::ostream& err) {
         return kExitBadInput;
       }
     }
+    if (!o.html.empty()) {
+      const std::string page =
+          sim::to_html(r, sim::to_json(r, sim::run_values(store, *id)), sim::viewer_dir());
+      // Written next to its place and renamed: a failed write leaves no half page behind.
+      const std::string tmp = o.html + ".tmp";
+      std::ofstream f(tmp, std::ios::binary);
+      f << page;
+      f.close();
+      if (!f || std::rename(tmp.c_str(), o.html.c_str()) != 0) {
+        std::remove(tmp.c_str());
+        err << "llsfsim report: cannot write " << o.html << "\n";
+        return kExitBadInput;
+      }
+    }
+  } catch (const sim::ViewerBundleMissing& e) {
+    err << "llsfsim report: " << e.what() << "\n";
+    return kExitBadInput;
   } catch (const sim::StatsError& e) {
     err << "llsfsim report: " << e.what() << "\n";
     return kExitBadInput;
@@ -73,11 +92,16 @@ Action add_report_command(CLI::App& app) {
   app.add_option("--csv", o->csv,
                  "Also write every statistic per variant (n, mean, median, quartiles, min, max, "
                  "pass rate) as CSV");
+  app.add_option("--html", o->html,
+                 "Also write a self-contained HTML page: box plots of the points per variant and "
+                 "per phase, the tables, and every run's statistics as JSON");
   app.add_flag("--list", o->list, "List the stored batches");
   app.footer(
       "Per variant: runs, pass rate and the distribution of the points; then every variant's "
       "mean points against the first variant's, with a bootstrap 95 % interval (* = the "
-      "interval excludes 0). Exit code 0, or 2 for a bad store or batch.");
+      "interval excludes 0). The HTML page inlines the viewer's bundle from $LLSF_VIEWER_DIR or "
+      "viewer/dist of the source tree (`make viewer` builds it). Exit code 0, or 2 for a bad "
+      "store or batch, a file that cannot be written or a missing viewer bundle.");
   return [o](std::ostream& out, std::ostream& err) { return report(*o, out, err); };
 }
 

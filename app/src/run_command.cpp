@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <ostream>
@@ -18,6 +19,7 @@
 #include "llsf/clips/agent.h"
 #include "llsf/core/error.h"
 #include "llsf/sim/agent_brain.h"
+#include "llsf/sim/recording.h"
 #include "llsf/sim/runner.h"
 #include "llsf/sim/scenario.h"
 #include "llsf/sim/stats_store.h"
@@ -34,7 +36,8 @@ struct RunOptions {
   bool quiet = false;
   std::string db{sim::StatsStore::kDefaultPath};
   bool no_db = false;
-  std::string record;
+  std::string record;  ///< "" = default_recordings_dir(db)/recording_file_name(...)
+  bool no_record = false;
   double speed = 0.0;  ///< 0: as fast as possible; else game seconds per wall second
   bool realtime = false;
 };
@@ -78,6 +81,11 @@ void print_summary(const sim::RunResult& r, std::ostream& out) {
   }
   out << fmt::format("robots     {} collisions, {} skill failures, {} agent runtime errors\n",
                      r.collisions, r.skill_failures, r.agent_runtime_errors);
+  if (r.lock_grants + r.lock_refusals > 0) {
+    out << fmt::format(
+        "locks      {} grants, {} refusals; {} waits, {:.1f} s waited in all, longest {:.1f} s\n",
+        r.lock_grants, r.lock_refusals, r.lock_waits, r.lock_wait_s, r.lock_wait_max_s);
+  }
   out << fmt::format("radio      {} copies sent, {} dropped\n", r.messages_sent,
                      r.messages_dropped);
   out << fmt::format("speed      {:.0f} s of game in {:.2f} s CPU: {:.0f}x real time\n",
@@ -117,7 +125,20 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
     }
   }
   sim::RunHooks hooks;
-  hooks.record_path = o.record;
+  if (!o.no_record) {
+    hooks.record_path = o.record;
+    if (hooks.record_path.empty()) {
+      const std::filesystem::path dir = default_recordings_dir(o.db);
+      std::error_code ec;
+      std::filesystem::create_directories(dir, ec);
+      if (ec) {
+        err << "llsfsim run: cannot create the recordings directory " << dir.string() << ": "
+            << ec.message() << "\n";
+        return kExitBadInput;
+      }
+      hooks.record_path = (dir / sim::recording_file_name(s->name, s->variant, seed)).string();
+    }
+  }
   // Paced mode: sleep between ticks so that game time runs `speed` times as fast as the wall
   // clock (the wall clock only paces; it never enters the game).
   const double speed = o.realtime ? 1.0 : o.speed;
@@ -153,9 +174,12 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
     return kExitBadInput;
   }
   if (tty) std::fprintf(stderr, "\r%60s\r", "");
+  std::string stored_as;
   if (store) {
     try {
-      store->add_run(store->open_batch(key), r, /*replace=*/true);
+      const std::int64_t batch = store->open_batch(key);
+      const std::int64_t run = store->add_run(batch, r, /*replace=*/true);
+      stored_as = fmt::format("{} (batch {}, run {})", o.db, batch, run);
     } catch (const sim::StatsError& e) {
       err << "llsfsim run: " << e.what() << "\n";
       return kExitBadInput;
@@ -165,6 +189,8 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
     out << sim::to_json(r) << "\n";
   } else if (!o.quiet) {
     print_summary(r, out);
+    if (!r.recording.empty()) out << fmt::format("recording  {}\n", r.recording);
+    if (!stored_as.empty()) out << fmt::format("database   {}\n", stored_as);
   }
   return r.passed() ? kExitOk : kExitFailed;
 }
@@ -223,13 +249,16 @@ Action add_run_command(CLI::App& app) {
                                "Paced: play X game seconds per wall-clock second (e.g. 4)")
                     ->check(CLI::PositiveNumber);
   app.add_flag("--realtime", o->realtime, "Paced at real time (= --speed 1)")->excludes(speed);
-  app.add_option("--record", o->record,
-                 "Write a recording of the game to FILE (gzip JSON lines, docs/recording.md; "
-                 "e.g. game.jsonl.gz)");
+  auto* record =
+      app.add_option("--record", o->record,
+                     "Write the recording to FILE (gzip JSON lines, docs/recording.md; default: "
+                     "llsfsim-recordings/<scenario>[-<variant>]-seed<N>.jsonl.gz, beside the --db "
+                     "file and named after it)");
+  app.add_flag("--no-record", o->no_record, "Do not record the game")->excludes(record);
   app.footer(
       "Plays one game headless and prints a summary and the test-case verdicts; stores the run "
       "in the statistics store (--db, default llsfsim.db; the latest game of each variant and "
-      "seed of a scenario file's content).\n"
+      "seed of a scenario file's content) and writes a recording of it.\n"
       "Exit code: 0 all test cases passed, 1 one failed, 2 bad scenario or agent.");
   return [o](std::ostream& out, std::ostream& err) { return run(*o, out, err); };
 }

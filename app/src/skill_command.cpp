@@ -235,7 +235,8 @@ Action add_skill_command(CLI::App& app) {
   app.add_option("--skills", o->skill_dirs,
                  "Extra skill directory (repeatable); its skills replace library skills of the "
                  "same name")
-      ->check(CLI::ExistingDirectory);
+      ->check(CLI::ExistingDirectory)
+      ->allow_extra_args(false);  // one directory per --skills: skill strings follow
   app.add_option("--library", o->library_dir,
                  "The skill library directory (default: lua/skills of the source tree)")
       ->check(CLI::ExistingDirectory);

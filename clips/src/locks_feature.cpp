@@ -36,7 +36,7 @@ class LocksFeature final : public Feature {
         env.release(sh.accept);
         sh.accept = assert_lock(env, "ACCEPT", r, true);
       }
-      sh.state = st;
+      set_state(sh, r, st);
       return Value{};
     });
     env.define_function("lock-release", "11k", [this, &env](Args& a) {
@@ -46,7 +46,7 @@ class LocksFeature final : public Feature {
       Shown& sh = shown_[std::string(r)];
       env.retract(sh.accept);
       env.retract(sh.refuse);
-      sh.state = mgr_->state(r);
+      set_state(sh, r, mgr_->state(r));
       if (sh.state == LockState::kNone) assert_lock(env, "RELEASE_RVCD", r, false);
       return Value{};
     });
@@ -120,6 +120,14 @@ class LocksFeature final : public Feature {
     sync(env);
   }
 
+  // Every change of a shown state goes to AgentIo::lock_events.
+  void set_state(Shown& sh, std::string_view r, LockState st) {
+    if (st == sh.state) return;
+    const LockState from = sh.state;
+    sh.state = st;
+    if (s_.io.lock_events) s_.io.lock_events(LockEvent{s_.now, r, from, st});
+  }
+
   bool check(Environment& env, Args& a, std::string_view& r) {
     if (!mgr_) {
       env.error(a.function(), "locks are off (AgentConfig::locks)");
@@ -178,7 +186,7 @@ class LocksFeature final : public Feature {
           env.retract(sh.accept);
           break;
       }
-      sh.state = st;
+      set_state(sh, r, st);
     }
   }
 

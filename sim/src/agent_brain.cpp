@@ -25,7 +25,8 @@ std::vector<std::string> agent_files(const std::vector<std::string>& entries) {
   return out;
 }
 
-AgentBrain::AgentBrain(Game& game, int index, AgentBrainConfig config, clips::LogSink log)
+AgentBrain::AgentBrain(Game& game, int index, AgentBrainConfig config, clips::LogSink log,
+                       clips::LockListener locks)
     : game_(game), index_(index) {
   skills_ = std::make_unique<SkillBrain>(game, index, std::move(config.skills));
   const RobotStack& stack = game.robot(index);
@@ -53,6 +54,7 @@ AgentBrain::AgentBrain(Game& game, int index, AgentBrainConfig config, clips::Lo
   RobotRadio* radio = &game.robot(index).radio();
   io.broadcast = [radio](const google::protobuf::Message& m) { radio->broadcast(m); };
   io.log = std::move(log);
+  io.lock_events = std::move(locks);
   agent_ = std::make_unique<clips::AgentHost>(std::move(ac), std::move(io));
   for (const std::string& f : agent_files(config.agent_files)) agent_->load_file(f);
   game_.set_brain(index_, this);  // replaces the SkillBrain, which this brain drives

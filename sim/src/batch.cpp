@@ -8,6 +8,7 @@
 #include <condition_variable>
 #include <deque>
 #include <exception>
+#include <filesystem>
 #include <map>
 #include <mutex>
 #include <set>
@@ -15,6 +16,7 @@
 #include <utility>
 
 #include "llsf/core/error.h"
+#include "llsf/sim/recording.h"
 
 namespace llsf::sim {
 
@@ -164,6 +166,19 @@ BatchResult run_batch(const ScenarioFile& file, const std::string& scenario_hash
     }
   }
 
+  std::string record_dir;
+  if (!options.recordings_dir.empty() && !jobs.empty()) {
+    const std::filesystem::path d =
+        std::filesystem::path(options.recordings_dir) / ("batch" + std::to_string(result.batch_id));
+    std::error_code ec;
+    std::filesystem::create_directories(d, ec);
+    if (ec) {
+      throw core::ConfigError("cannot create the recordings directory " + d.string() + ": " +
+                              ec.message());
+    }
+    record_dir = d.string();
+  }
+
   // Workers take jobs in order and queue their results; this thread stores them.
   struct Done {
     RunResult result;
@@ -194,7 +209,14 @@ BatchResult run_batch(const ScenarioFile& file, const std::string& scenario_hash
           const std::size_t j = next++;
           if (j >= jobs.size()) break;
           try {
-            RunResult r = run_game(*jobs[j].scenario, jobs[j].seed);
+            RunHooks run_hooks;
+            if (!record_dir.empty()) {
+              run_hooks.record_path = (std::filesystem::path(record_dir) /
+                                       recording_file_name(jobs[j].scenario->name,
+                                                           jobs[j].scenario->variant, jobs[j].seed))
+                                          .string();
+            }
+            RunResult r = run_game(*jobs[j].scenario, jobs[j].seed, run_hooks);
             const std::lock_guard lock(mutex);
             queue.push_back({std::move(r)});
           } catch (...) {

@@ -165,6 +165,29 @@ void Recorder::skill(const SkillStatusChange& c) {
   m.write(s + "}");
 }
 
+std::string recording_file_name(const std::string& scenario, const std::string& variant,
+                                std::uint64_t seed) {
+  std::string name = scenario.empty() ? "game" : scenario;
+  if (!variant.empty()) name += "-" + variant;
+  for (char& c : name) {
+    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                    c == '.' || c == '_' || c == '-';
+    if (!ok) c = '_';
+  }
+  return name + "-seed" + std::to_string(seed) + ".jsonl.gz";
+}
+
+void Recorder::agent(const clips::LogRecord& r) {
+  impl_->write(impl_->head(r.time, "agent") + ", \"robot\": " + quote(r.agent) + ", \"level\": \"" +
+               clips::to_string(r.level) + "\", \"text\": " + quote(r.text) + "}");
+}
+
+void Recorder::lock(const std::string& robot, const clips::LockEvent& e) {
+  impl_->write(impl_->head(e.time, "lock") + ", \"robot\": " + quote(robot) +
+               ", \"resource\": " + quote(e.resource) + ", \"from\": \"" +
+               clips::to_string(e.from) + "\", \"to\": \"" + clips::to_string(e.to) + "\"}");
+}
+
 void Recorder::note(SimTime t, const std::string& robot, const std::string& text) {
   impl_->write(impl_->head(t, "note") + ", \"robot\": " + quote(robot) +
                ", \"text\": " + quote(text) + "}");

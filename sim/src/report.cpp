@@ -2,10 +2,15 @@
 #include "llsf/sim/report.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <numeric>
+#include <sstream>
 
 #include "llsf/core/rng.h"
 
@@ -162,6 +167,207 @@ std::string to_text(const BatchReport& r) {
     out += line;
   }
   return out;
+}
+
+std::vector<RunValues> run_values(const StatsStore& store, std::int64_t batch_id) {
+  std::vector<RunValues> out;
+  for (const StoredRun& run : store.runs(batch_id)) {
+    RunValues v;
+    v.variant = run.variant;
+    v.seed = run.seed;
+    v.passed = run.passed;
+    v.result_hash = run.result_hash;
+    v.statistics = store.statistics(run.id);
+    out.push_back(std::move(v));
+  }
+  std::sort(out.begin(), out.end(), [](const RunValues& a, const RunValues& b) {
+    return a.variant != b.variant ? a.variant < b.variant : a.seed < b.seed;
+  });
+  return out;
+}
+
+namespace {
+
+using Json = nlohmann::ordered_json;  // keys in the order written: a stable, readable file
+
+/// A number, or null if it is not finite (JSON has no NaN or infinity).
+Json number(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+
+std::string hex16(std::uint64_t v) {
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(v));
+  return buf;
+}
+
+std::string html_escape(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (const char c : text) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
+/// `</script` (any case) would end the inline script early; `<\/script` means the same to
+/// JavaScript inside strings and regular expressions, the only places a bundle can hold it.
+std::string escape_script_end(const std::string& js) {
+  std::string out;
+  out.reserve(js.size());
+  for (std::size_t i = 0; i < js.size(); ++i) {
+    out += js[i];
+    if (js[i] != '<' || i + 7 >= js.size() || js[i + 1] != '/') continue;
+    std::string word = js.substr(i + 2, 6);
+    for (char& c : word) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (word == "script") out += '\\';
+  }
+  return out;
+}
+
+constexpr const char* kPageHead = R"(<!DOCTYPE html>
+<html lang="en">
+<head>
+<meta charset="utf-8">
+<meta name="viewport" content="width=device-width, initial-scale=1">
+<meta name="generator" content="llsfsim report --html">
+<title>)";
+
+constexpr const char* kPageStyle = R"(</title>
+<style>
+body { font: 14px/1.4 system-ui, sans-serif; color: #222; margin: 1.5rem auto; max-width: 1000px;
+       padding: 0 1rem; }
+h1 { font-size: 1.4rem; margin-bottom: 0.2rem; }
+h2 { font-size: 1.1rem; margin-top: 2rem; }
+.meta { color: #555; margin-top: 0; }
+table { border-collapse: collapse; margin: 0.5rem 0; font-variant-numeric: tabular-nums; }
+th, td { padding: 0.2rem 0.6rem; border-bottom: 1px solid #ddd; text-align: right; }
+th:first-child, td:first-child { text-align: left; }
+thead th { border-bottom: 2px solid #999; }
+.significant { font-weight: bold; }
+.note { color: #555; font-size: 0.9rem; }
+.error { color: #b00; }
+</style>
+</head>
+<body>
+<main id="llsf-report"><noscript><pre>)";
+
+}  // namespace
+
+std::string to_json(const BatchReport& r, const std::vector<RunValues>& runs) {
+  Json j;
+  j["format"] = "llsfsim-report";
+  j["format_version"] = 1;
+  j["llsfsim_version"] = std::string(llsfsim_version());
+  // The batch's identity and metadata; its created/finished times (wall clock) stay out.
+  Json batch;
+  batch["id"] = r.batch.id;
+  batch["kind"] = r.batch.kind;
+  batch["scenario_name"] = r.batch.scenario_name;
+  batch["scenario_file"] = r.batch.scenario_file;
+  batch["scenario_hash"] = r.batch.scenario_hash;
+  batch["runs_per_variant"] = r.batch.runs_per_variant;
+  batch["variants"] = r.batch.variants;
+  batch["seeds"] = r.batch.seeds;
+  j["batch"] = std::move(batch);
+
+  Json variants = Json::array();
+  for (const VariantReport& v : r.variants) {
+    Json jv;
+    jv["variant"] = v.variant;
+    jv["runs"] = v.runs;
+    jv["passed"] = v.passed;
+    jv["pass_rate"] = number(v.runs > 0 ? static_cast<double>(v.passed) / v.runs : 0.0);
+    Json stats = Json::object();
+    for (const StatSummary& s : v.stats) {
+      stats[s.name] = Json{{"n", s.n},
+                           {"mean", number(s.mean)},
+                           {"median", number(s.median)},
+                           {"q1", number(s.q1)},
+                           {"q3", number(s.q3)},
+                           {"min", number(s.min)},
+                           {"max", number(s.max)}};
+    }
+    jv["statistics"] = std::move(stats);
+    variants.push_back(std::move(jv));
+  }
+  j["variants"] = std::move(variants);
+
+  Json differences = Json::array();
+  for (const Difference& d : r.differences) {
+    differences.push_back(Json{{"variant", d.variant},
+                               {"baseline", d.baseline},
+                               {"statistic", d.statistic},
+                               {"diff", number(d.diff)},
+                               {"ci_low", number(d.ci_low)},
+                               {"ci_high", number(d.ci_high)}});
+  }
+  j["differences"] = std::move(differences);
+
+  Json jruns = Json::array();
+  for (const RunValues& run : runs) {
+    Json stats = Json::object();
+    for (const auto& [name, value] : run.statistics) stats[name] = number(value);
+    jruns.push_back(Json{{"variant", run.variant},
+                         {"seed", run.seed},
+                         {"passed", run.passed},
+                         {"result_hash", hex16(run.result_hash)},
+                         {"statistics", std::move(stats)}});
+  }
+  j["runs"] = std::move(jruns);
+  return j.dump(1, ' ', false, Json::error_handler_t::replace) + "\n";
+}
+
+std::string viewer_dir() {
+  const char* env = std::getenv("LLSF_VIEWER_DIR");
+  if (env != nullptr && *env != '\0') return env;
+  return LLSF_DEFAULT_VIEWER_DIR;
+}
+
+std::string to_html(const BatchReport& r, const std::string& json, const std::string& dir) {
+  const std::string bundle_path = dir + "/report.js";
+  std::ifstream in(bundle_path, std::ios::binary);
+  std::ostringstream bundle;
+  bundle << in.rdbuf();
+  if (!in || bundle.str().empty()) {
+    throw ViewerBundleMissing("the viewer bundle is missing (run `make viewer`): " + bundle_path +
+                              " cannot be read");
+  }
+  // '<' occurs in JSON only inside strings, where \u003c means the same: no `</script>` and no
+  // `<!--` can end or confuse the data block.
+  std::string data;
+  data.reserve(json.size());
+  for (const char c : json) {
+    if (c == '<') {
+      data += "\\u003c";
+    } else {
+      data += c;
+    }
+  }
+  std::string page = kPageHead;
+  page += html_escape("llsfsim report: " + r.batch.scenario_name + " (batch " +
+                      std::to_string(r.batch.id) + ")");
+  page += kPageStyle;
+  page += html_escape(to_text(r));
+  page += "</pre></noscript></main>\n<script id=\"llsf-report-data\" type=\"application/json\">\n";
+  page += data;
+  page += "</script>\n<script>\n";
+  page += escape_script_end(bundle.str());
+  page += "\n</script>\n</body>\n</html>\n";
+  return page;
 }
 
 }  // namespace llsf::sim

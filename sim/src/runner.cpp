@@ -3,8 +3,12 @@
 
 #include <llsf_msgs/GameState.pb.h>
 
+#include <algorithm>
+#include <chrono>
 #include <ctime>
+#include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "llsf/core/rng.h"
@@ -42,6 +46,78 @@ int deliveries_of(const refbox::Refbox& rb) {
   return n;
 }
 
+// Lock waits of the team. A wait opens with a request and closes with the grant. A refusal ends
+// it for now: asked again within kRetryGap (the agents retry every second) the wait goes on,
+// refusals and the time in between included; otherwise (the robot gave up) it ended with the
+// refusal. Waits still open at the end of the game count until the end.
+class LockWaits {
+ public:
+  static constexpr SimTime kRetryGap = SimTime::from_sec(5);
+
+  void on(const std::string& robot, const clips::LockEvent& e) {
+    using clips::LockState;
+    auto key = std::make_pair(robot, std::string(e.resource));
+    auto it = open_.find(key);
+    switch (e.to) {
+      case LockState::kRequested:
+        if (it != open_.end() && it->second.refused_at) {
+          if (e.time - *it->second.refused_at > kRetryGap) {  // a new wait
+            close(it->second, *it->second.refused_at);
+            it->second = Wait{e.time, {}};
+          } else {
+            it->second.refused_at.reset();
+          }
+        } else if (it == open_.end()) {
+          open_.emplace(std::move(key), Wait{e.time, {}});
+        }
+        return;
+      case LockState::kRefused:
+        if (e.from == LockState::kRequested) ++refusals_;
+        if (it != open_.end()) it->second.refused_at = e.time;
+        return;
+      case LockState::kAccepted:
+        ++grants_;
+        if (it != open_.end()) {
+          close(it->second, e.time);
+          open_.erase(it);
+        }
+        return;
+      case LockState::kNone:
+      case LockState::kReleasing:
+        if (it != open_.end()) {
+          close(it->second, it->second.refused_at.value_or(e.time));
+          open_.erase(it);
+        }
+        return;
+    }
+  }
+  void finish(SimTime end, RunResult& r) {
+    for (const auto& [key, w] : open_) close(w, w.refused_at.value_or(end));
+    open_.clear();
+    r.lock_grants = grants_;
+    r.lock_refusals = refusals_;
+    r.lock_waits = waits_;
+    r.lock_wait_s = total_s_;
+    r.lock_wait_max_s = max_s_;
+  }
+
+ private:
+  struct Wait {
+    SimTime since;
+    std::optional<SimTime> refused_at;  ///< refused and not asked again yet
+  };
+  void close(const Wait& w, SimTime until) {
+    const SimTime waited = until - w.since;
+    if (waited <= SimTime{}) return;  // granted in the cycle that asked
+    ++waits_;
+    total_s_ += waited.seconds();
+    max_s_ = std::max(max_s_, waited.seconds());
+  }
+  std::map<std::pair<std::string, std::string>, Wait> open_;
+  int grants_ = 0, refusals_ = 0, waits_ = 0;
+  double total_s_ = 0.0, max_s_ = 0.0;
+};
+
 }  // namespace
 
 bool RunResult::passed() const {
@@ -55,6 +131,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   GameConfig config = scenario.game;
   config.seed = seed;
   Game game(config);
+  LockWaits lock_waits;  // before the brains, which call it
   std::vector<std::unique_ptr<AgentBrain>> brains;
   int skill_failures = 0;
   std::unique_ptr<Recorder> recorder;
@@ -70,7 +147,19 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
     c.config = spec.config;
     c.skills = scenario.skills;
     c.locks = spec.locks;
-    brains.push_back(std::make_unique<AgentBrain>(game, i, c));
+    const std::string name(game.robot(i).name());
+    clips::LogSink log;
+    if (recorder) {
+      // The agent's decisions (info and above) go into the recording.
+      log = [&recorder](const clips::LogRecord& rec) {
+        if (rec.level != clips::LogLevel::kDebug) recorder->agent(rec);
+      };
+    }
+    auto locks = [&recorder, &lock_waits, name](const clips::LockEvent& e) {
+      lock_waits.on(name, e);
+      if (recorder) recorder->lock(name, e);
+    };
+    brains.push_back(std::make_unique<AgentBrain>(game, i, c, std::move(log), std::move(locks)));
     brains.back()->skills().set_listener(
         [&skill_failures, &hooks, &recorder](const SkillStatusChange& ch) {
           if (recorder) recorder->skill(ch);
@@ -131,11 +220,22 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   const SimTime end = scenario.duration;
   SimTime next_progress = hooks.progress_every;
   const double t0 = cpu_seconds();
+  double recording_ns =
+      0.0;  // with hooks.profile: the recorder's frames (wall clock, profile only)
   // The refbox records awards with its phase-relative time; the run notes the game time too.
   std::vector<double> award_times_s;
   while (game.time() < end) {
     game.step();
-    if (recorder) recorder->frame(game);
+    if (recorder) {
+      if (hooks.profile) {
+        const auto t = std::chrono::steady_clock::now();
+        recorder->frame(game);
+        recording_ns +=
+            std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t).count();
+      } else {
+        recorder->frame(game);
+      }
+    }
     if (hooks.tick) hooks.tick(game);
     while (award_times_s.size() < game.refbox().awards().size()) {
       award_times_s.push_back(game.time().seconds());
@@ -208,6 +308,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   r.collisions = s.collisions_robot_robot + s.collisions_robot_wall + s.collisions_robot_device;
   r.skill_failures = skill_failures;
   for (const auto& b : brains) r.agent_runtime_errors += b->agent().runtime_errors();
+  lock_waits.finish(game.time(), r);
   r.messages_sent = s.comm.sent;
   r.messages_dropped = s.comm.dropped_total();
   r.cpu_s = cpu;
@@ -228,8 +329,12 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
           Game::TickProfile::step_name(i),
           1e-9 * static_cast<double>(game.profile().ns[static_cast<std::size_t>(i)]));
     }
+    if (recorder) r.time_split.emplace_back("recording", 1e-9 * recording_ns);
   }
-  if (recorder) recorder->close();  // throws if the file could not be finished
+  if (recorder) {
+    recorder->close();  // throws if the file could not be finished
+    r.recording = hooks.record_path;
+  }
   for (int i = 0; i < game.robot_count(); ++i) game.set_brain(i, nullptr);
   return r;
 }
@@ -261,6 +366,9 @@ std::string to_json(const RunResult& r) {
     << ", \"P3\": " << r.products_p3 << "}, \"recycled\": " << r.recycled
     << ", \"collisions\": " << r.collisions << ", \"skill_failures\": " << r.skill_failures
     << ", \"agent_runtime_errors\": " << r.agent_runtime_errors
+    << ", \"locks\": {\"grants\": " << r.lock_grants << ", \"refusals\": " << r.lock_refusals
+    << ", \"waits\": " << r.lock_waits << ", \"wait_s\": " << r.lock_wait_s
+    << ", \"wait_max_s\": " << r.lock_wait_max_s << "}"
     << ", \"messages_sent\": " << r.messages_sent
     << ", \"messages_dropped\": " << r.messages_dropped << ", \"cpu_s\": " << r.cpu_s
     << ", \"real_time_factor\": " << r.real_time_factor << ", \"result_hash\": \"" << std::hex

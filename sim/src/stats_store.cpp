@@ -7,6 +7,7 @@
 #include <array>
 #include <cinttypes>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <sstream>
@@ -23,7 +24,7 @@ namespace {
 
 // The schema (docs/statistics.md explains every column). `PRAGMA user_version` holds
 // kSchemaVersion; a file with another version is refused rather than misread.
-constexpr int kSchemaVersion = 1;
+constexpr int kSchemaVersion = 2;
 constexpr const char* kSchema = R"sql(
 CREATE TABLE batches (
   id               INTEGER PRIMARY KEY,
@@ -52,6 +53,7 @@ CREATE TABLE runs (
   game_time_s      REAL    NOT NULL,
   cpu_s            REAL    NOT NULL,
   real_time_factor REAL    NOT NULL,
+  recording        TEXT,
   created          TEXT    NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%SZ', 'now')),
   UNIQUE (batch_id, variant, seed)
 );
@@ -234,7 +236,8 @@ class Transaction {
 std::string join_seeds(const std::vector<std::uint64_t>& seeds) {
   std::string out;
   for (std::size_t i = 0; i < seeds.size(); ++i) {
-    out += (i ? "," : "") + std::to_string(seeds[i]);
+    if (i > 0) out += ',';
+    out += std::to_string(seeds[i]);
   }
   return out;
 }
@@ -281,6 +284,12 @@ struct StatsStore::Impl {
     const int version = v.start().step() ? static_cast<int>(v.int64(0)) : 0;
     v.finish();
     if (version == kSchemaVersion) return;  // rolled back: nothing was written
+    if (version == 1) {                     // version 2 added runs.recording
+      exec(db.get(), path, "ALTER TABLE runs ADD COLUMN recording TEXT");
+      exec(db.get(), path, ("PRAGMA user_version = " + std::to_string(kSchemaVersion)).c_str());
+      t.commit();
+      return;
+    }
     if (version != 0) {
       throw StatsError(path + ": schema version " + std::to_string(version) +
                        " (this llsfsim reads version " + std::to_string(kSchemaVersion) + ")");
@@ -310,8 +319,8 @@ struct StatsStore::Impl {
     delete_run = prep("DELETE FROM runs WHERE batch_id = ? AND variant = ? AND seed = ?");
     insert_run = prep(
         "INSERT INTO runs (batch_id, scenario, variant, seed, llsfsim_version, result_hash, "
-        "passed, points, game_time_s, cpu_s, real_time_factor) "
-        "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+        "passed, points, game_time_s, cpu_s, real_time_factor, recording) "
+        "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
     insert_stat = prep("INSERT INTO statistics (run_id, name, value) VALUES (?, ?, ?)");
     insert_order = prep(
         "INSERT INTO orders (run_id, order_id, product, requested, delivered, window_begin_s, "
@@ -326,7 +335,8 @@ struct StatsStore::Impl {
         "VALUES (?, ?, ?, ?, ?, ?, ?)");
     select_runs = prep(
         "SELECT id, batch_id, scenario, variant, seed, llsfsim_version, result_hash, passed, "
-        "points, game_time_s, cpu_s, real_time_factor FROM runs WHERE batch_id = ? ORDER BY id");
+        "points, game_time_s, cpu_s, real_time_factor, recording FROM runs WHERE batch_id = ? "
+        "ORDER BY id");
     select_stats = prep("SELECT name, value FROM statistics WHERE run_id = ? ORDER BY name");
     select_awards = prep(
         "SELECT time_s, game_time_s, phase, points, reason, coalesce(device, ''), "
@@ -334,7 +344,18 @@ struct StatsStore::Impl {
   }
 };
 
-StatsStore::StatsStore(const std::string& path) : impl_(std::make_unique<Impl>(path)) {}
+namespace {
+// The store's directory is created if missing (a failure shows when SQLite opens the file).
+const std::string& with_parent_dir(const std::string& path) {
+  const std::filesystem::path dir = std::filesystem::path(path).parent_path();
+  std::error_code ec;
+  if (!dir.empty()) std::filesystem::create_directories(dir, ec);
+  return path;
+}
+}  // namespace
+
+StatsStore::StatsStore(const std::string& path)
+    : impl_(std::make_unique<Impl>(with_parent_dir(path))) {}
 StatsStore::~StatsStore() = default;
 StatsStore::StatsStore(StatsStore&&) noexcept = default;
 StatsStore& StatsStore::operator=(StatsStore&&) noexcept = default;
@@ -422,8 +443,12 @@ std::int64_t StatsStore::add_run(std::int64_t batch_id, const RunResult& r, bool
       .bind(r.points)
       .bind(r.game_time_s)
       .bind(r.cpu_s)
-      .bind(r.real_time_factor)
-      .run();
+      .bind(r.real_time_factor);
+  if (r.recording.empty())
+    m.insert_run->bind_null();
+  else
+    m.insert_run->bind(std::string_view(stored_recording_path(m.path, r.recording)));
+  m.insert_run->run();
   const std::int64_t run_id = sqlite3_last_insert_rowid(m.db.get());
 
   for (const auto& [name, value] : numeric_statistics(r)) {
@@ -534,6 +559,7 @@ std::vector<StoredRun> StatsStore::runs(std::int64_t batch_id) const {
     s.game_time_s = q.real(9);
     s.cpu_s = q.real(10);
     s.real_time_factor = q.real(11);
+    s.recording = q.null(12) ? std::string() : resolved_recording_path(impl_->path, q.text(12));
   }
   return out;
 }
@@ -590,6 +616,25 @@ std::string file_content_hash(const std::string& path) {
   return hex16(core::fnv1a(std::string_view(bytes)));
 }
 
+std::string stored_recording_path(const std::string& db_path, const std::string& recording) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path base = fs::absolute(fs::path(db_path).parent_path(), ec);
+  const fs::path file = fs::absolute(recording, ec);
+  if (ec) return recording;
+  const fs::path rel = file.lexically_normal().lexically_relative(base.lexically_normal());
+  // Inside the database's directory: relative (the pair can move together); else absolute.
+  if (rel.empty() || *rel.begin() == "..") return file.lexically_normal().string();
+  return rel.string();
+}
+
+std::string resolved_recording_path(const std::string& db_path, const std::string& stored) {
+  namespace fs = std::filesystem;
+  const fs::path p(stored);
+  if (p.is_absolute()) return stored;
+  return (fs::path(db_path).parent_path() / p).lexically_normal().string();
+}
+
 std::vector<std::pair<std::string, double>> numeric_statistics(const RunResult& r) {
   int requested = 0;
   int delivered = 0;
@@ -615,6 +660,11 @@ std::vector<std::pair<std::string, double>> numeric_statistics(const RunResult& 
       {"collisions", d(r.collisions)},
       {"skill_failures", d(r.skill_failures)},
       {"agent_runtime_errors", d(r.agent_runtime_errors)},
+      {"lock_grants", d(r.lock_grants)},
+      {"lock_refusals", d(r.lock_refusals)},
+      {"lock_waits", d(r.lock_waits)},
+      {"lock_wait_s", r.lock_wait_s},
+      {"lock_wait_max_s", r.lock_wait_max_s},
       {"messages_sent", d(r.messages_sent)},
       {"messages_dropped", d(r.messages_dropped)},
       {"cpu_s", r.cpu_s},

@@ -8,6 +8,7 @@
 #include <atomic>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 #include <tuple>
@@ -68,6 +69,11 @@ std::string write_tiny(const TempDir& dir, const std::string& tests = "  - no_ag
   return dir.file(name);
 }
 
+std::string slurp(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
+}
+
 using Key = std::tuple<std::string, std::uint64_t, std::uint64_t>;  // variant, seed, hash
 
 std::vector<Key> stored_runs(const std::string& db) {
@@ -118,10 +124,27 @@ TEST_CASE("llsfsim batch plays variants x seeds once, stores them, and resumes")
   CHECK(has(r.out, "4 runs, 0 played, 4 stored before"));
   CHECK(stored_runs(db2) == two);
 
-  // One worker: the same result hashes.
+  // One worker: the same result hashes, and byte for byte the same recordings.
   r = llsfsim({"batch", scenario, "--jobs", "1", "--db", db1});
   CHECK(r.code == llsf::app::kExitOk);
   CHECK(stored_runs(db1) == two);
+  CHECK(has(r.out, "recordings " + dir.file("one-recordings") + "/batch1/"));
+  {
+    const llsf::sim::StatsStore s1(db1), s2(db2);
+    const auto runs1 = s1.runs(1), runs2 = s2.runs(1);
+    REQUIRE(runs1.size() == 4);
+    REQUIRE(runs2.size() == 4);
+    for (const auto& a : runs1) {
+      const auto b = std::find_if(runs2.begin(), runs2.end(), [&](const auto& x) {
+        return x.variant == a.variant && x.seed == a.seed;
+      });
+      REQUIRE(b != runs2.end());
+      INFO(a.recording, " vs ", b->recording);
+      CHECK(a.recording.find("one-recordings/batch1/tiny-config_") != std::string::npos);
+      CHECK(fs::file_size(a.recording) > 1000);
+      CHECK(slurp(a.recording) == slurp(b->recording));
+    }
+  }
 
   // --runs 1: another batch (first seed of each variant), same results for those seeds.
   r = llsfsim({"batch", scenario, "--runs", "1", "--db", db1});
@@ -189,7 +212,7 @@ TEST_CASE("llsfsim batch: a failed test case exits 1, bad input exits 2") {
   CHECK(r.code == llsf::app::kExitBadInput);
   r = llsfsim({"batch", dir.file("missing.yaml")});
   CHECK(r.code == llsf::app::kExitBadInput);
-  r = llsfsim({"batch", tiny, "--db", dir.file("no/such/dir/x.db")});
+  r = llsfsim({"batch", tiny, "--db", dir.file("tiny.yaml/x.db")});  // below a file
   CHECK(r.code == llsf::app::kExitBadInput);
   CHECK(has(r.err, "x.db"));
 }
@@ -204,6 +227,16 @@ TEST_CASE("llsfsim run stores its game with --db, not with --no-db") {
   REQUIRE(runs.size() == 1);
   CHECK(std::get<0>(runs[0]) == "config=P3-P3");
   CHECK(std::get<1>(runs[0]) == 3);
+  // Recorded beside the store, and the summary says where.
+  CHECK(fs::file_size(dir.file("run-recordings/tiny-config_P3-P3-seed3.jsonl.gz")) > 1000);
+  r = llsfsim({"run", scenario, "--db", db, "--no-record"});
+  CHECK(has(r.out, "database   " + db + " (batch 1, run "));
+  CHECK(!has(r.out, "recording  "));
+  CHECK(llsf::sim::StatsStore(db).runs(1).back().recording.empty());
+  r = llsfsim({"run", scenario, "--db", db});
+  CHECK(has(r.out, "recording  " + dir.file("run-recordings/tiny-config_P3-P3-seed3.jsonl.gz")));
+  CHECK(llsf::sim::StatsStore(db).runs(1).back().recording ==
+        dir.file("run-recordings/tiny-config_P3-P3-seed3.jsonl.gz"));
 
   // The same game again replaces the stored one; another seed adds one.
   CHECK(llsfsim({"run", scenario, "--quiet", "--db", db}).code == llsf::app::kExitOk);
@@ -219,6 +252,6 @@ TEST_CASE("llsfsim run stores its game with --db, not with --no-db") {
   const std::string other = dir.file("other.db");
   CHECK(llsfsim({"run", scenario, "--quiet", "--no-db", "--db", other}).code ==
         llsf::app::kExitBadInput);  // they exclude each other
-  CHECK(llsfsim({"run", scenario, "--quiet", "--no-db"}).code == llsf::app::kExitOk);
+  CHECK(llsfsim({"run", scenario, "--quiet", "--no-db", "--no-record"}).code == llsf::app::kExitOk);
   CHECK(!fs::exists(other));
 }

@@ -34,6 +34,15 @@ TEST_CASE("llsfsim skill runs strings in turn and prints status changes with gam
         r.out);
 }
 
+TEST_CASE("llsfsim skill --skills DIR takes one directory; the skill strings follow") {
+  const Run r = llsfsim({"skill", "--skills", LLSF_SOURCE_DIR "/lua/skills/examples",
+                         "say_hello{who=\"tour\"}", "goto_place{place=\"M5\"}"});
+  INFO(r.out, r.err);
+  CHECK(r.code == 0);
+  CHECK(has(r.out, "robot1 FINAL  say_hello{who=\"tour\"}"));
+  CHECK(has(r.out, "robot1 FINAL  goto_place{place=\"M5\"}"));
+}
+
 TEST_CASE("llsfsim skill: a failing skill exits 1 with its reason; bad input exits 2") {
   Run r = llsfsim({"skill", "drive_to{place=\"M11\"}"});
   CHECK(r.code == llsf::app::kExitFailed);
@@ -109,17 +118,18 @@ TEST_CASE("llsfsim run --speed paces the game and gives the same result as unpac
            "/clips/agents/llsf2013]\n";
   }
   const auto t0 = std::chrono::steady_clock::now();
-  const Run paced = llsfsim({"run", scenario, "--no-db", "--json", "--speed", "40"});
+  const Run paced = llsfsim({"run", scenario, "--no-db", "--no-record", "--json", "--speed", "40"});
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   CHECK(paced.code == 0);
   CHECK(wall >= 0.24);  // 10 s of game at 40x: at least 0.25 s (minus a tick)
-  const Run fast = llsfsim({"run", scenario, "--no-db", "--json"});
+  const Run fast = llsfsim({"run", scenario, "--no-db", "--no-record", "--json"});
   auto hash = [](const std::string& json) {
     const auto p = json.find("\"result_hash\"");
     return json.substr(p, 40);
   };
   CHECK(hash(paced.out) == hash(fast.out));
-  CHECK(llsfsim({"run", scenario, "--speed", "0"}).code == llsf::app::kExitBadInput);
+  CHECK(llsfsim({"run", scenario, "--no-db", "--no-record", "--speed", "0"}).code ==
+        llsf::app::kExitBadInput);
 }
 
 TEST_CASE("llsfsim report: an empty store has no batch (exit 2); --list works; help") {

@@ -5,6 +5,7 @@
 #include <doctest/doctest.h>
 #include <llsf_agent_msgs/LockMessage.pb.h>
 
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -50,6 +51,11 @@ struct Team {
         hub.broadcast(peer, m, now);
       };
       io.log = [this](const LogRecord& r) { log.push_back(std::string(r.text)); };
+      io.lock_events = [this, name](const LockEvent& e) {
+        CHECK(e.time == now);
+        lock_events[name].push_back(std::string(e.resource) + " " + to_string(e.from) + ">" +
+                                    to_string(e.to));
+      };
       hosts.push_back(std::make_unique<AgentHost>(c, io));
       hosts.back()->load_string(kProbeRvcd, "probe-rvcd.clp");
       hosts.back()->load_string(kProbeMsg, "probe-msg.clp");
@@ -97,6 +103,7 @@ struct Team {
   std::vector<comm::PeerId> peers;
   std::vector<std::unique_ptr<AgentHost>> hosts;
   std::vector<std::string> log;
+  std::map<std::string, std::vector<std::string>> lock_events;  ///< per robot, in order
   SimTime now;
 };
 
@@ -158,6 +165,17 @@ TEST_CASE("lock facts: GET -> ACCEPT/REFUSE, RELEASE after 0.5 m -> RELEASE_RVCD
   // The master's own lock, served without the radio.
   t.assert_lock(master, "GET", "M2");
   REQUIRE(t.run_until([&] { return t.has_lock(master, "ACCEPT", "M2"); }, SimTime::from_sec(1)));
+
+  // Every state change went to AgentIo::lock_events, in order.
+  const std::string an = t.hosts[a]->config().robot_name, bn = t.hosts[b]->config().robot_name;
+  CHECK(t.lock_events[an] == std::vector<std::string>{"M1 NONE>REQUESTED", "M1 REQUESTED>ACCEPTED",
+                                                      "M1 ACCEPTED>RELEASING",
+                                                      "M1 RELEASING>NONE"});
+  CHECK(t.lock_events[bn] == std::vector<std::string>{"M1 NONE>REQUESTED", "M1 REQUESTED>REFUSED",
+                                                      "M1 REFUSED>REQUESTED",
+                                                      "M1 REQUESTED>ACCEPTED"});
+  CHECK(t.lock_events[master_name] ==
+        std::vector<std::string>{"M2 NONE>REQUESTED", "M2 REQUESTED>ACCEPTED"});
 
   // The lock messages never became protobuf-msg facts; nothing went wrong.
   for (std::size_t i = 0; i < 3; ++i) {

@@ -68,6 +68,27 @@ TEST_CASE("a full game is recorded: 10 Hz frames, events, well under 5 MB, reada
     award_points += std::stoi(l.json.substr(p + 10));
   }
   CHECK(award_points == r.exploration_points + r.production_points);
+  CHECK(r.recording == path);
+
+  // The agents' decisions and the lock protocol (default.yaml has locks on): every grant and
+  // refusal of the run's statistics is a lock line.
+  CHECK(kinds["agent"] > 10);
+  int grants = 0, refusals = 0;
+  for (const RecordingLine& l : lines) {
+    if (l.kind != "lock") continue;
+    CHECK(l.json.find("\"robot\": \"robot") != std::string::npos);
+    if (l.json.find("\"to\": \"ACCEPTED\"") != std::string::npos) ++grants;
+    if (l.json.find("\"from\": \"REQUESTED\", \"to\": \"REFUSED\"") != std::string::npos)
+      ++refusals;
+  }
+  MESSAGE("locks: ", r.lock_grants, " grants, ", r.lock_refusals, " refusals, ", r.lock_waits,
+          " waits, ", r.lock_wait_s, " s, longest ", r.lock_wait_max_s, " s");
+  CHECK(r.lock_grants > 10);
+  CHECK(grants == r.lock_grants);
+  CHECK(refusals == r.lock_refusals);
+  CHECK(r.lock_wait_s > 0.0);
+  CHECK(r.lock_wait_max_s <= r.lock_wait_s);
+  CHECK(r.lock_wait_max_s <= r.game_time_s);
 }
 
 TEST_CASE("bad recordings: missing, corrupt, wrong version, not JSON") {

@@ -3,6 +3,7 @@
 #include "llsf/sim/stats_store.h"
 
 #include <doctest/doctest.h>
+#include <sqlite3.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -91,7 +92,53 @@ TEST_CASE("StatsStore refuses files that are not a statistics store") {
   const TempDir dir;
   { std::ofstream(dir.file("text.db")) << "not a database, just text that is long enough......"; }
   CHECK_THROWS_AS(StatsStore(dir.file("text.db")), StatsError);
-  CHECK_THROWS_AS(StatsStore(dir.file("missing/dir/x.db")), StatsError);
+  // A missing directory is created; one that cannot be (below a file) is an error.
+  CHECK_NOTHROW(StatsStore(dir.file("missing/dir/x.db")));
+  CHECK_THROWS_AS(StatsStore(dir.file("text.db/x.db")), StatsError);
+}
+
+TEST_CASE("StatsStore keeps recording paths relative to its directory, and reads schema 1") {
+  const TempDir dir;
+  const std::string db = dir.file("stats.db");
+  {
+    StatsStore store(db);
+    const std::int64_t batch = store.open_batch(sample_key());
+    RunResult inside = sample_run("a", 1);
+    inside.recording = dir.file("recordings/batch1/a-seed1.jsonl.gz");
+    RunResult outside = sample_run("a", 2);
+    outside.recording = "/var/tmp/elsewhere.jsonl.gz";
+    RunResult none = sample_run("b", 1);
+    store.add_run(batch, inside);
+    store.add_run(batch, outside);
+    store.add_run(batch, none);
+    const auto runs = store.runs(batch);
+    REQUIRE(runs.size() == 3);
+    CHECK(runs[0].recording == inside.recording);
+    CHECK(runs[1].recording == outside.recording);
+    CHECK(runs[2].recording.empty());
+  }
+  // What the file holds: the path relative to the database's directory.
+  sqlite3* h = nullptr;
+  REQUIRE(sqlite3_open(db.c_str(), &h) == SQLITE_OK);
+  sqlite3_stmt* q = nullptr;
+  REQUIRE(sqlite3_prepare_v2(h, "SELECT recording FROM runs ORDER BY id", -1, &q, nullptr) ==
+          SQLITE_OK);
+  REQUIRE(sqlite3_step(q) == SQLITE_ROW);
+  CHECK(std::string(reinterpret_cast<const char*>(sqlite3_column_text(q, 0))) ==
+        "recordings/batch1/a-seed1.jsonl.gz");
+  sqlite3_finalize(q);
+  // Schema 1 (before runs.recording): the store adds the column and keeps the runs.
+  CHECK(sqlite3_exec(h, "ALTER TABLE runs DROP COLUMN recording; PRAGMA user_version = 1", nullptr,
+                     nullptr, nullptr) == SQLITE_OK);
+  sqlite3_close(h);
+  StatsStore old(db);
+  const std::int64_t batch = old.open_batch(sample_key());
+  CHECK(old.runs(batch).size() == 3);
+  CHECK(old.runs(batch)[0].recording.empty());
+  RunResult again = sample_run("b", 2);
+  again.recording = dir.file("r.jsonl.gz");
+  old.add_run(batch, again);
+  CHECK(old.runs(batch).back().recording == again.recording);
 }
 
 TEST_CASE("StatsStore writes a run and reads it back") {

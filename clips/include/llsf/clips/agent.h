@@ -56,6 +56,16 @@ using LogSink = std::function<void(const LogRecord&)>;
 /// The message is borrowed for the duration of the call.
 using BroadcastFn = std::function<void(const google::protobuf::Message&)>;
 
+/// A change of this robot's state for one lock (AgentConfig::locks): e.g. REQUESTED -> ACCEPTED
+/// is a grant, REQUESTED -> REFUSED a refusal. `resource` is valid during the call only.
+struct LockEvent {
+  core::SimTime time;  ///< simulated time of the cycle (or the lock-request/-release call)
+  std::string_view resource;
+  LockState from = LockState::kNone;
+  LockState to = LockState::kNone;
+};
+using LockListener = std::function<void(const LockEvent&)>;
+
 /// Read-only configuration of one agent.
 struct AgentConfig {
   std::string robot_name = "robot1";          ///< ?*ROBOT-NAME* (a symbol)
@@ -81,6 +91,7 @@ struct AgentIo {
   const comm::MessageRegistry* messages = nullptr;
   BroadcastFn broadcast;
   LogSink log;
+  LockListener lock_events;  ///< every lock state change of this robot (with locks on)
 };
 
 /// What one cycle did.

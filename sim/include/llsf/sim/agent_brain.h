@@ -47,8 +47,10 @@ std::vector<std::string> agent_files(const std::vector<std::string>& entries);
 class AgentBrain final : public RobotBrain, private clips::SkillRunner {
  public:
   /// Loads the agent files; throws clips::AgentLoadError for bad agent code and
-  /// core::ConfigError for a bad skill-engine config. `log` receives the agent's output.
-  AgentBrain(Game& game, int index, AgentBrainConfig config, clips::LogSink log = {});
+  /// core::ConfigError for a bad skill-engine config. `log` receives the agent's output,
+  /// `locks` every change of the robot's lock states (with locks on).
+  AgentBrain(Game& game, int index, AgentBrainConfig config, clips::LogSink log = {},
+             clips::LockListener locks = {});
   ~AgentBrain() override;
   AgentBrain(const AgentBrain&) = delete;
   AgentBrain& operator=(const AgentBrain&) = delete;

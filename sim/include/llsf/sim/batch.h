@@ -24,6 +24,9 @@ struct BatchOptions {
   std::optional<int> runs;
   /// Worker threads (>= 1); 0: std::thread::hardware_concurrency().
   int jobs = 0;
+  /// If set, every game is recorded to <recordings_dir>/batch<ID>/recording_file_name(...)
+  /// (the directory is created) and the store keeps the path with the run.
+  std::string recordings_dir;
 };
 
 /// The seeds a batch plays for `s`. Throws core::ConfigError if `runs` < 1 or exceeds a seed

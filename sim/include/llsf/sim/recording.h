@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Recordings of games for replay (the viewer) and analysis: the poses of every robot (true and
 // believed) and puck at 10 Hz plus every event -- refbox phases and points, lamp changes, RFID,
-// collisions, skill status changes, radio drops -- in gzip-compressed JSON lines, versioned.
-// docs/recording.md documents the format.
+// collisions, skill status changes, agent decisions, lock grants and refusals, radio drops -- in
+// gzip-compressed JSON lines, versioned. docs/recording.md documents the format.
 #pragma once
 
 #include <cstdint>
@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "llsf/clips/agent.h"
 #include "llsf/core/sim_time.h"
 #include "llsf/sim/game.h"
 #include "llsf/sim/skill_brain.h"
@@ -43,6 +44,10 @@ class Recorder {
   void frame(const Game& game);
   /// A skill status change of a robot.
   void skill(const SkillStatusChange& change);
+  /// A line of agent output (its decisions: (log-info ...), warnings, errors).
+  void agent(const clips::LogRecord& record);
+  /// A change of a robot's lock state (grants, refusals, releases).
+  void lock(const std::string& robot, const clips::LockEvent& event);
   /// A free-form event from an agent or tool ({"t":..,"e":"note","robot":..,"text":..}).
   void note(SimTime t, const std::string& robot, const std::string& text);
   /// Flushes and closes the file (idempotent).
@@ -54,6 +59,12 @@ class Recorder {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+/// The file name of a game's recording: "<scenario>[-<variant>]-seed<N>.jsonl.gz", every
+/// character other than letters, digits, '.', '_' and '-' replaced by '_'
+/// (e.g. "auction-vs-roles-agent_auction-seed3.jsonl.gz").
+std::string recording_file_name(const std::string& scenario, const std::string& variant,
+                                std::uint64_t seed);
 
 /// One parsed line of a recording (tests, tools): its time, its kind ("header", "frame", or the
 /// event name) and the raw JSON text.

@@ -1,11 +1,14 @@
 // SPDX-License-Identifier: MIT
 // Reports over a batch of stored runs: per variant the distribution of every statistic (mean,
 // median, quartiles, min, max) and the pass rate, and the difference of each variant's mean
-// from the first variant's with a bootstrap 95 % confidence interval.
+// from the first variant's with a bootstrap 95 % confidence interval; as text, CSV, JSON and a
+// self-contained HTML page with box plots (the viewer's bundle, viewer/README.md).
 #pragma once
 
 #include <cstdint>
+#include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "llsf/sim/stats_store.h"
@@ -50,6 +53,41 @@ BatchReport make_report(const StatsStore& store, std::int64_t batch_id, std::uin
 std::string to_csv(const BatchReport& r);
 /// A readable table: per variant the pass rate and points, then the differences.
 std::string to_text(const BatchReport& r);
+
+/// One stored run with every statistic of it: the raw values behind a report.
+struct RunValues {
+  std::string variant;
+  std::uint64_t seed = 0;
+  bool passed = false;
+  std::uint64_t result_hash = 0;
+  std::vector<std::pair<std::string, double>> statistics;  ///< by name (StatsStore::statistics)
+};
+
+/// Every run of batch `batch_id` with its statistics, in (variant, seed) order (independent of
+/// the order in which a batch's workers stored them).
+std::vector<RunValues> run_values(const StatsStore& store, std::int64_t batch_id);
+
+/// The report and its runs as one JSON object (docs/llsfsim.md, "report --html"): `format`,
+/// `llsfsim_version`, `batch` (id, kind, scenario, runs per variant, seeds; no wall-clock time),
+/// `variants` (runs, passed, pass_rate, statistics by name), `differences` and `runs` (variant,
+/// seed, passed, result_hash, statistics by name). Non-finite numbers are written as null; the
+/// same report and runs give the same bytes.
+std::string to_json(const BatchReport& r, const std::vector<RunValues>& runs);
+
+/// The viewer's bundle (`report.js`) is not in the viewer directory.
+class ViewerBundleMissing : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Where the viewer's bundle is looked for: $LLSF_VIEWER_DIR if set and not empty, else
+/// viewer/dist of the source tree (built by `make viewer`).
+std::string viewer_dir();
+
+/// A self-contained HTML page of the report: a small template, `dir`/report.js inlined, and
+/// `json` (to_json's output) in `<script id="llsf-report-data" type="application/json">`; the
+/// text report in a <noscript>. Throws ViewerBundleMissing if `dir`/report.js cannot be read.
+std::string to_html(const BatchReport& r, const std::string& json, const std::string& dir);
 
 /// Quantile `q` in [0, 1] of sorted values, linear interpolation between order statistics
 /// (R's type 7); 0 for an empty vector.

@@ -64,15 +64,26 @@ struct RunResult {
   int collisions = 0;
   int skill_failures = 0;
   int agent_runtime_errors = 0;
+  /// Locks (robots with locks on): grants, refusals, and the waits -- a wait runs from a
+  /// request to the grant, through refusals the robot answered by asking again within 5 s; a
+  /// robot that gave up stopped waiting at the last refusal; a wait still open at the end counts
+  /// until the end. lock_waits counts the waits that took time (not granted in the asking cycle).
+  int lock_grants = 0;
+  int lock_refusals = 0;
+  int lock_waits = 0;
+  double lock_wait_s = 0.0;      ///< summed over robots and resources
+  double lock_wait_max_s = 0.0;  ///< the longest single wait
   std::int64_t messages_sent = 0;
   std::int64_t messages_dropped = 0;
   double cpu_s = 0.0;
   double real_time_factor = 0.0;
   std::uint64_t result_hash = 0;
   std::vector<TestVerdict> tests;
-  /// With RunHooks::profile: seconds spent per tick step (Game::TickProfile names).
+  /// With RunHooks::profile: seconds spent per tick step (Game::TickProfile names), plus
+  /// "recording" (the recorder's frames) when the game was recorded.
   std::vector<std::pair<std::string, double>> time_split;
   std::vector<RunAward> awards;  ///< every points award, in order
+  std::string recording;         ///< RunHooks::record_path if the game was recorded
   bool passed() const;
 };
 

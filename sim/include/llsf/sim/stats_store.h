@@ -71,6 +71,9 @@ struct StoredRun {
   double game_time_s = 0.0;
   double cpu_s = 0.0;
   double real_time_factor = 0.0;
+  /// The run's recording ("" if none): a path relative to the working directory (or absolute),
+  /// resolved from what the store keeps -- relative to the database's directory when inside it.
+  std::string recording;
 };
 
 /// The statistics database. Not thread-safe: one thread writes (a batch queues its results to
@@ -132,5 +135,11 @@ std::string file_content_hash(const std::string& path);
 /// The statistics of `r` by name, in the order of docs/statistics.md: every numeric field of
 /// RunResult (points, exploration_points, ..., cpu_s, real_time_factor).
 std::vector<std::pair<std::string, double>> numeric_statistics(const RunResult& r);
+
+/// How the store keeps a recording path: relative to the database file's directory when the
+/// file lies inside it (database and recordings can move together), else absolute.
+std::string stored_recording_path(const std::string& db_path, const std::string& recording);
+/// The inverse: a kept path as a path usable from the working directory.
+std::string resolved_recording_path(const std::string& db_path, const std::string& stored);
 
 }  // namespace llsf::sim
