@@ -3,6 +3,7 @@
 
 #include <zlib.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -89,13 +90,17 @@ struct Recorder::Impl {
   std::map<std::uint32_t, int> delivered;
   std::int64_t dropped = 0;
   std::vector<std::string> robot_names;
+  std::vector<std::vector<core::Vec2>> paths;  // per robot, as last written
+  LineSink sink;
 
   void write(const std::string& s) {
-    if (file == nullptr) return;
-    if (gzwrite(file, s.data(), static_cast<unsigned>(s.size())) != static_cast<int>(s.size()) ||
-        gzputc(file, '\n') < 0) {
+    if (file == nullptr && !sink) return;
+    if (file != nullptr &&
+        (gzwrite(file, s.data(), static_cast<unsigned>(s.size())) != static_cast<int>(s.size()) ||
+         gzputc(file, '\n') < 0)) {
       throw std::runtime_error(path + ": cannot write the recording");
     }
+    if (sink) sink(s);
     ++lines;
   }
   std::string head(SimTime t, const char* event) {
@@ -104,12 +109,16 @@ struct Recorder::Impl {
 };
 
 Recorder::Recorder(const std::string& path, const Game& game, const RecordingInfo& info,
-                   double pose_rate_hz)
+                   double pose_rate_hz, LineSink sink)
     : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   m.path = path;
-  m.file = gzopen(path.c_str(), "wb6");
-  if (m.file == nullptr) throw std::runtime_error(path + ": cannot create the recording");
+  m.sink = std::move(sink);
+  if (!path.empty()) {
+    m.file = gzopen(path.c_str(), "wb6");
+    if (m.file == nullptr) throw std::runtime_error(path + ": cannot create the recording");
+  }
+  m.paths.resize(static_cast<std::size_t>(game.robot_count()));
   m.period = SimTime::period_of_hz(pose_rate_hz);
   m.next_frame = game.time();
   const kinematic::WorldConfig& w = game.config().world;
@@ -257,6 +266,27 @@ void Recorder::frame(const Game& game) {
 
   if (t < m.next_frame) return;
   while (m.next_frame <= t) m.next_frame += m.period;
+
+  // Planned paths that changed since the last frame (empty while not navigating).
+  for (int i = 0; i < game.robot_count(); ++i) {
+    const planner::Navigator& nav = game.robot(i).nav();
+    static const std::vector<core::Vec2> kNone;
+    const std::vector<core::Vec2>& now =
+        nav.status().outcome == planner::NavOutcome::kRunning ? nav.path().points : kNone;
+    std::vector<core::Vec2>& last = m.paths[static_cast<std::size_t>(i)];
+    if (now.size() == last.size() &&
+        std::equal(now.begin(), now.end(), last.begin(),
+                   [](const core::Vec2& a, const core::Vec2& b) { return (a - b).norm() < 1e-3; }))
+      continue;
+    last = now;
+    std::string e = m.head(t, "path") +
+                    ", \"robot\": " + quote(m.robot_names.at(static_cast<std::size_t>(i))) +
+                    ", \"points\": [";
+    for (std::size_t k = 0; k < now.size(); ++k) {
+      e += std::string(k ? ", " : "") + "[" + num(now[k].x(), 3) + ", " + num(now[k].y(), 3) + "]";
+    }
+    m.write(e + "]}");
+  }
 
   // Pose frame: robots (true pose, believed pose, held puck), pucks that moved, removed pucks.
   std::string& s = m.line;

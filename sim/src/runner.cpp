@@ -135,9 +135,10 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   std::vector<std::unique_ptr<AgentBrain>> brains;
   int skill_failures = 0;
   std::unique_ptr<Recorder> recorder;
-  if (!hooks.record_path.empty()) {
+  if (!hooks.record_path.empty() || hooks.record_sink) {
     recorder = std::make_unique<Recorder>(
-        hooks.record_path, game, RecordingInfo{scenario.name, scenario.variant, seed, "0.1.0"});
+        hooks.record_path, game, RecordingInfo{scenario.name, scenario.variant, seed, "0.1.0"},
+        10.0, hooks.record_sink);
   }
   for (int i = 0; i < game.robot_count(); ++i) {
     const RobotSpec& spec = scenario.robots.at(static_cast<std::size_t>(i));

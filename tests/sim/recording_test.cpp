@@ -61,6 +61,7 @@ TEST_CASE("a full game is recorded: 10 Hz frames, events, well under 5 MB, reada
   CHECK(kinds["skill"] > 0);
   CHECK(kinds["puck"] > 20);
   CHECK(kinds["order"] > 0);
+  CHECK(kinds["path"] > 10);  // planned paths as they change
   int award_points = 0;
   for (const RecordingLine& l : lines) {
     if (l.kind != "award") continue;
@@ -89,6 +90,37 @@ TEST_CASE("a full game is recorded: 10 Hz frames, events, well under 5 MB, reada
   CHECK(r.lock_wait_s > 0.0);
   CHECK(r.lock_wait_max_s <= r.lock_wait_s);
   CHECK(r.lock_wait_max_s <= r.game_time_s);
+}
+
+TEST_CASE("a line sink gets every recorded line, with or without a file") {
+  ScenarioFile f = load_scenario(LLSF_SOURCE_DIR "/scenarios/default.yaml");
+  Scenario s = f.variants[0];
+  s.duration = core::SimTime::from_sec(40);
+  const std::string path = (temp_dir() / "sink.jsonl.gz").string();
+  std::vector<std::string> sunk;
+  RunHooks hooks;
+  hooks.record_path = path;
+  hooks.record_sink = [&](std::string_view line) { sunk.emplace_back(line); };
+  const RunResult r = run_game(s, 2, hooks);
+  const std::vector<RecordingLine> lines = read_recording(path);
+  REQUIRE(lines.size() == sunk.size());
+  for (std::size_t i = 0; i < lines.size(); ++i) CHECK(lines[i].json == sunk[i]);
+  bool path_seen = false;
+  for (const std::string& l : sunk) {
+    if (l.find("\"e\": \"path\", \"robot\": \"robot") != std::string::npos &&
+        l.find("\"points\": [[") != std::string::npos)
+      path_seen = true;
+  }
+  CHECK(path_seen);
+
+  // Without a file: the same lines, the same game.
+  std::vector<std::string> only;
+  RunHooks sink_only;
+  sink_only.record_sink = [&](std::string_view line) { only.emplace_back(line); };
+  const RunResult r2 = run_game(s, 2, sink_only);
+  CHECK(only == sunk);
+  CHECK(r2.result_hash == r.result_hash);
+  CHECK(r2.recording.empty());
 }
 
 TEST_CASE("bad recordings: missing, corrupt, wrong version, not JSON") {

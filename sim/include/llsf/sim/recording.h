@@ -6,8 +6,10 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "llsf/clips/agent.h"
@@ -28,14 +30,19 @@ struct RecordingInfo {
   std::string llsfsim_version = "0.1.0";
 };
 
+/// Receives every line of a recording as it is written (without the newline), e.g. for a live
+/// viewer. The view is valid during the call only.
+using LineSink = std::function<void(std::string_view line)>;
+
 /// Writes a recording while a game runs. Call frame() after every tick (e.g. from
 /// RunHooks::tick) and skill() from the skill brains' listeners; close() (or the destructor)
 /// finishes the file. Throws std::runtime_error if the file cannot be written.
 class Recorder {
  public:
-  /// `pose_rate_hz`: pose frames per simulated second (default 10).
+  /// `pose_rate_hz`: pose frames per simulated second (default 10). `path` empty: no file,
+  /// the lines go to `sink` only; with both, to both.
   Recorder(const std::string& path, const Game& game, const RecordingInfo& info,
-           double pose_rate_hz = 10.0);
+           double pose_rate_hz = 10.0, LineSink sink = {});
   ~Recorder();
   Recorder(const Recorder&) = delete;
   Recorder& operator=(const Recorder&) = delete;

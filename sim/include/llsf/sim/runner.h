@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "llsf/sim/game.h"
@@ -97,6 +98,9 @@ struct RunHooks {
   std::function<void(const SkillStatusChange&)> skill;
   /// If set, the game is recorded to this file (docs/recording.md).
   std::string record_path;
+  /// If set, every recording line also goes here as it is written (a live viewer), whether or
+  /// not a file is recorded. Called on the game's thread.
+  std::function<void(std::string_view line)> record_sink;
   /// Measure where the tick's time goes (RunResult::time_split).
   bool profile = false;
 };
