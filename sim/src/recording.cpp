@@ -91,6 +91,7 @@ struct Recorder::Impl {
   std::int64_t dropped = 0;
   std::vector<std::string> robot_names;
   std::vector<std::vector<core::Vec2>> paths;  // per robot, as last written
+  std::vector<std::int64_t> robot_dropped;     // per robot: its copies dropped so far
   LineSink sink;
 
   void write(const std::string& s) {
@@ -119,6 +120,7 @@ Recorder::Recorder(const std::string& path, const Game& game, const RecordingInf
     if (m.file == nullptr) throw std::runtime_error(path + ": cannot create the recording");
   }
   m.paths.resize(static_cast<std::size_t>(game.robot_count()));
+  m.robot_dropped.assign(static_cast<std::size_t>(game.robot_count()), 0);
   m.period = SimTime::period_of_hz(pose_rate_hz);
   m.next_frame = game.time();
   const kinematic::WorldConfig& w = game.config().world;
@@ -328,6 +330,24 @@ void Recorder::frame(const Game& game) {
   if (dropped != m.dropped) {
     s += ", \"drops\": " + std::to_string(dropped - m.dropped);
     m.dropped = dropped;
+    // By sender robot: copies of its messages dropped on any link.
+    const comm::Hub& hub = game.hub();
+    std::string by;
+    for (int i = 0; i < game.robot_count(); ++i) {
+      const comm::PeerId from = game.robot_peer(i);
+      std::int64_t n = 0;
+      for (int to = 0; to < hub.peer_count(); ++to) {
+        if (to != from.value()) n += hub.link_counters(from, comm::PeerId(to)).dropped_total();
+      }
+      std::int64_t& last = m.robot_dropped[static_cast<std::size_t>(i)];
+      if (n != last) {
+        by += std::string(by.empty() ? "" : ", ") +
+              quote(m.robot_names.at(static_cast<std::size_t>(i))) + ": " +
+              std::to_string(n - last);
+        last = n;
+      }
+    }
+    if (!by.empty()) s += ", \"drops_from\": {" + by + "}";
   }
   m.write(s + "}");
 

@@ -123,6 +123,37 @@ TEST_CASE("a line sink gets every recorded line, with or without a file") {
   CHECK(r2.recording.empty());
 }
 
+TEST_CASE("radio drops are recorded per frame and per sender robot") {
+  const ScenarioFile f = load_scenario(LLSF_SOURCE_DIR "/scenarios/packet-loss.yaml");
+  Scenario s = f.variants.at(2);  // 20 % per-link loss
+  REQUIRE(s.variant == "loss=20");
+  s.duration = core::SimTime::from_sec(30);
+  std::vector<std::string> lines;
+  RunHooks hooks;
+  hooks.record_sink = [&](std::string_view line) { lines.emplace_back(line); };
+  const RunResult r = run_game(s, 1, hooks);
+  REQUIRE(r.messages_dropped > 0);
+  // Every frame's drops_from sums to at most its drops (the refbox's drops are not a robot's).
+  auto number_after = [](const std::string& l, std::size_t at) { return std::stol(l.substr(at)); };
+  long drops = 0, by_robots = 0;
+  for (const std::string& l : lines) {
+    const auto d = l.find("\"drops\": ");
+    if (d == std::string::npos) continue;
+    const long frame_drops = number_after(l, d + 9);
+    drops += frame_drops;
+    long frame_by = 0;
+    for (const char* robot : {"robot1", "robot2", "robot3"}) {
+      const auto b = l.find("\"" + std::string(robot) + "\": ", l.find("\"drops_from\""));
+      if (l.find("\"drops_from\"") != std::string::npos && b != std::string::npos)
+        frame_by += number_after(l, b + 10);
+    }
+    CHECK(frame_by <= frame_drops);
+    by_robots += frame_by;
+  }
+  CHECK(drops == r.messages_dropped);
+  CHECK(by_robots > 0);
+}
+
 TEST_CASE("bad recordings: missing, corrupt, wrong version, not JSON") {
   const auto dir = temp_dir();
   CHECK_THROWS_WITH(read_recording((dir / "missing.gz").string()),
