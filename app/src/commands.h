@@ -31,5 +31,7 @@ Action add_batch_command(CLI::App& app);
 Action add_report_command(CLI::App& app);
 /// `llsfsim check`: validate scenarios and their agent/skill files without playing.
 Action add_check_command(CLI::App& app);
+/// `llsfsim serve`: the browser viewer's HTTP/WebSocket server (server.h) until SIGINT/SIGTERM.
+Action add_serve_command(CLI::App& app);
 
 }  // namespace llsf::app

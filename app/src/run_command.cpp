@@ -11,6 +11,7 @@
 #include <optional>
 #include <ostream>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <vector>
 
@@ -23,6 +24,7 @@
 #include "llsf/sim/runner.h"
 #include "llsf/sim/scenario.h"
 #include "llsf/sim/stats_store.h"
+#include "server.h"
 
 namespace llsf::app {
 
@@ -40,6 +42,9 @@ struct RunOptions {
   bool no_record = false;
   double speed = 0.0;  ///< 0: as fast as possible; else game seconds per wall second
   bool realtime = false;
+  bool serve = false;  ///< serve the viewer with the game live (server.h)
+  int port = 8080;
+  bool serve_exit = false;  ///< with serve: exit when the game ends instead of serving on
 };
 
 const sim::Scenario* pick_variant(const sim::ScenarioFile& f, const std::string& name,
@@ -150,6 +155,25 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
       std::this_thread::sleep_until(due);
     };
   }
+  // --serve: the viewer's server on a background thread, fed every recording line.
+  std::ostream& note = o.json ? err : out;  // keep --json's stdout one JSON object
+  LiveFeed feed;
+  std::unique_ptr<Server> server;
+  if (o.serve) {
+    ServerOptions so;
+    so.port = o.port;
+    so.db = o.no_db ? "" : o.db;
+    so.recordings = default_recordings_dir(o.db);
+    try {
+      server = std::make_unique<Server>(so, &feed);
+    } catch (const std::runtime_error& e) {
+      err << "llsfsim run: " << e.what() << "\n";
+      return kExitBadInput;
+    }
+    server->start();
+    note << "llsfsim serve: " << server->url() << std::endl;
+    hooks.record_sink = [&feed](std::string_view line) { feed.publish(line); };
+  }
   const bool tty = isatty(STDERR_FILENO) != 0 && !o.quiet && !o.json;
   if (tty) {
     hooks.progress_every = core::SimTime::from_sec(10);
@@ -173,6 +197,7 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
     err << "llsfsim run: " << e.what() << "\n";
     return kExitBadInput;
   }
+  feed.finish();
   if (tty) std::fprintf(stderr, "\r%60s\r", "");
   std::string stored_as;
   if (store) {
@@ -191,6 +216,10 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
     print_summary(r, out);
     if (!r.recording.empty()) out << fmt::format("recording  {}\n", r.recording);
     if (!stored_as.empty()) out << fmt::format("database   {}\n", stored_as);
+  }
+  if (server && !o.serve_exit) {
+    note << "game over; serving until Ctrl-C" << std::endl;
+    wait_for_stop_signal();
   }
   return r.passed() ? kExitOk : kExitFailed;
 }
@@ -255,6 +284,16 @@ Action add_run_command(CLI::App& app) {
                      "llsfsim-recordings/<scenario>[-<variant>]-seed<N>.jsonl.gz, beside the --db "
                      "file and named after it)");
   app.add_flag("--no-record", o->no_record, "Do not record the game")->excludes(record);
+  auto* serve = app.add_flag("--serve", o->serve,
+                             "Serve the browser viewer with this game live (like `llsfsim serve`; "
+                             "best with --speed or --realtime)");
+  app.add_option("--port", o->port, "With --serve: the port (0: any free port)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 65535))
+      ->needs(serve);
+  app.add_flag("--serve-exit", o->serve_exit,
+               "With --serve: exit when the game ends (default: serve on until Ctrl-C)")
+      ->needs(serve);
   app.footer(
       "Plays one game headless and prints a summary and the test-case verdicts; stores the run "
       "in the statistics store (--db, default llsfsim.db; the latest game of each variant and "

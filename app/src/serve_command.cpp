@@ -1,0 +1,51 @@
+// SPDX-License-Identifier: MIT
+// `llsfsim serve`: the browser viewer's server over the statistics store and the recordings,
+// until SIGINT or SIGTERM.
+#include <memory>
+#include <ostream>
+#include <stdexcept>
+#include <string>
+
+#include "commands.h"
+#include "llsf/app/cli.h"
+#include "llsf/sim/stats_store.h"
+#include "server.h"
+
+namespace llsf::app {
+
+Action add_serve_command(CLI::App& app) {
+  auto o = std::make_shared<ServerOptions>();
+  o->db = std::string(sim::StatsStore::kDefaultPath);
+  app.add_option("--bind", o->bind, "Address to listen on")->capture_default_str();
+  app.add_option("--port", o->port, "Port to listen on (0: any free port)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 65535));
+  app.add_option("--db", o->db, "Statistics store whose batches are served (docs/statistics.md)")
+      ->capture_default_str();
+  app.add_option("--recordings", o->recordings,
+                 "Recordings served below /api/recordings/ (default: <db>-recordings beside "
+                 "the --db file)");
+  app.add_option("--viewer", o->viewer,
+                 "The built viewer (default: $LLSF_VIEWER_DIR, else viewer/dist of the source "
+                 "tree; `make viewer`)");
+  app.footer(
+      "Serves the browser viewer, the stored batches, runs and reports as JSON and the "
+      "recordings as JSON lines (docs/llsfsim.md). Prints 'llsfsim serve: URL' and runs until "
+      "Ctrl-C or SIGTERM. Exit code 0, or 2 if it cannot listen.");
+  return [o](std::ostream& out, std::ostream& err) {
+    std::unique_ptr<Server> server;
+    try {
+      server = std::make_unique<Server>(*o);
+    } catch (const std::runtime_error& e) {
+      err << "llsfsim serve: " << e.what() << "\n";
+      return kExitBadInput;
+    }
+    server->start();
+    out << "llsfsim serve: " << server->url() << std::endl;
+    wait_for_stop_signal();
+    server->stop();
+    return kExitOk;
+  };
+}
+
+}  // namespace llsf::app

@@ -1,0 +1,458 @@
+// SPDX-License-Identifier: MIT
+// A recording (docs/recording.md) in memory, indexed for replay: lines are appended as they arrive
+// (a download in chunks, or a live game's WebSocket), frames are indexed by time for binary
+// search, and the derived state of the game (pucks, lamps, skills, locks, orders, points, ...) is
+// rebuilt incrementally with snapshots every few seconds, so seeking anywhere costs at most one
+// snapshot's copy plus a few seconds of lines.
+
+export interface DeviceInfo {
+  name: string;
+  x: number;
+  y: number;
+  ori: number;
+  box: [number, number, number, number, number];  // cx, cy, depth, width, theta
+}
+
+export interface Header {
+  format: string;
+  version: number;
+  scenario: string;
+  variant: string;
+  seed: number;
+  llsfsim: string;
+  pose_hz: number;
+  field: {width: number; height: number};
+  devices: DeviceInfo[];
+  robots: string[];
+  robot_radius: number;
+  puck_radius: number;
+}
+
+/// One line after the header: a frame (`f`) or an event (`e`), always with `t`.
+// eslint-disable-next-line @typescript-eslint/no-explicit-any
+export type Line = {t: number; f?: number; e?: string; [key: string]: any};
+
+export interface PuckState {
+  x: number;
+  y: number;
+  on: boolean;  // on the field (false after `pr`)
+  state: string;
+}
+
+export interface RobotState {
+  skill: string;
+  status: string;
+  skillInfo: string;  // result or error of the last skill
+  agent: string;
+  agentLevel: string;
+  agentT: number;
+  role: string;
+  locks: Record<string, string>;  // resource -> lock state (NONE entries removed)
+  drops: number;
+  dropT: number;  // time of the last drop attributed to this robot
+  path: [number, number][] | null;
+  held: number;
+}
+
+export interface OrderState {
+  id: number;
+  product: string;
+  requested: number;
+  delivered: number;
+  window: [number, number];
+}
+
+/// The game at one moment, as far as lines up to that moment tell.
+export interface State {
+  t: number;
+  phase: string;
+  gameState: string;
+  points: number;
+  phasePoints: Record<string, number>;
+  planTypes: Record<string, string>;
+  exploredTypes: Record<string, string>;
+  lights: Record<string, number[]>;
+  pucks: Record<number, PuckState>;
+  robots: Record<string, RobotState>;
+  orders: Record<number, OrderState>;
+  drops: number;
+  dropT: number;
+  collisions: number;
+  skillFailures: number;
+}
+
+export interface Marker {
+  t: number;
+  kind: "award" | "failure" | "collision";
+  label: string;
+}
+
+function emptyRobot(): RobotState {
+  return {
+    skill: "",
+    status: "",
+    skillInfo: "",
+    agent: "",
+    agentLevel: "",
+    agentT: -1,
+    role: "",
+    locks: {},
+    drops: 0,
+    dropT: -1e9,
+    path: null,
+    held: 0,
+  };
+}
+
+function emptyState(header: Header): State {
+  const robots: Record<string, RobotState> = {};
+  for (const r of header.robots) robots[r] = emptyRobot();
+  return {
+    t: 0,
+    phase: "",
+    gameState: "",
+    points: 0,
+    phasePoints: {},
+    planTypes: {},
+    exploredTypes: {},
+    lights: {},
+    pucks: {},
+    robots,
+    orders: {},
+    drops: 0,
+    dropT: -1e9,
+    collisions: 0,
+    skillFailures: 0,
+  };
+}
+
+function robotOf(s: State, name: unknown): RobotState | null {
+  if (typeof name !== "string") return null;
+  return (s.robots[name] ??= emptyRobot());
+}
+
+/// Applies one line to the state (lines must come in file order).
+function apply(s: State, header: Header, line: Line): void {
+  s.t = line.t;
+  if (line.f) {
+    const p = line.p as [number, number, number][] | undefined;
+    if (p) {
+      for (const [id, x, y] of p) {
+        const q = (s.pucks[id] ??= {x, y, on: true, state: ""});
+        q.x = x;
+        q.y = y;
+        q.on = true;
+      }
+    }
+    const pr = line.pr as number[] | undefined;
+    if (pr) for (const id of pr) if (s.pucks[id]) s.pucks[id].on = false;
+    const r = line.r as number[][] | undefined;
+    if (r) {
+      r.forEach((pose, i) => {
+        const robot = robotOf(s, header.robots[i]);
+        if (robot) robot.held = pose[6] ?? 0;
+      });
+    }
+    // `drops`: a number (radio copies dropped since the last frame), or per robot (an array in
+    // the header's robot order, or an object by robot name) when the recording says who sent.
+    const drops = line.drops as unknown;
+    if (typeof drops === "number" && drops > 0) {
+      s.drops += drops;
+      s.dropT = line.t;
+    } else if (Array.isArray(drops)) {
+      drops.forEach((n, i) => {
+        const robot = robotOf(s, header.robots[i]);
+        if (robot && typeof n === "number" && n > 0) {
+          robot.drops += n;
+          robot.dropT = line.t;
+          s.drops += n;
+          s.dropT = line.t;
+        }
+      });
+    } else if (drops && typeof drops === "object") {
+      for (const [name, n] of Object.entries(drops as Record<string, number>)) {
+        const robot = robotOf(s, name);
+        if (robot && n > 0) {
+          robot.drops += n;
+          robot.dropT = line.t;
+          s.drops += n;
+          s.dropT = line.t;
+        }
+      }
+    }
+    return;
+  }
+  switch (line.e) {
+    case "game":
+      s.phase = line.phase ?? s.phase;
+      s.gameState = line.state ?? s.gameState;
+      if (typeof line.points === "number") s.points = line.points;
+      break;
+    case "plan":
+      Object.assign(s.planTypes, line.types ?? {});
+      break;
+    case "award": {
+      const phase = s.phase || "?";
+      s.phasePoints[phase] = (s.phasePoints[phase] ?? 0) + (line.points ?? 0);
+      if (typeof line.total === "number") s.points = line.total;
+      break;
+    }
+    case "lights":
+      s.lights[line.d] = line.l;
+      break;
+    case "collision":
+      s.collisions++;
+      break;
+    case "skill": {
+      const robot = robotOf(s, line.robot);
+      if (!robot) break;
+      robot.skill = line.string ?? robot.skill;
+      robot.status = line.status ?? "";
+      robot.skillInfo = line.error ?? line.result ?? "";
+      if (line.status === "FAILED") s.skillFailures++;
+      break;
+    }
+    case "puck": {
+      const q = (s.pucks[line.id] ??= {x: 0, y: 0, on: false, state: ""});
+      q.state = line.state;
+      break;
+    }
+    case "order":
+      s.orders[line.id] = {
+        id: line.id,
+        product: line.product,
+        requested: line.requested,
+        delivered: line.delivered,
+        window: line.window,
+      };
+      break;
+    case "agent": {
+      const robot = robotOf(s, line.robot);
+      if (!robot) break;
+      const text = String(line.text ?? "");
+      robot.agent = text;
+      robot.agentLevel = line.level ?? "";
+      robot.agentT = line.t;
+      let m = /^production: role (.+)$/.exec(text);
+      if (m) robot.role = m[1];
+      m = /^won (\S+)/.exec(text);
+      if (m) robot.role = m[1];
+      m = /^explore: (\S+) is an? (\S+)/.exec(text);
+      if (m) s.exploredTypes[m[1]] = m[2];
+      break;
+    }
+    case "lock": {
+      const robot = robotOf(s, line.robot);
+      if (!robot) break;
+      if (line.to === "NONE") delete robot.locks[line.resource];
+      else robot.locks[line.resource] = line.to;
+      break;
+    }
+    case "path": {
+      const robot = robotOf(s, line.robot);
+      if (!robot) break;
+      const pts = line.points as [number, number][] | undefined;
+      robot.path = pts && pts.length > 0 ? pts : null;
+      break;
+    }
+    default:
+      break;
+  }
+}
+
+/// Lines of `text` that hold JSON objects; a line that is not one is an error with its number.
+export function parseLine(text: string, number: number): Line | Header {
+  let v: unknown;
+  try {
+    v = JSON.parse(text);
+  } catch {
+    throw new Error(`line ${number}: not JSON`);
+  }
+  if (!v || typeof v !== "object" || Array.isArray(v)) {
+    throw new Error(`line ${number}: not a JSON object`);
+  }
+  return v as Line | Header;
+}
+
+const kSnapshotEvery = 5;  // simulated seconds between snapshots
+
+export class Recording {
+  header: Header | null = null;
+  readonly lines: Line[] = [];
+  readonly lineT: number[] = [];
+  readonly frameT: number[] = [];
+  readonly frameR: number[][][] = [];
+  readonly markers: Marker[] = [];
+  readonly phaseStarts: {t: number; phase: string}[] = [];
+  /// Incremented whenever lines were appended (the views redraw what depends on them).
+  version = 0;
+  private builder: State | null = null;
+  private snapshots: {index: number; state: State}[] = [];
+  private lastPhase = "";
+  private lineCount = 0;
+
+  get endTime(): number {
+    return this.lineT.length > 0 ? this.lineT[this.lineT.length - 1] : 0;
+  }
+
+  /// Appends one text line (empty lines are skipped). Throws on a bad line.
+  appendText(text: string): void {
+    const trimmed = text.trim();
+    if (trimmed === "") return;
+    this.lineCount++;
+    const v = parseLine(trimmed, this.lineCount);
+    if (!this.header) {
+      const h = v as Header;
+      if (h.format !== "llsfsim-recording") {
+        throw new Error(`line 1: not an llsfsim recording (format ${String(h.format)})`);
+      }
+      if (h.version !== 1) {
+        throw new Error(`line 1: recording version ${h.version} (this viewer reads version 1)`);
+      }
+      this.header = h;
+      this.builder = emptyState(h);
+      this.snapshots.push({index: 0, state: structuredClone(this.builder)});
+      this.version++;
+      return;
+    }
+    const line = v as Line;
+    if (typeof line.t !== "number") throw new Error(`line ${this.lineCount}: no "t"`);
+    this.append(line);
+  }
+
+  private append(line: Line): void {
+    const header = this.header!;
+    const builder = this.builder!;
+    const index = this.lines.length;
+    // A snapshot of the state before this line, every few seconds.
+    const last = this.snapshots[this.snapshots.length - 1];
+    const lastT = last.index === 0 ? 0 : this.lineT[last.index - 1];
+    if (line.t >= lastT + kSnapshotEvery && index > last.index) {
+      this.snapshots.push({index, state: structuredClone(builder)});
+    }
+    this.lines.push(line);
+    this.lineT.push(line.t);
+    if (line.f) {
+      this.frameT.push(line.t);
+      this.frameR.push(line.r ?? []);
+    } else if (line.e === "award") {
+      this.markers.push({
+        t: line.t,
+        kind: "award",
+        label: `${line.points >= 0 ? "+" : ""}${line.points} ${line.reason ?? ""}` +
+          (line.device ? ` ${line.device}` : ""),
+      });
+    } else if (line.e === "skill" && line.status === "FAILED") {
+      this.markers.push({
+        t: line.t,
+        kind: "failure",
+        label: `${line.robot}: ${line.string ?? ""} failed: ${line.error ?? ""}`,
+      });
+    } else if (line.e === "collision") {
+      this.markers.push({
+        t: line.t,
+        kind: "collision",
+        label: `${line.kind}: ${line.robot}${line.other ? ` with ${line.other}` : ""}`,
+      });
+    } else if (line.e === "game" && line.phase && line.phase !== this.lastPhase) {
+      this.lastPhase = line.phase;
+      this.phaseStarts.push({t: line.t, phase: line.phase});
+    }
+    apply(builder, header, line);
+    this.version++;
+  }
+
+  /// The number of lines with t <= time.
+  upperBound(time: number): number {
+    let lo = 0;
+    let hi = this.lineT.length;
+    while (lo < hi) {
+      const mid = (lo + hi) >>> 1;
+      if (this.lineT[mid] <= time) lo = mid + 1;
+      else hi = mid;
+    }
+    return lo;
+  }
+
+  /// The index of the last frame with t <= time (-1 when none).
+  frameAt(time: number): number {
+    let lo = 0;
+    let hi = this.frameT.length;
+    while (lo < hi) {
+      const mid = (lo + hi) >>> 1;
+      if (this.frameT[mid] <= time) lo = mid + 1;
+      else hi = mid;
+    }
+    return lo - 1;
+  }
+
+  /// Robot poses at `time`: [x, y, theta, bx, by, btheta, held] per robot, interpolated
+  /// linearly between the frames around it (held puck from the earlier frame).
+  posesAt(time: number): number[][] {
+    const i = this.frameAt(time);
+    if (i < 0) return this.frameR.length > 0 ? this.frameR[0] : [];
+    const a = this.frameR[i];
+    if (i + 1 >= this.frameR.length) return a;
+    const b = this.frameR[i + 1];
+    const t0 = this.frameT[i];
+    const t1 = this.frameT[i + 1];
+    const u = t1 > t0 ? Math.min(1, Math.max(0, (time - t0) / (t1 - t0))) : 0;
+    if (u === 0) return a;
+    return a.map((pa, k) => {
+      const pb = b[k] ?? pa;
+      const lerp = (j: number) => pa[j] + (pb[j] - pa[j]) * u;
+      const angle = (j: number) => {
+        let d = pb[j] - pa[j];
+        while (d > Math.PI) d -= 2 * Math.PI;
+        while (d < -Math.PI) d += 2 * Math.PI;
+        return pa[j] + d * u;
+      };
+      return [lerp(0), lerp(1), angle(2), lerp(3), lerp(4), angle(5), pa[6]];
+    });
+  }
+
+  /// A cursor over the derived state.
+  cursor(): Cursor {
+    return new Cursor(this);
+  }
+
+  /** @internal */ snapshotBefore(index: number): {index: number; state: State} {
+    let lo = 0;
+    let hi = this.snapshots.length;
+    while (lo < hi) {
+      const mid = (lo + hi) >>> 1;
+      if (this.snapshots[mid].index <= index) lo = mid + 1;
+      else hi = mid;
+    }
+    return this.snapshots[Math.max(0, lo - 1)];
+  }
+
+  /** @internal */ applyLine(state: State, index: number): void {
+    apply(state, this.header!, this.lines[index]);
+  }
+}
+
+/// The derived state at a chosen time: moving forward applies the lines in between; moving back
+/// (or far forward) restarts from the nearest snapshot.
+export class Cursor {
+  private state: State | null = null;
+  private index = 0;  // lines applied
+
+  constructor(private readonly rec: Recording) {}
+
+  at(time: number): State | null {
+    const rec = this.rec;
+    if (!rec.header) return null;
+    const target = rec.upperBound(time);
+    if (!this.state || target < this.index || target - this.index > 2000) {
+      const snap = rec.snapshotBefore(target);
+      if (!this.state || snap.index > this.index || target < this.index) {
+        this.state = structuredClone(snap.state);
+        this.index = snap.index;
+      }
+    }
+    while (this.index < target) rec.applyLine(this.state, this.index++);
+    this.state.t = time;
+    return this.state;
+  }
+}

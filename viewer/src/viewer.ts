@@ -1,0 +1,728 @@
+// SPDX-License-Identifier: MIT
+// The browser viewer served by `llsfsim serve` (index.html + this bundle). Hash routes:
+//   #/            the batches of the statistics store
+//   #/batch/ID    the batch's report (box plots, tables) and its runs
+//   #/run/ID      replay of a run's recording (/api/runs/ID/recording)
+//   #/file/PATH   replay of /api/recordings/PATH
+//   #/live        the live game (WebSocket /api/live)
+// Test hook: window.llsfViewer (see Replay.hook); #app carries data-page and data-ready.
+import {drawField, kPuckColors, kRobotColors} from "./field";
+import {Cursor, Recording, type State} from "./recording";
+import {el, renderReport, table, type Child, type ReportData} from "./report_view";
+
+interface BatchInfo {
+  id: number;
+  kind: string;
+  scenario_name: string;
+  scenario_file: string;
+  variants: number;
+  runs_per_variant: number;
+  finished: boolean;
+}
+
+interface RunInfo {
+  id: number;
+  variant: string;
+  seed: number;
+  points: number;
+  passed: boolean;
+  result_hash: string;
+  recording: boolean;
+}
+
+interface ViewerHook {
+  page: string;
+  ready: boolean;
+  error: string | null;
+  time(): number;
+  endTime(): number;
+  robots(): {name: string; x: number; y: number}[];
+  seek(t: number): void;
+  play(on: boolean): void;
+  devicesDrawn(): number;
+  robotsDrawn(): number;
+  pucksDrawn(): number;
+}
+
+declare global {
+  interface Window {
+    llsfViewer?: ViewerHook;
+  }
+}
+
+const app = document.getElementById("app") as HTMLElement;
+let teardown: (() => void) | null = null;
+
+async function fetchJson<T>(url: string, signal: AbortSignal): Promise<T> {
+  const res = await fetch(url, {signal});
+  if (!res.ok) throw new Error(await errorText(res));
+  return (await res.json()) as T;
+}
+
+async function errorText(res: Response): Promise<string> {
+  let msg = `${res.status} ${res.statusText}`;
+  try {
+    const j = (await res.json()) as {error?: string};
+    if (j.error) msg = `${j.error} (${res.status})`;
+  } catch {
+    // not JSON: keep the status
+  }
+  return `${res.url}: ${msg}`;
+}
+
+function showError(target: HTMLElement, e: unknown): void {
+  if (e instanceof DOMException && e.name === "AbortError") return;
+  const msg = e instanceof Error ? e.message : String(e);
+  target.append(el("p", {class: "error"}, msg));
+  app.setAttribute("data-error", msg);
+}
+
+function fmtTime(t: number): string {
+  const m = Math.floor(t / 60);
+  const s = t - m * 60;
+  return `${m}:${s.toFixed(1).padStart(4, "0")}`;
+}
+
+// ---------------------------------------------------------------------------------------------
+// #/ and #/batch/ID
+
+function batchesPage(signal: AbortSignal): void {
+  const root = el("div", {class: "page"}, el("h1", {}, "Batches"));
+  app.replaceChildren(root);
+  fetchJson<BatchInfo[]>("/api/batches", signal)
+    .then((batches) => {
+      const rows: Child[][] = batches.map((b) => [
+        el("a", {href: `#/batch/${b.id}`}, `batch ${b.id}`),
+        b.kind,
+        b.scenario_name,
+        b.scenario_file,
+        b.variants,
+        b.runs_per_variant,
+        b.finished ? "yes" : "running",
+      ]);
+      root.append(
+        batches.length === 0
+          ? el("p", {class: "note"}, "The statistics store holds no batch yet.")
+          : table(
+              ["batch", "kind", "scenario", "file", "variants", "runs/variant", "finished"],
+              rows,
+              {"data-table": "batches"},
+            ),
+        el("p", {class: "note"}, el("a", {href: "#/live"}, "Live game"), " (when one is served)"),
+      );
+      app.setAttribute("data-ready", "true");
+    })
+    .catch((e) => showError(root, e));
+}
+
+function batchPage(id: string, signal: AbortSignal): void {
+  const report = el("div", {id: "llsf-batch-report"});
+  const runs = el("div", {}, el("h2", {}, "Runs"));
+  const root = el("div", {class: "page"}, el("p", {}, el("a", {href: "#/"}, "← batches")), report, runs);
+  app.replaceChildren(root);
+  const enc = encodeURIComponent(id);
+  Promise.all([
+    fetchJson<ReportData>(`/api/batches/${enc}/report`, signal),
+    fetchJson<RunInfo[]>(`/api/batches/${enc}/runs`, signal),
+  ])
+    .then(([data, list]) => {
+      renderReport(report, data);
+      const rows: Child[][] = list.map((r) => [
+        r.recording ? el("a", {href: `#/run/${r.id}`}, `run ${r.id}`) : `run ${r.id}`,
+        r.variant || "(no matrix)",
+        r.seed,
+        r.points,
+        r.passed ? "yes" : el("span", {class: "failed"}, "no"),
+        el("code", {}, r.result_hash),
+        r.recording ? el("a", {href: `#/run/${r.id}`}, "replay") : "–",
+      ]);
+      runs.append(
+        table(["run", "variant", "seed", "points", "passed", "result hash", "recording"], rows, {
+          "data-table": "runs",
+        }),
+      );
+      app.setAttribute("data-ready", "true");
+    })
+    .catch((e) => showError(root, e));
+}
+
+// ---------------------------------------------------------------------------------------------
+// The replay: field, side panel, controls and timeline.
+
+const kSpeeds = [0.25, 0.5, 1, 2, 4, 8, 16, 32, 64];
+
+class Replay {
+  readonly rec = new Recording();
+  private readonly cursor: Cursor = this.rec.cursor();
+  private time = 0;
+  private playing = false;
+  private speed = 1;
+  follow = false;
+  private raf = 0;
+  private lastWall = 0;
+  private lastPanel = -1;
+  private panelVersion = -1;
+  private lastStats = {devices: 0, robots: 0, pucks: 0};
+  private timelineCache: HTMLCanvasElement | null = null;
+  private timelineKey = "";
+  private fpsFrames = 0;
+  private fpsT0 = 0;
+  fps = 0;
+  ready = false;
+  error: string | null = null;
+
+  readonly root: HTMLElement;
+  private readonly title = el("span", {class: "title"});
+  private readonly status = el("span", {class: "status"});
+  private readonly canvas = el("canvas", {class: "field", "data-field": ""});
+  private readonly panel = el("div", {class: "panel", "data-panel": ""});
+  private readonly timeline = el("canvas", {class: "timeline", "data-timeline": ""});
+  private readonly tip = el("div", {class: "tip"});
+  private readonly playBtn = el("button", {title: "play/pause (space)", "data-control": "play"}, "play");
+  private readonly speedSel = el("select", {title: "speed", "data-control": "speed"});
+  private readonly timeLabel = el("span", {class: "time", "data-time": "0"});
+  private readonly followBox = el("input", {type: "checkbox", "data-control": "follow"});
+
+  constructor(private readonly live: boolean) {
+    for (const s of kSpeeds) {
+      const o = el("option", {value: String(s)}, `${s}×`);
+      if (s === 1) o.selected = true;
+      this.speedSel.append(o);
+    }
+    const back = el("button", {title: "one frame back (←)", "data-control": "back"}, "‹ frame");
+    const fwd = el("button", {title: "one frame forward (→)", "data-control": "forward"}, "frame ›");
+    back.onclick = () => this.step(-1);
+    fwd.onclick = () => this.step(1);
+    this.playBtn.onclick = () => this.setPlaying(!this.playing);
+    this.speedSel.onchange = () => (this.speed = Number(this.speedSel.value));
+    const followLabel = el("label", {class: "follow"}, this.followBox, " follow live");
+    this.followBox.onchange = () => (this.follow = this.followBox.checked);
+    if (!live) followLabel.style.display = "none";
+    const controls = el(
+      "div",
+      {class: "controls"},
+      back,
+      this.playBtn,
+      fwd,
+      this.speedSel,
+      this.timeLabel,
+      followLabel,
+      this.status,
+    );
+    this.root = el(
+      "div",
+      {class: "replay"},
+      el("div", {class: "bar"}, el("a", {href: "#/"}, "batches"), " · ", this.title),
+      el(
+        "div",
+        {class: "main"},
+        el("div", {class: "fieldbox"}, this.canvas),
+        this.panel,
+      ),
+      controls,
+      el("div", {class: "timelinebox"}, this.timeline, this.tip),
+    );
+    this.setupTimeline();
+  }
+
+  setTitle(text: string): void {
+    this.title.textContent = text;
+  }
+
+  setStatus(text: string): void {
+    this.status.textContent = text;
+  }
+
+  fail(e: unknown): void {
+    if (e instanceof DOMException && e.name === "AbortError") return;
+    this.error = e instanceof Error ? e.message : String(e);
+    this.setStatus("");
+    this.root.append(el("p", {class: "error"}, this.error));
+    app.setAttribute("data-error", this.error);
+  }
+
+  setFollow(on: boolean): void {
+    this.follow = on;
+    this.followBox.checked = on;
+  }
+
+  setPlaying(on: boolean): void {
+    this.playing = on;
+    this.playBtn.textContent = on ? "pause" : "play";
+    if (on && this.time >= this.rec.endTime && !this.live) this.time = 0;
+  }
+
+  seek(t: number): void {
+    this.time = Math.max(0, Math.min(this.rec.endTime, t));
+    if (this.live) this.setFollow(this.time >= this.rec.endTime - 0.001);
+  }
+
+  step(dir: number): void {
+    this.setPlaying(false);
+    const rec = this.rec;
+    if (rec.frameT.length === 0) return;
+    let i = rec.frameAt(this.time);
+    if (dir > 0) i = Math.min(rec.frameT.length - 1, i + 1);
+    else if (i > 0 && rec.frameT[i] >= this.time - 1e-9) i -= 1;
+    this.seek(rec.frameT[Math.max(0, i)]);
+  }
+
+  start(): void {
+    const loop = (now: number) => {
+      this.raf = requestAnimationFrame(loop);
+      this.tick(now);
+    };
+    this.lastWall = performance.now();
+    this.raf = requestAnimationFrame(loop);
+    window.addEventListener("keydown", this.onKey);
+    const hook: ViewerHook = {
+      page: this.live ? "live" : "replay",
+      get ready() {
+        return replay.ready;
+      },
+      get error() {
+        return replay.error;
+      },
+      time: () => this.time,
+      endTime: () => this.rec.endTime,
+      robots: () => {
+        const h = this.rec.header;
+        if (!h) return [];
+        return this.rec.posesAt(this.time).map((p, i) => ({name: h.robots[i], x: p[0], y: p[1]}));
+      },
+      seek: (t: number) => {
+        this.seek(t);
+        this.render(performance.now(), true);
+      },
+      play: (on: boolean) => this.setPlaying(on),
+      devicesDrawn: () => this.lastStats.devices,
+      robotsDrawn: () => this.lastStats.robots,
+      pucksDrawn: () => this.lastStats.pucks,
+    };
+    // eslint-disable-next-line @typescript-eslint/no-this-alias
+    const replay = this;
+    window.llsfViewer = hook;
+  }
+
+  stop(): void {
+    cancelAnimationFrame(this.raf);
+    window.removeEventListener("keydown", this.onKey);
+    delete window.llsfViewer;
+  }
+
+  private onKey = (ev: KeyboardEvent) => {
+    if (ev.target instanceof HTMLInputElement || ev.target instanceof HTMLSelectElement) return;
+    if (ev.key === " ") {
+      this.setPlaying(!this.playing);
+      ev.preventDefault();
+    } else if (ev.key === "ArrowRight") {
+      this.step(1);
+    } else if (ev.key === "ArrowLeft") {
+      this.step(-1);
+    }
+  };
+
+  private tick(now: number): void {
+    const dt = Math.min(0.25, (now - this.lastWall) / 1000);
+    this.lastWall = now;
+    const end = this.rec.endTime;
+    if (this.live && this.follow) {
+      this.time = end;
+    } else if (this.playing) {
+      this.time = Math.min(end, this.time + dt * this.speed);
+      if (this.time >= end && !this.live) this.setPlaying(false);
+    }
+    this.render(now, false);
+    this.fpsFrames++;
+    if (now - this.fpsT0 > 1000) {
+      this.fps = (this.fpsFrames * 1000) / (now - this.fpsT0);
+      this.fpsFrames = 0;
+      this.fpsT0 = now;
+      this.root.setAttribute("data-fps", this.fps.toFixed(0));
+    }
+  }
+
+  render(now: number, force: boolean): void {
+    const h = this.rec.header;
+    if (!h) return;
+    const state = this.cursor.at(this.time);
+    if (!state) return;
+    const poses = this.rec.posesAt(this.time);
+    this.lastStats = drawField(this.canvas, h, state, poses, this.time);
+    this.canvas.setAttribute("data-devices", String(this.lastStats.devices));
+    this.canvas.setAttribute("data-robots", String(this.lastStats.robots));
+    this.timeLabel.textContent = `${fmtTime(this.time)} / ${fmtTime(this.rec.endTime)}`;
+    this.timeLabel.setAttribute("data-time", this.time.toFixed(2));
+    // The panel at most 8 times a second (DOM work), at once when forced or paused on a change.
+    const key = this.time * 1000 + this.rec.version;
+    if (force || (now - this.lastPanel > 120 && key !== this.panelVersion)) {
+      this.lastPanel = now;
+      this.panelVersion = key;
+      this.renderPanel(state);
+    }
+    this.drawTimeline();
+  }
+
+  // --- side panel ---
+
+  private renderPanel(s: State): void {
+    const h = this.rec.header!;
+    const gate = ["D1", "D2", "D3"].find((d) => {
+      const l = s.lights[d];
+      return l && (l[2] === 1 || l[2] === 2);
+    });
+    const phases = Object.entries(s.phasePoints)
+      .map(([p, n]) => `${p.toLowerCase()} ${n}`)
+      .join(", ");
+    const orders = Object.values(s.orders).sort((a, b) => a.id - b.id);
+    const robotRows = h.robots.map((name, i) => {
+      const r = s.robots[name];
+      const color = kRobotColors[i % kRobotColors.length];
+      const locks = r
+        ? Object.entries(r.locks)
+            .map(([res, st]) => (st === "ACCEPTED" ? res : `${res}:${st.toLowerCase()}`))
+            .join(" ")
+        : "";
+      return el(
+        "div",
+        {class: "robot", "data-robot": name},
+        el("div", {class: "rname", style: `color:${color}`}, name, r?.role ? ` · ${r.role}` : ""),
+        el("div", {class: "skill"}, r?.skill ? `${r.skill} ${r.status}` : "–"),
+        r?.skillInfo ? el("div", {class: "info"}, r.skillInfo) : "",
+        el(
+          "div",
+          {class: `agent ${r?.agentLevel ?? ""}`},
+          r?.agent ? `[${fmtTime(r.agentT)}] ${r.agent}` : "no agent decision yet",
+        ),
+        locks ? el("div", {class: "locks"}, `locks: ${locks}`) : "",
+        r && r.drops > 0 ? el("div", {class: "info"}, `radio drops: ${r.drops}`) : "",
+      );
+    });
+    this.panel.replaceChildren(
+      el(
+        "div",
+        {class: "game"},
+        el("div", {class: "big", "data-points": String(s.points)}, `${s.points} points`),
+        el("div", {}, `${s.phase || "–"} · ${s.gameState || "–"}`),
+        el("div", {}, `game time ${fmtTime(this.time)}`),
+        phases ? el("div", {class: "info"}, phases) : "",
+        el("div", {}, `delivery gate: ${gate ?? "–"}`),
+        el(
+          "div",
+          {class: "info"},
+          `radio drops ${s.drops} · collisions ${s.collisions} · skill failures ${s.skillFailures}`,
+        ),
+      ),
+      orders.length > 0
+        ? table(
+            ["order", "product", "delivered", "window (production)"],
+            orders.map((o) => [
+              o.id,
+              o.product,
+              `${o.delivered}/${o.requested}`,
+              `${fmtTime(o.window[0])}–${fmtTime(o.window[1])}`,
+            ]),
+            {"data-table": "orders", class: "small"},
+          )
+        : el("div", {class: "info"}, "no orders yet"),
+      ...robotRows,
+      el(
+        "div",
+        {class: "legend"},
+        ...Object.entries(kPuckColors).map(([st, c]) =>
+          el("span", {}, el("i", {style: `background:${c}`}), st),
+        ),
+      ),
+    );
+  }
+
+  // --- timeline ---
+
+  private timelineX(t: number): number {
+    const w = this.timeline.clientWidth;
+    const end = Math.max(1, this.rec.endTime);
+    return 8 + (t / end) * (w - 16);
+  }
+
+  private timelineT(x: number): number {
+    const w = this.timeline.clientWidth;
+    const end = Math.max(1, this.rec.endTime);
+    return Math.max(0, Math.min(end, ((x - 8) / (w - 16)) * end));
+  }
+
+  private markerNear(x: number): {t: number; label: string} | null {
+    let best: {t: number; label: string} | null = null;
+    let bestD = 5;
+    for (const m of this.rec.markers) {
+      const d = Math.abs(this.timelineX(m.t) - x);
+      if (d < bestD) {
+        bestD = d;
+        best = m;
+      }
+    }
+    return best;
+  }
+
+  private setupTimeline(): void {
+    let dragging = false;
+    const seekAt = (ev: PointerEvent, snap: boolean) => {
+      const x = ev.offsetX;
+      const m = snap ? this.markerNear(x) : null;
+      this.seek(m ? m.t : this.timelineT(x));
+    };
+    this.timeline.addEventListener("pointerdown", (ev) => {
+      dragging = true;
+      this.timeline.setPointerCapture(ev.pointerId);
+      seekAt(ev, true);
+    });
+    this.timeline.addEventListener("pointermove", (ev) => {
+      if (dragging) seekAt(ev, false);
+      const m = this.markerNear(ev.offsetX);
+      this.tip.textContent = m ? `${fmtTime(m.t)} ${m.label}` : fmtTime(this.timelineT(ev.offsetX));
+      this.tip.style.left = `${Math.min(ev.offsetX, this.timeline.clientWidth - 260)}px`;
+      this.tip.style.display = "block";
+    });
+    this.timeline.addEventListener("pointerup", () => (dragging = false));
+    this.timeline.addEventListener("pointerleave", () => (this.tip.style.display = "none"));
+  }
+
+  private drawTimeline(): void {
+    const c = this.timeline;
+    const dpr = window.devicePixelRatio || 1;
+    const w = c.clientWidth;
+    const hgt = c.clientHeight;
+    if (w === 0) return;
+    const key = `${w}x${hgt}@${dpr}/${this.rec.markers.length}/${this.rec.endTime}`;
+    if (key !== this.timelineKey || !this.timelineCache) {
+      this.timelineKey = key;
+      const cache = this.timelineCache ?? document.createElement("canvas");
+      cache.width = Math.round(w * dpr);
+      cache.height = Math.round(hgt * dpr);
+      const g = cache.getContext("2d")!;
+      g.setTransform(dpr, 0, 0, dpr, 0, 0);
+      g.fillStyle = "#f3f3f3";
+      g.fillRect(0, 0, w, hgt);
+      // Phases as bands.
+      const starts = this.rec.phaseStarts;
+      starts.forEach((p, i) => {
+        const x0 = this.timelineX(p.t);
+        const x1 = this.timelineX(i + 1 < starts.length ? starts[i + 1].t : this.rec.endTime);
+        g.fillStyle = p.phase === "EXPLORATION" ? "#fbecd2" : p.phase === "PRODUCTION" ? "#dde7f3" : "#eee";
+        g.fillRect(x0, 0, x1 - x0, hgt);
+        g.fillStyle = "#777";
+        g.font = "10px sans-serif";
+        g.textBaseline = "top";
+        g.textAlign = "left";
+        g.fillText(p.phase.toLowerCase(), x0 + 3, 2);
+      });
+      const rows = {award: 0.35, failure: 0.6, collision: 0.85};
+      const colors = {award: "#2e7d32", failure: "#c0392b", collision: "#ef6c00"};
+      for (const m of this.rec.markers) {
+        const x = this.timelineX(m.t);
+        g.strokeStyle = colors[m.kind];
+        g.lineWidth = 2;
+        g.beginPath();
+        g.moveTo(x, hgt * rows[m.kind] - 6);
+        g.lineTo(x, hgt * rows[m.kind] + 5);
+        g.stroke();
+      }
+      this.timelineCache = cache;
+    }
+    if (c.width !== Math.round(w * dpr) || c.height !== Math.round(hgt * dpr)) {
+      c.width = Math.round(w * dpr);
+      c.height = Math.round(hgt * dpr);
+    }
+    const ctx = c.getContext("2d")!;
+    ctx.setTransform(1, 0, 0, 1, 0, 0);
+    ctx.drawImage(this.timelineCache!, 0, 0);
+    ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+    const x = this.timelineX(this.time);
+    ctx.strokeStyle = "#000";
+    ctx.lineWidth = 2;
+    ctx.beginPath();
+    ctx.moveTo(x, 0);
+    ctx.lineTo(x, hgt);
+    ctx.stroke();
+  }
+}
+
+/// Reads a response body as lines into the recording, chunk by chunk (the page shows the game
+/// while the rest loads).
+async function loadInto(replay: Replay, url: string, signal: AbortSignal): Promise<void> {
+  replay.setStatus("loading…");
+  const res = await fetch(url, {signal});
+  if (!res.ok) throw new Error(await errorText(res));
+  const reader = res.body!.getReader();
+  const decoder = new TextDecoder();
+  let rest = "";
+  let started = false;
+  for (;;) {
+    const {done, value} = await reader.read();
+    if (done) break;
+    rest += decoder.decode(value, {stream: true});
+    const lines = rest.split("\n");
+    rest = lines.pop() ?? "";
+    for (const l of lines) replay.rec.appendText(l);
+    if (!started && replay.rec.header) {
+      started = true;
+      replay.start();
+    }
+  }
+  rest += decoder.decode();
+  if (rest.trim()) replay.rec.appendText(rest);
+  if (!replay.rec.header) throw new Error(`${url}: the recording is empty`);
+  if (!started) replay.start();
+  const h = replay.rec.header;
+  replay.setStatus(
+    `${replay.rec.lines.length + 1} lines · ${h.robots.length} robots · seed ${h.seed}`,
+  );
+  replay.ready = true;
+  app.setAttribute("data-ready", "true");
+}
+
+function replayPage(url: string, title: string, signal: AbortSignal): () => void {
+  const replay = new Replay(false);
+  replay.setTitle(title);
+  app.replaceChildren(replay.root);
+  loadInto(replay, url, signal)
+    .then(() => {
+      const h = replay.rec.header!;
+      replay.setTitle(
+        `${title} · ${h.scenario}${h.variant ? ` (${h.variant})` : ""} · seed ${h.seed}`,
+      );
+    })
+    .catch((e) => replay.fail(e));
+  return () => replay.stop();
+}
+
+function livePage(signal: AbortSignal): () => void {
+  const replay = new Replay(true);
+  replay.setTitle("live game");
+  app.replaceChildren(replay.root);
+  replay.setFollow(true);
+  let ws: WebSocket | null = null;
+  let retry = 0;
+  let closed = false;
+  const connect = async () => {
+    if (closed) return;
+    try {
+      const st = await fetchJson<{live: boolean}>("/api/live/status", signal);
+      if (!st.live) {
+        replay.setStatus("no live game is served; waiting…");
+        retry = window.setTimeout(connect, 2000);
+        return;
+      }
+    } catch (e) {
+      if (closed) return;
+      replay.setStatus(`live status: ${e instanceof Error ? e.message : String(e)}; retrying…`);
+      retry = window.setTimeout(connect, 2000);
+      return;
+    }
+    const proto = location.protocol === "https:" ? "wss:" : "ws:";
+    ws = new WebSocket(`${proto}//${location.host}/api/live`);
+    let started = false;
+    let rest = "";
+    replay.setStatus("connecting…");
+    ws.onmessage = (ev) => {
+      if (typeof ev.data !== "string") return;
+      // Messages hold whole lines; a trailing partial line is kept for the next one.
+      const lines = (rest + ev.data).split("\n");
+      rest = lines.pop() ?? "";
+      try {
+        if (rest.trim() !== "") {
+          // A message ending without "\n" whose last line parses is complete.
+          try {
+            JSON.parse(rest);
+            lines.push(rest);
+            rest = "";
+          } catch {
+            // incomplete: wait for the rest
+          }
+        }
+        for (const l of lines) replay.rec.appendText(l);
+      } catch (e) {
+        replay.fail(e);
+        ws?.close();
+        return;
+      }
+      if (!started && replay.rec.header) {
+        started = true;
+        replay.start();
+        replay.ready = true;
+        app.setAttribute("data-ready", "true");
+      }
+      replay.setStatus(`live${over ? " · game over" : ""} · ${replay.rec.lines.length + 1} lines`);
+    };
+    // The server keeps the socket open after the game; its status says when the game is over.
+    let over = false;
+    const poll = async () => {
+      if (closed || over) return;
+      try {
+        const st = await fetchJson<{live: boolean; running?: boolean}>("/api/live/status", signal);
+        if (st.running === false) {
+          over = true;
+          replay.setStatus(`live · game over · ${replay.rec.lines.length + 1} lines`);
+          return;
+        }
+      } catch {
+        // the server may be gone (--serve-exit): stop polling
+        return;
+      }
+      retry = window.setTimeout(poll, 2000);
+    };
+    retry = window.setTimeout(poll, 2000);
+    ws.onclose = () => {
+      if (!closed) replay.setStatus(`live game ended · ${replay.rec.lines.length + 1} lines`);
+    };
+    ws.onerror = () => {
+      if (!closed) replay.setStatus("live connection failed");
+    };
+  };
+  void connect();
+  return () => {
+    closed = true;
+    window.clearTimeout(retry);
+    ws?.close();
+    replay.stop();
+  };
+}
+
+// ---------------------------------------------------------------------------------------------
+// The router.
+
+function route(): void {
+  teardown?.();
+  teardown = null;
+  const controller = new AbortController();
+  const signal = controller.signal;
+  app.removeAttribute("data-ready");
+  app.removeAttribute("data-error");
+  const hash = location.hash.replace(/^#/, "") || "/";
+  let m: RegExpExecArray | null;
+  let stop: (() => void) | null = null;
+  if ((m = /^\/batch\/([^/]+)$/.exec(hash))) {
+    app.setAttribute("data-page", "batch");
+    batchPage(decodeURIComponent(m[1]), signal);
+  } else if ((m = /^\/run\/([^/]+)$/.exec(hash))) {
+    app.setAttribute("data-page", "run");
+    stop = replayPage(`/api/runs/${m[1]}/recording`, `run ${decodeURIComponent(m[1])}`, signal);
+  } else if ((m = /^\/file\/(.+)$/.exec(hash))) {
+    app.setAttribute("data-page", "file");
+    const path = decodeURIComponent(m[1]);
+    const url = `/api/recordings/${path.split("/").map(encodeURIComponent).join("/")}`;
+    stop = replayPage(url, path, signal);
+  } else if (hash === "/live") {
+    app.setAttribute("data-page", "live");
+    stop = livePage(signal);
+  } else {
+    app.setAttribute("data-page", "batches");
+    batchesPage(signal);
+  }
+  teardown = () => {
+    controller.abort();
+    stop?.();
+  };
+}
+
+window.addEventListener("hashchange", route);
+route();
