@@ -153,6 +153,17 @@ RayCaster::RayCaster(const WorldConfig& config) {
       groups_.push_back({box.pose.x, box.pose.y, box.half_extents.norm(), first, count});
     }
   }
+  // Extra obstacles: boxes seen like walls.
+  for (const ObstacleConfig& o : config.obstacles) {
+    const core::OrientedBox box = o.footprint();
+    const auto c = box.corners();
+    const int first = static_cast<int>(segments_.size());
+    for (int k = 0; k < 4; ++k) add_segment(c[k], c[(k + 1) % 4], HitKind::kWall, -1);
+    const int count = static_cast<int>(segments_.size()) - first;
+    if (count > 0) {
+      groups_.push_back({box.pose.x, box.pose.y, box.half_extents.norm(), first, count});
+    }
+  }
 }
 
 void RayCaster::add_segment(const Vec2& a, const Vec2& b, HitKind kind, int index) {

@@ -180,6 +180,20 @@ struct World::Impl : public b2ContactListener {
       fd.userData.pointer = tag(Owner::kDevice, d);
       ground->CreateFixture(&fd);
     }
+    // Extra obstacles behave like walls (contacts count as robot-wall collisions).
+    for (const ObstacleConfig& o : cfg.obstacles) {
+      const core::OrientedBox box = o.footprint();
+      b2PolygonShape s;
+      s.SetAsBox(static_cast<float>(std::max(box.half_extents.x() - kSkin, 0.001)),
+                 static_cast<float>(std::max(box.half_extents.y() - kSkin, 0.001)),
+                 to_b2(box.pose.position()), static_cast<float>(box.pose.theta));
+      b2FixtureDef fd;
+      fd.shape = &s;
+      fd.friction = 0.3f;
+      fd.filter.categoryBits = kCatWall;
+      fd.userData.pointer = tag(Owner::kWall, 0);
+      ground->CreateFixture(&fd);
+    }
   }
 
   void add_robot(int i, const core::Rng& rng) {

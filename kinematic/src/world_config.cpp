@@ -241,6 +241,38 @@ std::optional<int> device_hit(const WorldConfig& c, const Vec2& center, double r
   return std::nullopt;
 }
 
+/// The obstacle whose box the circle overlaps, if any.
+std::optional<std::size_t> obstacle_hit(const WorldConfig& c, const Vec2& center, double r) {
+  for (std::size_t i = 0; i < c.obstacles.size(); ++i) {
+    if (circle_overlaps_box(center, r, c.obstacles[i].footprint())) return i;
+  }
+  return std::nullopt;
+}
+
+void validate_obstacles(const WorldConfig& c) {
+  const FieldConfig& f = c.field;
+  for (std::size_t i = 0; i < c.obstacles.size(); ++i) {
+    const ObstacleConfig& o = c.obstacles[i];
+    const std::string p = indexed("obstacles", i);
+    if (o.name.empty()) fail(p + ".name", "must not be empty");
+    for (std::size_t j = 0; j < i; ++j) {
+      if (c.obstacles[j].name == o.name) {
+        fail(p + ".name", "duplicate obstacle name '" + o.name + "' (also used by " +
+                              indexed("obstacles", j) + ")");
+      }
+    }
+    require_finite(p + ".x", o.pose.x);
+    require_finite(p + ".y", o.pose.y);
+    require_finite(p + ".ori", o.pose.theta);
+    require_positive(p + ".size_x_m", o.size_x_m);
+    require_positive(p + ".size_y_m", o.size_y_m);
+    if (!core::inside_rect(o.footprint(), Vec2(0.0, 0.0), Vec2(f.width_m, f.height_m))) {
+      fail(p, "obstacle '" + o.name + "' at " + at_xy(o.pose.position()) +
+                  " is not entirely inside the field (" + field_size(f) + ")");
+    }
+  }
+}
+
 void validate_pucks(const WorldConfig& c) {
   const PuckModelConfig& m = c.puck;
   require_positive("puck.radius_m", m.radius_m);
@@ -268,6 +300,9 @@ void validate_pucks(const WorldConfig& c) {
     }
     if (auto d = device_hit(c, pk.position, r)) {
       fail(p, what + " overlaps the footprint of " + device_path(*d));
+    }
+    if (auto o = obstacle_hit(c, pk.position, r)) {
+      fail(p, what + " overlaps " + indexed("obstacles", *o));
     }
     for (std::size_t j = 0; j < i; ++j) {
       if (circles_overlap(pk.position, r, c.pucks[j].position, r)) {
@@ -320,6 +355,9 @@ void validate_robots(const WorldConfig& c) {
     }
     if (auto d = device_hit(c, pos, r)) {
       fail(p, what + " overlaps the footprint of " + device_path(*d));
+    }
+    if (auto o = obstacle_hit(c, pos, r)) {
+      fail(p, what + " overlaps " + indexed("obstacles", *o));
     }
     for (std::size_t j = 0; j < i; ++j) {
       if (circles_overlap(pos, r, c.robots[j].pose.position(), r)) {
@@ -400,6 +438,7 @@ void WorldConfig::validate() const {
   // Models before placements: the placement checks use the sizes.
   validate_field(field);
   validate_devices(*this);
+  validate_obstacles(*this);
   validate_pucks(*this);
   validate_robots(*this);
   validate_sensors(sensors);

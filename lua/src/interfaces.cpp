@@ -5,6 +5,8 @@
 #include <exception>
 #include <limits>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "engine_impl.h"
 
@@ -387,6 +389,175 @@ int pucks_nearest(lua_State* L) {
   });
 }
 
+// ---- ColourPuckInterface (puck_detector): the hackathon's flashlight camera ----
+void push_colour_puck(lua_State* L, const ColourPuckSighting& p) {
+  lua_pushnumber(L, p.position.x());
+  lua_pushnumber(L, p.position.y());
+  lua_pushnumber(L, p.distance_m);
+  lua_pushnumber(L, p.bearing_rad);
+  lua_pushstring(L, p.colour.c_str());
+}
+/// Whether `colour` matches the filter at stack index `arg`: none/nil, a string or a list.
+bool colour_matches(lua_State* L, int arg, const std::string& colour) {
+  if (lua_isnoneornil(L, arg)) return true;
+  if (lua_type(L, arg) == LUA_TSTRING) return colour == lua_tostring(L, arg);
+  if (lua_type(L, arg) != LUA_TTABLE) return false;
+  const lua_Integer n = static_cast<lua_Integer>(lua_rawlen(L, arg));
+  for (lua_Integer i = 1; i <= n; ++i) {
+    lua_rawgeti(L, arg, i);
+    const bool match = lua_type(L, -1) == LUA_TSTRING && colour == lua_tostring(L, -1);
+    lua_pop(L, 1);
+    if (match) return true;
+  }
+  return false;
+}
+int cpucks_available(lua_State* L) {
+  return guarded(L, [&](Impl& e) {
+    lua_pushboolean(L, e.robot.rescue() != nullptr);
+    return 1;
+  });
+}
+int cpucks_count(lua_State* L) {
+  return guarded(L, [&](Impl& e) {
+    lua_pushinteger(L, static_cast<lua_Integer>(e.robot.colour_pucks().size()));
+    return 1;
+  });
+}
+int cpucks_puck(lua_State* L) {
+  const lua_Integer i = luaL_checkinteger(L, 2);
+  return guarded(L, [&](Impl& e) {
+    const auto pucks = e.robot.colour_pucks();
+    if (i < 1 || i > static_cast<lua_Integer>(pucks.size())) return 0;
+    push_colour_puck(L, pucks[static_cast<std::size_t>(i - 1)]);
+    return 5;
+  });
+}
+int cpucks_list(lua_State* L) {
+  return guarded(L, [&](Impl& e) {
+    const auto pucks = e.robot.colour_pucks();
+    lua_createtable(L, static_cast<int>(pucks.size()), 0);
+    for (std::size_t i = 0; i < pucks.size(); ++i) {
+      const ColourPuckSighting& p = pucks[i];
+      lua_createtable(L, 0, 5);
+      lua_pushnumber(L, p.position.x());
+      lua_setfield(L, -2, "x");
+      lua_pushnumber(L, p.position.y());
+      lua_setfield(L, -2, "y");
+      lua_pushnumber(L, p.distance_m);
+      lua_setfield(L, -2, "distance");
+      lua_pushnumber(L, p.bearing_rad);
+      lua_setfield(L, -2, "bearing");
+      lua_pushstring(L, p.colour.c_str());
+      lua_setfield(L, -2, "colour");
+      lua_rawseti(L, -2, static_cast<lua_Integer>(i + 1));
+    }
+    return 1;
+  });
+}
+int cpucks_nearest(lua_State* L) {
+  return guarded(L, [&](Impl& e) {
+    const ColourPuckSighting* best = nullptr;
+    for (const ColourPuckSighting& p : e.robot.colour_pucks()) {
+      if (!colour_matches(L, 2, p.colour)) continue;
+      if (best == nullptr || p.distance_m < best->distance_m) best = &p;
+    }
+    if (best == nullptr) return 0;
+    push_colour_puck(L, *best);
+    return 5;
+  });
+}
+
+// ---- RescueInterface (rescue): the hackathon's task ----
+bool in_rect(const RescueInfo& r, const core::Vec2& p) {
+  return p.x() >= r.safe_lo.x() && p.y() >= r.safe_lo.y() && p.x() <= r.safe_hi.x() &&
+         p.y() <= r.safe_hi.y();
+}
+void push_string_list(lua_State* L, const std::vector<std::string>& v) {
+  lua_createtable(L, static_cast<int>(v.size()), 0);
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    lua_pushstring(L, v[i].c_str());
+    lua_rawseti(L, -2, static_cast<lua_Integer>(i + 1));
+  }
+}
+bool contains(const std::vector<std::string>& v, const char* s) {
+  for (const std::string& x : v) {
+    if (x == s) return true;
+  }
+  return false;
+}
+int rescue_active(lua_State* L) {
+  return guarded(L, [&](Impl& e) {
+    lua_pushboolean(L, e.robot.rescue() != nullptr);
+    return 1;
+  });
+}
+int rescue_in_safe_area(lua_State* L) {
+  return guarded(L, [&](Impl& e) {
+    const RescueInfo* r = e.robot.rescue();
+    lua_pushboolean(L, r != nullptr && in_rect(*r, e.robot.pose().pose.position()));
+    return 1;
+  });
+}
+int rescue_holder_in_safe_area(lua_State* L) {
+  return guarded(L, [&](Impl& e) {
+    const RescueInfo* r = e.robot.rescue();
+    const bool in =
+        r != nullptr &&
+        in_rect(*r, e.robot.pose().pose.to_parent(core::Vec2(r->held_puck_offset_m, 0.0)));
+    lua_pushboolean(L, in);
+    return 1;
+  });
+}
+int rescue_safe_area(lua_State* L) {
+  return guarded(L, [&](Impl& e) {
+    const RescueInfo* r = e.robot.rescue();
+    if (r == nullptr) return 0;
+    lua_pushnumber(L, r->safe_lo.x());
+    lua_pushnumber(L, r->safe_lo.y());
+    lua_pushnumber(L, r->safe_hi.x());
+    lua_pushnumber(L, r->safe_hi.y());
+    return 4;
+  });
+}
+int rescue_safe_place(lua_State* L) {
+  return guarded(L, [&](Impl& e) {
+    const RescueInfo* r = e.robot.rescue();
+    if (r == nullptr) return 0;
+    lua_pushstring(L, r->safe_place.c_str());
+    return 1;
+  });
+}
+int rescue_counts(lua_State* L) {
+  const char* colour = luaL_checkstring(L, 2);
+  return guarded(L, [&](Impl& e) {
+    const RescueInfo* r = e.robot.rescue();
+    lua_pushboolean(L, r != nullptr && contains(r->counted, colour));
+    return 1;
+  });
+}
+int rescue_is_decoy(lua_State* L) {
+  const char* colour = luaL_checkstring(L, 2);
+  return guarded(L, [&](Impl& e) {
+    const RescueInfo* r = e.robot.rescue();
+    lua_pushboolean(L, r != nullptr && contains(r->decoys, colour));
+    return 1;
+  });
+}
+int rescue_colours(lua_State* L) {
+  return guarded(L, [&](Impl& e) {
+    const RescueInfo* r = e.robot.rescue();
+    push_string_list(L, r != nullptr ? r->counted : std::vector<std::string>{});
+    return 1;
+  });
+}
+int rescue_decoys(lua_State* L) {
+  return guarded(L, [&](Impl& e) {
+    const RescueInfo* r = e.robot.rescue();
+    push_string_list(L, r != nullptr ? r->decoys : std::vector<std::string>{});
+    return 1;
+  });
+}
+
 // ---- Laser360Interface (laser) ----
 int laser_num_beams(lua_State* L) {
   return guarded(L, [&](Impl& e) {
@@ -497,6 +668,19 @@ void push_interfaces(lua_State* L) {
                                    {nullptr, nullptr}};
   static const luaL_Reg pucks[] = {
       {"count", pucks_count}, {"puck", pucks_puck}, {"nearest", pucks_nearest}, {nullptr, nullptr}};
+  static const luaL_Reg colour_pucks[] = {{"available", cpucks_available}, {"count", cpucks_count},
+                                          {"puck", cpucks_puck},           {"list", cpucks_list},
+                                          {"nearest", cpucks_nearest},     {nullptr, nullptr}};
+  static const luaL_Reg rescue[] = {{"active", rescue_active},
+                                    {"in_safe_area", rescue_in_safe_area},
+                                    {"holder_in_safe_area", rescue_holder_in_safe_area},
+                                    {"safe_area", rescue_safe_area},
+                                    {"safe_place", rescue_safe_place},
+                                    {"counts", rescue_counts},
+                                    {"is_decoy", rescue_is_decoy},
+                                    {"colours", rescue_colours},
+                                    {"decoys", rescue_decoys},
+                                    {nullptr, nullptr}};
   static const luaL_Reg laser[] = {{"num_beams", laser_num_beams},
                                    {"distances", laser_distances},
                                    {"angle", laser_angle},
@@ -520,6 +704,8 @@ void push_interfaces(lua_State* L) {
                            {"RobotinoLightInterface", light, light_constants},
                            {"PuckVisionInterface", pucks, nullptr},
                            {"Laser360Interface", laser, nullptr},
+                           {"ColourPuckInterface", colour_pucks, nullptr},
+                           {"RescueInterface", rescue, nullptr},
                            {"SymbolicInterface", sym, nullptr}};
   // native (at -1).interfaces = {Type = object, ...}; native.interface_names = "A, B, ..."
   lua_newtable(L);

@@ -71,7 +71,8 @@ local interface_types = native.interfaces  -- type name -> interface object
 local conventional_vars = {pose = "Position3DInterface", navigator = "NavigatorInterface",
                            motor = "MotorInterface", sensor = "RobotinoSensorInterface",
                            light = "RobotinoLightInterface", pucks = "PuckVisionInterface",
-                           laser = "Laser360Interface"}
+                           laser = "Laser360Interface", puck_detector = "ColourPuckInterface",
+                           rescue = "RescueInterface"}
 
 local function where(level)
   local info = debug_getinfo(level + 1, "Sl")

@@ -19,6 +19,7 @@
 #include <llsf_msgs/Sync.pb.h>
 #include <llsf_msgs/VersionInfo.pb.h>
 
+#include <algorithm>
 #include <string>
 #include <utility>
 
@@ -108,6 +109,8 @@ planner::FieldMap field_map_from_world(const kinematic::WorldConfig& w) {
   m.late_order_area = rect(w.field.late_order_area);
   m.late_order_slot = w.field.late_order_slot;
   m.delivery_zone = rect(w.field.delivery_zone);
+  for (const kinematic::ObstacleConfig& o : w.obstacles)
+    m.obstacles.push_back({o.name, o.footprint()});
   return m;
 }
 
@@ -115,6 +118,18 @@ planner::FieldMap field_map_from_world(const kinematic::WorldConfig& w) {
 
 Game::Game(GameConfig config) : config_(std::move(config)), rng_(config_.seed) {
   config_.validate();
+  // The hackathon variant: boxes, the coloured pucks of this seed, the safe place.
+  if (config_.hackathon) {
+    const HackathonConfig& h = *config_.hackathon;
+    hackathon_layout_ = generate_hackathon_layout(h, config_.world, rng_);
+    apply_hackathon_layout(h, *hackathon_layout_, config_.world);
+    config_.planner.places.extra.push_back(
+        {h.safe_place,
+         hackathon_safe_pose(h, config_.world, config_.planner.places.held_puck_offset_m)});
+    for (const HackathonPuck& p : hackathon_layout_->pucks) {
+      puck_colour_by_id_.emplace(p.id.value(), p.colour);
+    }
+  }
   world_ = std::make_unique<kinematic::World>(config_.world, rng_);
   protocol_ = std::make_unique<refbox::RefboxProtocol>(config_.refbox, rng_, config_.protocol);
 
@@ -165,6 +180,7 @@ Game::Game(GameConfig config) : config_(std::move(config)), rng_(config_.seed) {
   discs_.reserve(robots);
   others_.reserve(robots);
   puck_positions_.reserve(config_.world.pucks.size() + 32);
+  puck_colours_.reserve(config_.world.pucks.size() + 32);
   events_ = &no_events_;
 }
 
@@ -388,9 +404,15 @@ void Game::step() {
     lights_[static_cast<std::size_t>(i)] = world_->lights(core::DeviceId(i));
   }
   puck_positions_.clear();
+  puck_colours_.clear();
   for (const core::PuckId p : world_->pucks()) {
     // World::pucks() also lists removed pucks (see docs/sim.md, "Notes on other modules").
-    if (world_->has_puck(p)) puck_positions_.push_back(world_->puck_position(p));
+    if (!world_->has_puck(p)) continue;
+    puck_positions_.push_back(world_->puck_position(p));
+    if (hackathon_layout_) {
+      const auto it = puck_colour_by_id_.find(p.value());
+      puck_colours_.push_back(it == puck_colour_by_id_.end() ? -1 : it->second);
+    }
   }
   for (int i = 0; i < n; ++i) {
     const core::RobotId id(i);
@@ -400,6 +422,7 @@ void Game::step() {
     p.sensors = &world_->sensors(id);
     p.lights = lights_;
     p.pucks = puck_positions_;
+    p.puck_colours = puck_colours_;
     stacks_[static_cast<std::size_t>(i)]->sense(p);
   }
 
@@ -505,6 +528,24 @@ core::Vec2 Game::free_storage_spot() const {
 }
 
 // --- summary ---------------------------------------------------------------------------------
+
+std::optional<HackathonScore> Game::hackathon_score() const {
+  if (!hackathon_layout_) return std::nullopt;
+  std::vector<HackathonPuckState> states;
+  std::vector<core::PuckId> held;
+  for (int r = 0; r < robot_count(); ++r) {
+    if (const auto p = puck_in_pocket(r)) held.push_back(*p);
+  }
+  for (const HackathonPuck& p : hackathon_layout_->pucks) {
+    HackathonPuckState s;
+    s.id = p.id;
+    s.on_field = world_->has_puck(p.id);
+    if (s.on_field) s.position = world_->puck_position(p.id);
+    s.held = std::find(held.begin(), held.end(), p.id) != held.end();
+    states.push_back(s);
+  }
+  return score_hackathon(*config_.hackathon, *hackathon_layout_, states);
+}
 
 GameSummary Game::summary() const {
   const refbox::Refbox& rb = refbox();

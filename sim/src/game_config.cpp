@@ -103,6 +103,13 @@ void GameConfig::validate() const {
   hub.validate();
   planner.validate();
   controller.validate();
+  if (hackathon) {
+    try {
+      hackathon->validate(world);
+    } catch (const core::ConfigError& e) {
+      throw core::ConfigError("game." + std::string(e.what()));
+    }
+  }
 }
 
 }  // namespace llsf::sim

@@ -92,6 +92,8 @@ struct Recorder::Impl {
   std::vector<std::string> robot_names;
   std::vector<std::vector<core::Vec2>> paths;  // per robot, as last written
   std::vector<std::int64_t> robot_dropped;     // per robot: its copies dropped so far
+  HackathonScore score;                        // hackathon: as last written
+  bool score_known = false;
   LineSink sink;
 
   void write(const std::string& s) {
@@ -147,7 +149,38 @@ Recorder::Recorder(const std::string& path, const Game& game, const RecordingInf
     h += std::string(i ? ", " : "") + quote(game.robot(i).name());
   }
   h += "], \"robot_radius\": " + num(w.robot.radius_m, 3) +
-       ", \"puck_radius\": " + num(w.puck.radius_m, 4) + "}";
+       ", \"puck_radius\": " + num(w.puck.radius_m, 4);
+  // Extra obstacles and the hackathon's task (only when present; docs/recording.md).
+  if (!w.obstacles.empty()) {
+    h += ", \"obstacles\": [";
+    for (std::size_t i = 0; i < w.obstacles.size(); ++i) {
+      const kinematic::ObstacleConfig& o = w.obstacles[i];
+      h += std::string(i ? ", " : "") + "{\"name\": " + quote(o.name) + ", \"box\": [" +
+           num(o.pose.x, 3) + ", " + num(o.pose.y, 3) + ", " + num(o.size_x_m, 3) + ", " +
+           num(o.size_y_m, 3) + ", " + num(o.pose.theta, 3) + "]}";
+    }
+    h += "]";
+  }
+  if (const HackathonLayout* layout = game.hackathon_layout()) {
+    const HackathonConfig& hc = *game.config().hackathon;
+    const kinematic::Rect& a = hc.safe_area;
+    h += ", \"hackathon\": {\"safe_area\": [" + num(a.lo.x(), 3) + ", " + num(a.lo.y(), 3) + ", " +
+         num(a.hi.x(), 3) + ", " + num(a.hi.y(), 3) + "], \"safe_place\": " + quote(hc.safe_place) +
+         ", \"colours\": [";
+    for (std::size_t i = 0; i < hc.colours.size(); ++i) {
+      h += std::string(i ? ", " : "") + "{\"name\": " + quote(hc.colours[i].name) +
+           ", \"decoy\": " + (hc.colours[i].decoy ? "true" : "false") + "}";
+    }
+    h += "], \"pucks\": {";
+    for (std::size_t i = 0; i < layout->pucks.size(); ++i) {
+      const HackathonPuck& p = layout->pucks[i];
+      h += std::string(i ? ", " : "") + quote(std::to_string(p.id.value())) + ": " +
+           quote(hc.colours[static_cast<std::size_t>(p.colour)].name);
+    }
+    h += "}, \"points_per_puck\": " + std::to_string(hc.points_per_puck) +
+         ", \"decoy_penalty\": " + std::to_string(hc.decoy_penalty) + "}";
+  }
+  h += "}";
   m.write(h);
 }
 
@@ -350,6 +383,24 @@ void Recorder::frame(const Game& game) {
     if (!by.empty()) s += ", \"drops_from\": {" + by + "}";
   }
   m.write(s + "}");
+
+  // The hackathon score, at the frame rate, when it changed.
+  if (const std::optional<HackathonScore> score = game.hackathon_score()) {
+    if (!m.score_known || score->points != m.score.points || score->rescued != m.score.rescued ||
+        score->decoys != m.score.decoys || score->in_safe_area != m.score.in_safe_area) {
+      if (m.score_known || score->rescued != 0 || score->decoys != 0) {
+        std::string ids;
+        for (const core::PuckId id : score->in_safe_area) {
+          ids += (ids.empty() ? "" : ", ") + std::to_string(id.value());
+        }
+        m.write(m.head(t, "rescue") + ", \"points\": " + std::to_string(score->points) +
+                ", \"rescued\": " + std::to_string(score->rescued) +
+                ", \"decoys\": " + std::to_string(score->decoys) + ", \"pucks\": [" + ids + "]}");
+      }
+      m.score = *score;
+      m.score_known = true;
+    }
+  }
 
   // Puck states and orders, at the frame rate.
   for (const refbox::Puck& p : rb.pucks()) {

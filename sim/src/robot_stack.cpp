@@ -85,7 +85,8 @@ RobotStack::RobotStack(std::string name, int index, const core::Pose2D& start,
       planner_(&planner),
       nav_(planner, config.controller, rng.stream("planner/" + name_)),
       loc_rng_(rng.stream("sim/" + name_ + "/localization")),
-      light_rng_(rng.stream("sim/" + name_ + "/light")) {
+      light_rng_(rng.stream("sim/" + name_ + "/light")),
+      colour_rng_(rng.stream("sim/" + name_ + "/colour")) {
   pose_.pose = start;
   est_ref_ = start;
   odo_ref_ = start;
@@ -101,6 +102,21 @@ RobotStack::RobotStack(std::string name, int index, const core::Pose2D& start,
   sightings_.reserve(64);
   scratch_.reserve(64);
   cluster_.reserve(64);
+  if (config.hackathon) {
+    const HackathonConfig& h = *config.hackathon;
+    camera_ = h.camera;
+    lua::RescueInfo info;
+    info.safe_lo = h.safe_area.lo;
+    info.safe_hi = h.safe_area.hi;
+    info.safe_place = h.safe_place;
+    for (const HackathonColour& c : h.colours) {
+      colour_names_.push_back(c.name);
+      (c.decoy ? info.decoys : info.counted).push_back(c.name);
+    }
+    info.held_puck_offset_m = config.world.robot.radius_m + config.world.puck.radius_m;
+    rescue_ = std::move(info);
+    colour_sightings_.reserve(64);
+  }
 }
 
 // --- actuation -------------------------------------------------------------------------------
@@ -254,6 +270,7 @@ void RobotStack::sense(const RobotPercept& p) {
     sense_light_vision(p);
   }
   sense_pucks(p);
+  if (camera_) sense_colour_pucks(p);
 }
 
 void RobotStack::sense_localization(const RobotPercept& p) {
@@ -483,6 +500,44 @@ void RobotStack::sense_pucks(const RobotPercept& p) {
       }
     }
     sightings_.push_back({sum / static_cast<double>(count)});
+  }
+}
+
+}  // namespace llsf::sim
+
+namespace llsf::sim {
+
+// The hackathon's flashlight camera: a cone ahead of the robot, one frame every 1/frame_rate_hz;
+// per puck in the cone three draws (miss, false colour, which colour) and two for the position
+// noise, whatever the outcome, so that one puck's luck does not shift the others'.
+void RobotStack::sense_colour_pucks(const RobotPercept& p) {
+  const ColourCameraConfig& c = *camera_;
+  if (p.now < colour_next_frame_) return;
+  const SimTime period = SimTime::period_of_hz(c.frame_rate_hz);
+  colour_next_frame_ += period;
+  if (colour_next_frame_ <= p.now) colour_next_frame_ = p.now + period;
+  colour_sightings_.clear();
+  const double half_fov = 0.5 * c.fov_rad;
+  const int colours = static_cast<int>(colour_names_.size());
+  for (std::size_t i = 0; i < p.pucks.size() && i < p.puck_colours.size(); ++i) {
+    const int colour = p.puck_colours[i];
+    if (colour < 0) continue;
+    const core::Vec2 l = p.true_pose.to_local(p.pucks[i]);
+    const double d = l.norm();
+    if (d > c.range_m || std::abs(std::atan2(l.y(), l.x())) > half_fov) continue;
+    const bool missed = colour_rng_.bernoulli(c.miss_rate);
+    const bool wrong = colour_rng_.bernoulli(c.false_colour_rate);
+    const std::int64_t other = colours > 1 ? colour_rng_.uniform_int(0, colours - 2) : 0;
+    const core::Vec2 noise(colour_rng_.normal(0.0, c.position_noise_m),
+                           colour_rng_.normal(0.0, c.position_noise_m));
+    if (missed) continue;
+    int seen = colour;
+    if (wrong && colours > 1)
+      seen =
+          static_cast<int>(other) >= colour ? static_cast<int>(other) + 1 : static_cast<int>(other);
+    const core::Vec2 at = l + noise;
+    colour_sightings_.push_back(
+        {at, at.norm(), std::atan2(at.y(), at.x()), colour_names_[static_cast<std::size_t>(seen)]});
   }
 }
 

@@ -29,6 +29,7 @@ double cpu_seconds() {
 }
 
 void start_game(Game& g, StartMode start) {
+  if (start == StartMode::kNone) return;  // the refbox stays in PRE_GAME
   if (start != StartMode::kGame) {
     llsf_msgs::SetGamePhase p;
     p.set_phase(start == StartMode::kExploration ? llsf_msgs::GameState::EXPLORATION
@@ -324,6 +325,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
     if (!judged[i]) judge(i, s.points, deliveries_of(rb));
   }
   r.tests = std::move(verdicts);
+  r.hackathon = game.hackathon_score();
   if (hooks.profile) {
     for (int i = 0; i < Game::TickProfile::kSteps; ++i) {
       r.time_split.emplace_back(
@@ -381,7 +383,14 @@ std::string to_json(const RunResult& r) {
       << ", \"passed\": " << (t.passed ? "true" : "false") << ", \"detail\": " << str(t.detail)
       << "}";
   }
-  o << "]}";
+  o << "]";
+  if (r.hackathon) {
+    const HackathonScore& h = *r.hackathon;
+    o << ", \"hackathon\": {\"points\": " << h.points << ", \"rescued\": " << h.rescued
+      << ", \"decoys\": " << h.decoys << ", \"rescuable\": " << h.rescuable
+      << ", \"total_pucks\": " << h.total_pucks << "}";
+  }
+  o << "}";
   return o.str();
 }
 

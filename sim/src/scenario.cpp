@@ -18,6 +18,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
+/// A hackathon run's length unless `duration_s` says otherwise.
+constexpr SimTime kHackathonDefaultDuration = SimTime::from_sec(300);
+
 std::string read_text(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw core::ConfigError(path + ": cannot read the scenario file");
@@ -253,7 +256,7 @@ Scenario read_scenario(const core::ConfigNode& root, const std::string& file) {
   root.require_map();
   root.check_keys({"name", "description", "seed", "seeds", "start", "duration_s", "refbox", "world",
                    "radio", "navigation", "levels", "rates", "team", "robots", "skills", "tests",
-                   "matrix"});
+                   "matrix", "hackathon"});
   const std::string dir = fs::path(file).parent_path().string();
   Scenario s;
   s.file = file;
@@ -273,10 +276,15 @@ Scenario read_scenario(const core::ConfigNode& root, const std::string& file) {
   read_levels(root["levels"], s.game.levels);
   read_rates(root["rates"], s.game);
   root.read("team", s.game.team);
+  if (root["hackathon"].defined()) {
+    s.game.hackathon = load_hackathon_config(root["hackathon"], s.game.world);
+    s.start = StartMode::kNone;
+  }
   if (root["start"].defined()) {
     s.start = enum_of<StartMode>(root["start"], {{"game", StartMode::kGame},
                                                  {"exploration", StartMode::kExploration},
-                                                 {"production", StartMode::kProduction}});
+                                                 {"production", StartMode::kProduction},
+                                                 {"none", StartMode::kNone}});
   }
   const refbox::RefboxConfig& rb = s.game.refbox;
   double duration = rb.production_duration.seconds();
@@ -284,6 +292,7 @@ Scenario read_scenario(const core::ConfigNode& root, const std::string& file) {
   if (s.start == StartMode::kGame && !rb.team.empty() && !rb.skip_setup) {
     duration += rb.setup_duration.seconds();
   }
+  if (s.game.hackathon) duration = kHackathonDefaultDuration.seconds();
   if (root["duration_s"].defined()) duration = positive(root["duration_s"]);
   s.duration = SimTime::from_seconds(duration);
   read_robots(root["robots"], dir, s);
@@ -327,6 +336,12 @@ std::string describe(const TestCase& t) {
   }
   if (t.by_s) ss << " by " << *t.by_s << " s";
   return ss.str();
+}
+
+Scenario read_scenario_map(const core::ConfigNode& root, const std::string& file) {
+  root.require_map();
+  if (root["matrix"].defined()) root["matrix"].fail("a matrix is not allowed here");
+  return read_scenario(root, file);
 }
 
 ScenarioFile load_scenario(const std::string& path) {

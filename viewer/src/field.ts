@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Draws the field to scale on a 2D canvas: walls, the 16 devices with name, type and lamps,
 // pucks coloured by state, robots with heading, name, held puck, skill and status, the believed
-// pose as a ghost, lock holders, radio drops and planned paths.
+// pose as a ghost, lock holders, radio drops and planned paths. Worlds with extra obstacles get
+// them as dark boxes; the hackathon variant (docs/hackathon.md) its safe area and coloured pucks.
 import type {Header, State} from "./recording";
 
 export const kRobotColors = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#8c564b", "#e377c2"];
@@ -20,10 +21,73 @@ export const kPuckColors: Record<string, string> = {
 const kLampColors = ["#e53935", "#fbc02d", "#43a047"];
 const kLampOff = ["#4a2323", "#4a4123", "#234a26"];
 
+/// CSS colours of the hackathon's colour names; other names are tried as CSS colours, then
+/// given one of kFallbackColours by a hash of the name.
+const kNamedColours: Record<string, string> = {
+  red: "#e53935",
+  green: "#43a047",
+  blue: "#1e88e5",
+  yellow: "#fdd835",
+  orange: "#fb8c00",
+  purple: "#8e24aa",
+  violet: "#8e24aa",
+  magenta: "#d81b60",
+  pink: "#f06292",
+  cyan: "#00acc1",
+  white: "#fafafa",
+  black: "#212121",
+  grey: "#9e9e9e",
+  gray: "#9e9e9e",
+  brown: "#6d4c41",
+};
+const kFallbackColours = ["#00897b", "#5e35b1", "#c0ca33", "#6d4c41", "#546e7a", "#f4511e"];
+const colourCache = new Map<string, string>();
+
+/// The CSS colour to draw pucks of the hackathon colour `name` with.
+export function colourCss(name: string): string {
+  const known = colourCache.get(name);
+  if (known) return known;
+  const key = name.trim().toLowerCase();
+  let css = kNamedColours[key];
+  if (!css) {
+    // A CSS colour name the browser knows ("teal", "#abc") is taken as it is.
+    const probe = document.createElement("canvas").getContext("2d");
+    if (probe) {
+      probe.fillStyle = "#010203";
+      probe.fillStyle = key;
+      if (probe.fillStyle !== "#010203") css = probe.fillStyle;
+    }
+  }
+  if (!css) {
+    let h = 0;
+    for (const ch of key) h = (h * 31 + ch.charCodeAt(0)) >>> 0;
+    css = kFallbackColours[h % kFallbackColours.length];
+  }
+  colourCache.set(name, css);
+  return css;
+}
+
+/// Black or white, whichever reads better on `css` (a #rrggbb colour; others get black).
+function textOn(css: string): string {
+  const m = /^#([0-9a-f]{2})([0-9a-f]{2})([0-9a-f]{2})$/i.exec(css);
+  if (!m) return "#000";
+  const [r, g, b] = [m[1], m[2], m[3]].map((x) => parseInt(x, 16));
+  return 0.299 * r + 0.587 * g + 0.114 * b < 140 ? "#fff" : "#000";
+}
+
 export interface DrawStats {
   devices: number;
   robots: number;
   pucks: number;
+  obstacles: number;
+}
+
+/// How a puck is drawn: fill, label colour, and the hackathon's marks.
+interface PuckLook {
+  fill: string;
+  text: string;
+  decoy: boolean;  // hackathon: a colour that costs points (an 'x' over it)
+  counted: boolean;  // hackathon: in the safe area and scored (a ring around it)
 }
 
 /// Whether a lamp in mode m (0 off, 1 on, 2 blinking at 2 Hz) is lit at simulated time t.
@@ -56,7 +120,8 @@ export function drawField(
   const oy = (cssH - fh * s) / 2;
   const X = (x: number) => ox + x * s;
   const Y = (y: number) => oy + (fh - y) * s;
-  const stats: DrawStats = {devices: 0, robots: 0, pucks: 0};
+  const stats: DrawStats = {devices: 0, robots: 0, pucks: 0, obstacles: 0};
+  const hack = header.hackathon;
 
   // The floor, a 1 m grid and the walls.
   ctx.fillStyle = "#fafaf7";
@@ -73,9 +138,72 @@ export function drawField(
     ctx.lineTo(X(fw), Y(y));
   }
   ctx.stroke();
+
+  // Hackathon: the safe area, tinted and hatched, labelled with its planner place.
+  const fontPx = Math.max(9, Math.min(13, s * 0.09));
+  if (hack && Array.isArray(hack.safe_area) && hack.safe_area.length === 4) {
+    const [x0, y0, x1, y1] = hack.safe_area;
+    const rx = X(x0);
+    const ry = Y(y1);
+    const rw = (x1 - x0) * s;
+    const rh = (y1 - y0) * s;
+    ctx.save();
+    ctx.fillStyle = "rgba(46, 160, 67, 0.16)";
+    ctx.fillRect(rx, ry, rw, rh);
+    ctx.beginPath();
+    ctx.rect(rx, ry, rw, rh);
+    ctx.clip();
+    ctx.strokeStyle = "rgba(46, 125, 50, 0.35)";
+    ctx.lineWidth = 1;
+    ctx.beginPath();
+    for (let d = -rh; d < rw; d += 9) {
+      ctx.moveTo(rx + d, ry + rh);
+      ctx.lineTo(rx + d + rh, ry);
+    }
+    ctx.stroke();
+    ctx.restore();
+    ctx.strokeStyle = "#2e7d32";
+    ctx.lineWidth = 2;
+    ctx.setLineDash([6, 3]);
+    ctx.strokeRect(rx, ry, rw, rh);
+    ctx.setLineDash([]);
+    const label = hack.safe_place || "SAFE";
+    ctx.font = `bold ${fontPx}px sans-serif`;
+    ctx.textAlign = "center";
+    ctx.textBaseline = "top";
+    const tw = ctx.measureText(label).width;
+    ctx.fillStyle = "rgba(250,250,247,0.85)";
+    ctx.fillRect(rx + rw / 2 - tw / 2 - 2, ry + 4, tw + 4, fontPx + 2);
+    ctx.fillStyle = "#1b5e20";
+    ctx.fillText(label, rx + rw / 2, ry + 5);
+  }
+
   ctx.strokeStyle = "#333";
   ctx.lineWidth = 3;
   ctx.strokeRect(X(0), Y(fh), fw * s, fh * s);
+
+  // Extra static obstacles: dark boxes.
+  for (const o of header.obstacles ?? []) {
+    if (!Array.isArray(o.box) || o.box.length < 4) continue;
+    const [cx, cy, sx, sy, theta = 0] = o.box;
+    ctx.save();
+    ctx.translate(X(cx), Y(cy));
+    ctx.rotate(-theta);
+    ctx.fillStyle = "#37474f";
+    ctx.strokeStyle = "#111";
+    ctx.lineWidth = 1.2;
+    ctx.fillRect((-sx / 2) * s, (-sy / 2) * s, sx * s, sy * s);
+    ctx.strokeRect((-sx / 2) * s, (-sy / 2) * s, sx * s, sy * s);
+    ctx.restore();
+    if (o.name && sx * s >= 24) {
+      ctx.font = `${Math.max(8, fontPx - 3)}px sans-serif`;
+      ctx.textAlign = "center";
+      ctx.textBaseline = "middle";
+      ctx.fillStyle = "#eceff1";
+      ctx.fillText(o.name, X(cx), Y(cy));
+    }
+    stats.obstacles++;
+  }
 
   const robotColor = new Map<string, string>();
   header.robots.forEach((r, i) => robotColor.set(r, kRobotColors[i % kRobotColors.length]));
@@ -104,7 +232,6 @@ export function drawField(
   });
 
   // Devices: footprint, lamps, name and type, lock holders.
-  const fontPx = Math.max(9, Math.min(13, s * 0.09));
   for (const d of header.devices) {
     const [cx, cy, depth, width, theta] = d.box;
     ctx.save();
@@ -165,11 +292,28 @@ export function drawField(
 
   // Pucks on the field (held ones are drawn with their robot).
   const held = new Set(poses.map((p) => p[6]).filter((id) => id > 0));
-  const pr = Math.max(2.5, header.puck_radius * s);
+  // Hackathon pucks are drawn a little larger so that their colour shows.
+  const pr = Math.max(hack ? 5.5 : 2.5, header.puck_radius * s);
+  const decoyColours = new Set((hack?.colours ?? []).filter((c) => c.decoy).map((c) => c.name));
+  const counted = new Set(state.rescue.pucks);
+  const look = (id: number): PuckLook => {
+    const colour = hack?.pucks?.[String(id)];
+    if (colour !== undefined) {
+      const fill = colourCss(colour);
+      return {fill, text: textOn(fill), decoy: decoyColours.has(colour), counted: counted.has(id)};
+    }
+    const st = state.pucks[id]?.state ?? "";
+    return {
+      fill: kPuckColors[st] ?? "#bbbbbb",
+      text: st === "CONSUMED" || st === "P2" || st === "P3" ? "#fff" : "#000",
+      decoy: false,
+      counted: false,
+    };
+  };
   for (const [idText, q] of Object.entries(state.pucks)) {
     const id = Number(idText);
     if (!q.on || held.has(id)) continue;
-    drawPuck(ctx, X(q.x), Y(q.y), pr, q.state, id, fontPx);
+    drawPuck(ctx, X(q.x), Y(q.y), pr, look(id), id, fontPx);
     stats.pucks++;
   }
 
@@ -208,7 +352,7 @@ export function drawField(
     if (heldId > 0) {
       const hx = X(x) + Math.cos(th) * (rr + pr * 0.6);
       const hy = Y(y) - Math.sin(th) * (rr + pr * 0.6);
-      drawPuck(ctx, hx, hy, pr, state.pucks[heldId]?.state ?? "", heldId, fontPx);
+      drawPuck(ctx, hx, hy, pr, look(heldId), heldId, fontPx);
     }
     // A radio drop from this robot in the last second: a red flash on its rim.
     if (rs && time - rs.dropT >= 0 && time - rs.dropT < 1) {
@@ -255,22 +399,41 @@ function drawPuck(
   x: number,
   y: number,
   r: number,
-  state: string,
+  look: PuckLook,
   id: number,
   fontPx: number,
 ): void {
+  if (look.counted) {
+    // In the safe area and scored: a ring, green (counts) or red (a decoy, costs points).
+    ctx.beginPath();
+    ctx.arc(x, y, r + 3, 0, 2 * Math.PI);
+    ctx.strokeStyle = look.decoy ? "#c62828" : "#2e7d32";
+    ctx.lineWidth = 2;
+    ctx.stroke();
+  }
   ctx.beginPath();
   ctx.arc(x, y, r, 0, 2 * Math.PI);
-  ctx.fillStyle = kPuckColors[state] ?? "#bbbbbb";
+  ctx.fillStyle = look.fill;
   ctx.fill();
   ctx.strokeStyle = "#333";
   ctx.lineWidth = 1;
   ctx.stroke();
-  if (r >= 5) {
+  if (look.decoy) {
+    // A decoy: an 'x' across it, reaching past its rim.
+    const k = r * 1.25;
+    ctx.strokeStyle = "#111";
+    ctx.lineWidth = 1.6;
+    ctx.beginPath();
+    ctx.moveTo(x - k, y - k);
+    ctx.lineTo(x + k, y + k);
+    ctx.moveTo(x - k, y + k);
+    ctx.lineTo(x + k, y - k);
+    ctx.stroke();
+  } else if (r >= 5) {
     ctx.font = `${Math.max(7, fontPx - 3)}px sans-serif`;
     ctx.textAlign = "center";
     ctx.textBaseline = "middle";
-    ctx.fillStyle = state === "CONSUMED" || state === "P2" || state === "P3" ? "#fff" : "#000";
+    ctx.fillStyle = look.text;
     ctx.fillText(String(id), x, y + 0.5);
   }
 }

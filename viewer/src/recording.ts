@@ -13,6 +13,22 @@ export interface DeviceInfo {
   box: [number, number, number, number, number];  // cx, cy, depth, width, theta
 }
 
+/// An extra static box of the world (`obstacles` in the header).
+export interface ObstacleInfo {
+  name: string;
+  box: [number, number, number, number, number];  // cx, cy, size_x, size_y, theta
+}
+
+/// The hackathon variant's task (`hackathon` in the header, docs/hackathon.md).
+export interface HackathonInfo {
+  safe_area: [number, number, number, number];  // x_min, y_min, x_max, y_max
+  safe_place: string;
+  colours: {name: string; decoy: boolean}[];
+  pucks: Record<string, string>;  // puck id -> colour name
+  points_per_puck: number;
+  decoy_penalty: number;
+}
+
 export interface Header {
   format: string;
   version: number;
@@ -26,6 +42,8 @@ export interface Header {
   robots: string[];
   robot_radius: number;
   puck_radius: number;
+  obstacles?: ObstacleInfo[];
+  hackathon?: HackathonInfo;
 }
 
 /// One line after the header: a frame (`f`) or an event (`e`), always with `t`.
@@ -79,11 +97,20 @@ export interface State {
   dropT: number;
   collisions: number;
   skillFailures: number;
+  /// The hackathon score as of the last `rescue` event (zero before the first one).
+  rescue: RescueState;
+}
+
+export interface RescueState {
+  points: number;
+  rescued: number;
+  decoys: number;
+  pucks: number[];  // ids in the safe area that count
 }
 
 export interface Marker {
   t: number;
-  kind: "award" | "failure" | "collision";
+  kind: "award" | "failure" | "collision" | "rescue";
   label: string;
 }
 
@@ -123,6 +150,7 @@ function emptyState(header: Header): State {
     dropT: -1e9,
     collisions: 0,
     skillFailures: 0,
+    rescue: {points: 0, rescued: 0, decoys: 0, pucks: []},
   };
 }
 
@@ -154,30 +182,31 @@ function apply(s: State, header: Header, line: Line): void {
       });
     }
     // `drops`: a number (radio copies dropped since the last frame), or per robot (an array in
-    // the header's robot order, or an object by robot name) when the recording says who sent.
+    // the header's robot order, or an object by robot name). `drops_from` names the senders of
+    // the number's copies (robots with drops only); the rest has no known sender.
     const drops = line.drops as unknown;
+    const addRobot = (name: unknown, n: unknown): number => {
+      const robot = robotOf(s, name);
+      if (!robot || typeof n !== "number" || n <= 0) return 0;
+      robot.drops += n;
+      robot.dropT = line.t;
+      return n;
+    };
     if (typeof drops === "number" && drops > 0) {
       s.drops += drops;
-      s.dropT = line.t;
+      let named = 0;
+      const from = line.drops_from as unknown;
+      if (from && typeof from === "object" && !Array.isArray(from)) {
+        for (const [name, n] of Object.entries(from as Record<string, unknown>)) {
+          named += addRobot(name, n);
+        }
+      }
+      if (drops > named) s.dropT = line.t;
     } else if (Array.isArray(drops)) {
-      drops.forEach((n, i) => {
-        const robot = robotOf(s, header.robots[i]);
-        if (robot && typeof n === "number" && n > 0) {
-          robot.drops += n;
-          robot.dropT = line.t;
-          s.drops += n;
-          s.dropT = line.t;
-        }
-      });
+      drops.forEach((n, i) => (s.drops += addRobot(header.robots[i], n)));
     } else if (drops && typeof drops === "object") {
-      for (const [name, n] of Object.entries(drops as Record<string, number>)) {
-        const robot = robotOf(s, name);
-        if (robot && n > 0) {
-          robot.drops += n;
-          robot.dropT = line.t;
-          s.drops += n;
-          s.dropT = line.t;
-        }
+      for (const [name, n] of Object.entries(drops as Record<string, unknown>)) {
+        s.drops += addRobot(name, n);
       }
     }
     return;
@@ -248,6 +277,14 @@ function apply(s: State, header: Header, line: Line): void {
       else robot.locks[line.resource] = line.to;
       break;
     }
+    case "rescue":
+      s.rescue = {
+        points: typeof line.points === "number" ? line.points : s.rescue.points,
+        rescued: typeof line.rescued === "number" ? line.rescued : s.rescue.rescued,
+        decoys: typeof line.decoys === "number" ? line.decoys : s.rescue.decoys,
+        pucks: Array.isArray(line.pucks) ? (line.pucks as number[]) : [],
+      };
+      break;
     case "path": {
       const robot = robotOf(s, line.robot);
       if (!robot) break;
@@ -284,6 +321,8 @@ export class Recording {
   readonly frameR: number[][][] = [];
   readonly markers: Marker[] = [];
   readonly phaseStarts: {t: number; phase: string}[] = [];
+  /// The hackathon score after each `rescue` event (for the timeline).
+  readonly rescueSteps: {t: number; points: number}[] = [];
   /// Incremented whenever lines were appended (the views redraw what depends on them).
   version = 0;
   private builder: State | null = null;
@@ -353,6 +392,17 @@ export class Recording {
         t: line.t,
         kind: "collision",
         label: `${line.kind}: ${line.robot}${line.other ? ` with ${line.other}` : ""}`,
+      });
+    } else if (line.e === "rescue") {
+      const prev = this.rescueSteps.length > 0 ? this.rescueSteps[this.rescueSteps.length - 1].points : 0;
+      const points = typeof line.points === "number" ? line.points : prev;
+      const d = points - prev;
+      this.rescueSteps.push({t: line.t, points});
+      this.markers.push({
+        t: line.t,
+        kind: "rescue",
+        label: `${d >= 0 ? "+" : ""}${d} rescue: ${points} points, ${line.rescued ?? 0} rescued, ` +
+          `${line.decoys ?? 0} decoys`,
       });
     } else if (line.e === "game" && line.phase && line.phase !== this.lastPhase) {
       this.lastPhase = line.phase;

@@ -6,7 +6,7 @@
 //   #/file/PATH   replay of /api/recordings/PATH
 //   #/live        the live game (WebSocket /api/live)
 // Test hook: window.llsfViewer (see Replay.hook); #app carries data-page and data-ready.
-import {drawField, kPuckColors, kRobotColors} from "./field";
+import {colourCss, drawField, kPuckColors, kRobotColors} from "./field";
 import {Cursor, Recording, type State} from "./recording";
 import {el, renderReport, table, type Child, type ReportData} from "./report_view";
 
@@ -42,6 +42,9 @@ interface ViewerHook {
   devicesDrawn(): number;
   robotsDrawn(): number;
   pucksDrawn(): number;
+  obstaclesDrawn(): number;
+  /// The hackathon score at the shown time (null outside the variant).
+  rescue(): {points: number; rescued: number; decoys: number; pucks: number[]} | null;
 }
 
 declare global {
@@ -162,7 +165,7 @@ class Replay {
   private lastWall = 0;
   private lastPanel = -1;
   private panelVersion = -1;
-  private lastStats = {devices: 0, robots: 0, pucks: 0};
+  private lastStats = {devices: 0, robots: 0, pucks: 0, obstacles: 0};
   private timelineCache: HTMLCanvasElement | null = null;
   private timelineKey = "";
   private fpsFrames = 0;
@@ -298,6 +301,12 @@ class Replay {
       devicesDrawn: () => this.lastStats.devices,
       robotsDrawn: () => this.lastStats.robots,
       pucksDrawn: () => this.lastStats.pucks,
+      obstaclesDrawn: () => this.lastStats.obstacles,
+      rescue: () => {
+        if (!this.rec.header?.hackathon) return null;
+        const st = this.cursor.at(this.time);
+        return st ? {...st.rescue, pucks: [...st.rescue.pucks]} : null;
+      },
     };
     // eslint-disable-next-line @typescript-eslint/no-this-alias
     const replay = this;
@@ -351,6 +360,7 @@ class Replay {
     this.lastStats = drawField(this.canvas, h, state, poses, this.time);
     this.canvas.setAttribute("data-devices", String(this.lastStats.devices));
     this.canvas.setAttribute("data-robots", String(this.lastStats.robots));
+    this.canvas.setAttribute("data-obstacles", String(this.lastStats.obstacles));
     this.timeLabel.textContent = `${fmtTime(this.time)} / ${fmtTime(this.rec.endTime)}`;
     this.timeLabel.setAttribute("data-time", this.time.toFixed(2));
     // The panel at most 8 times a second (DOM work), at once when forced or paused on a change.
@@ -398,21 +408,97 @@ class Replay {
         r && r.drops > 0 ? el("div", {class: "info"}, `radio drops: ${r.drops}`) : "",
       );
     });
-    this.panel.replaceChildren(
-      el(
-        "div",
-        {class: "game"},
-        el("div", {class: "big", "data-points": String(s.points)}, `${s.points} points`),
-        el("div", {}, `${s.phase || "–"} · ${s.gameState || "–"}`),
-        el("div", {}, `game time ${fmtTime(this.time)}`),
-        phases ? el("div", {class: "info"}, phases) : "",
-        el("div", {}, `delivery gate: ${gate ?? "–"}`),
+    // The hackathon (docs/hackathon.md): the rescue score leads; the refbox's parts (phase,
+    // points, delivery gate, orders) show only when the refbox plays (it stays in PRE_GAME by
+    // default, lamps and all).
+    const hack = h.hackathon;
+    const refbox = !hack || (s.phase !== "" && s.phase !== "PRE_GAME") || orders.length > 0;
+    const game: Child[] = [];
+    if (hack) {
+      const r = s.rescue;
+      const colourOf = hack.pucks ?? {};
+      const decoyNames = new Set((hack.colours ?? []).filter((c) => c.decoy).map((c) => c.name));
+      const countable = Object.values(colourOf).filter((c) => !decoyNames.has(c)).length;
+      game.push(
+        el(
+          "div",
+          {
+            class: "big",
+            "data-points": String(r.points),
+            "data-rescue": `${r.points}/${r.rescued}/${r.decoys}`,
+          },
+          `${r.points} points`,
+        ),
+        el(
+          "div",
+          {class: "rescue"},
+          `rescued ${r.rescued} of ${countable}`,
+          r.decoys > 0 ? el("span", {class: "failed"}, ` · decoys ${r.decoys}`) : " · decoys 0",
+          " in the safe area",
+        ),
         el(
           "div",
           {class: "info"},
-          `radio drops ${s.drops} · collisions ${s.collisions} · skill failures ${s.skillFailures}`,
+          `${hack.points_per_puck} per puck, −${hack.decoy_penalty} per decoy · ` +
+            `safe place ${hack.safe_place || "SAFE"}`,
         ),
+      );
+      if (refbox) {
+        game.push(el("div", {}, `refbox ${s.points} points · ${s.phase || "–"} · ${s.gameState || "–"}`));
+      }
+    } else {
+      game.push(
+        el("div", {class: "big", "data-points": String(s.points)}, `${s.points} points`),
+        el("div", {}, `${s.phase || "–"} · ${s.gameState || "–"}`),
+      );
+    }
+    game.push(el("div", {}, `game time ${fmtTime(this.time)}`));
+    if (phases) game.push(el("div", {class: "info"}, phases));
+    if (refbox) game.push(el("div", {}, `delivery gate: ${gate ?? "–"}`));
+    game.push(
+      el(
+        "div",
+        {class: "info"},
+        `radio drops ${s.drops} · collisions ${s.collisions} · skill failures ${s.skillFailures}`,
       ),
+    );
+    let legend: HTMLElement;
+    if (hack) {
+      // The colours: swatch (decoys crossed), name, pucks in the safe area (released there, as the
+      // last rescue event says) of all of that colour.
+      const inSafe = new Map<string, number>();
+      const total = new Map<string, number>();
+      for (const c of Object.values(hack.pucks ?? {})) {
+        total.set(c, (total.get(c) ?? 0) + 1);
+      }
+      for (const id of s.rescue.pucks) {
+        const c = hack.pucks?.[String(id)];
+        if (c !== undefined) inSafe.set(c, (inSafe.get(c) ?? 0) + 1);
+      }
+      legend = el(
+        "div",
+        {class: "legend colours", "data-legend": "colours"},
+        ...(hack.colours ?? []).map((c) =>
+          el(
+            "span",
+            {"data-colour": c.name, title: c.decoy ? "decoy: costs points in the safe area" : "counts"},
+            el("i", {class: c.decoy ? "decoy" : "", style: `background-color:${colourCss(c.name)}`}),
+            c.decoy ? `${c.name} (decoy)` : c.name,
+            ` ${inSafe.get(c.name) ?? 0}/${total.get(c.name) ?? 0} safe`,
+          ),
+        ),
+      );
+    } else {
+      legend = el(
+        "div",
+        {class: "legend"},
+        ...Object.entries(kPuckColors).map(([st, c]) =>
+          el("span", {}, el("i", {style: `background:${c}`}), st),
+        ),
+      );
+    }
+    this.panel.replaceChildren(
+      el("div", {class: "game"}, ...game),
       orders.length > 0
         ? table(
             ["order", "product", "delivered", "window (production)"],
@@ -424,15 +510,11 @@ class Replay {
             ]),
             {"data-table": "orders", class: "small"},
           )
-        : el("div", {class: "info"}, "no orders yet"),
+        : hack
+          ? ""
+          : el("div", {class: "info"}, "no orders yet"),
       ...robotRows,
-      el(
-        "div",
-        {class: "legend"},
-        ...Object.entries(kPuckColors).map(([st, c]) =>
-          el("span", {}, el("i", {style: `background:${c}`}), st),
-        ),
-      ),
+      legend,
     );
   }
 
@@ -515,8 +597,32 @@ class Replay {
         g.textAlign = "left";
         g.fillText(p.phase.toLowerCase(), x0 + 3, 2);
       });
-      const rows = {award: 0.35, failure: 0.6, collision: 0.85};
-      const colors = {award: "#2e7d32", failure: "#c0392b", collision: "#ef6c00"};
+      // The hackathon score as a step line (scaled to its range, 0 included).
+      const steps = this.rec.rescueSteps;
+      if (steps.length > 0) {
+        const lo = Math.min(0, ...steps.map((p) => p.points));
+        const hi = Math.max(1, ...steps.map((p) => p.points));
+        const yOf = (v: number) => hgt - 4 - ((v - lo) / (hi - lo)) * (hgt - 16);
+        g.strokeStyle = "rgba(0, 137, 123, 0.6)";
+        g.lineWidth = 1.5;
+        g.beginPath();
+        g.moveTo(this.timelineX(0), yOf(0));
+        let last = 0;
+        for (const p of steps) {
+          g.lineTo(this.timelineX(p.t), yOf(last));
+          g.lineTo(this.timelineX(p.t), yOf(p.points));
+          last = p.points;
+        }
+        g.lineTo(this.timelineX(this.rec.endTime), yOf(last));
+        g.stroke();
+        g.fillStyle = "#00695c";
+        g.font = "10px sans-serif";
+        g.textAlign = "right";
+        g.textBaseline = "top";
+        g.fillText(`rescue ${last} points`, w - 10, 2);
+      }
+      const rows = {award: 0.35, failure: 0.6, collision: 0.85, rescue: 0.35};
+      const colors = {award: "#2e7d32", failure: "#c0392b", collision: "#ef6c00", rescue: "#00897b"};
       for (const m of this.rec.markers) {
         const x = this.timelineX(m.t);
         g.strokeStyle = colors[m.kind];

@@ -91,6 +91,18 @@ struct PuckModelConfig {
   double restitution = 0.1;
 };
 
+/// A static box on the field that is not a device (the hackathon's boxes, a board put down for
+/// a test). Robots and pucks collide with it like with a wall; the laser sees it.
+struct ObstacleConfig {
+  std::string name;       ///< unique, non-empty ("box1")
+  Pose2D pose;            ///< centre; the heading is the direction of size_x_m
+  double size_x_m = 0.0;  ///< extent along the heading
+  double size_y_m = 0.0;  ///< extent across the heading
+
+  /// The box in field coordinates.
+  core::OrientedBox footprint() const { return {pose, Vec2(0.5 * size_x_m, 0.5 * size_y_m)}; }
+};
+
 /// A puck present at the start, with its RFID id.
 struct PuckPlacement {
   int id = 0;
@@ -206,6 +218,8 @@ struct PhysicsConfig {
 struct WorldConfig {
   FieldConfig field;
   std::array<DeviceConfig, kDeviceCount> devices{};
+  /// Extra static boxes (none on the 2013 field; sim's hackathon variant adds some).
+  std::vector<ObstacleConfig> obstacles;
   PuckModelConfig puck;
   std::vector<PuckPlacement> pucks;
   RobotModelConfig robot;

@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "llsf/core/geometry.h"
 #include "llsf/core/sim_time.h"
@@ -59,6 +60,24 @@ struct LightReading {
 /// A puck seen by the puck detection, in the robot frame (x forward, y left), metres.
 struct PuckSighting {
   core::Vec2 position{0.0, 0.0};
+};
+
+/// A puck seen by the hackathon's flashlight camera, in the robot frame (x forward, y left).
+struct ColourPuckSighting {
+  core::Vec2 position{0.0, 0.0};  ///< metres
+  double distance_m = 0.0;        ///< from the robot centre
+  double bearing_rad = 0.0;       ///< atan2(y, x): 0 straight ahead, positive to the left
+  std::string colour;             ///< "red", ... (may be wrong: the camera's false-colour rate)
+};
+
+/// What a rescue skill knows about the hackathon's task (docs/hackathon.md).
+struct RescueInfo {
+  core::Vec2 safe_lo{0.0, 0.0};  ///< the safe area [lo, hi] in the field frame, metres
+  core::Vec2 safe_hi{0.0, 0.0};
+  std::string safe_place;              ///< the navigator place in front of the safe area ("SAFE")
+  std::vector<std::string> counted;    ///< colours that score
+  std::vector<std::string> decoys;     ///< colours that cost points in the safe area
+  double held_puck_offset_m = 0.2225;  ///< robot centre to a held puck's centre
 };
 
 /// The two digital optical sensors at the holder's arm tips.
@@ -128,6 +147,11 @@ class RobotApi {
   virtual std::span<const PuckSighting> pucks() const = 0;
   /// The latest laser scan.
   virtual LaserView laser() const = 0;
+  /// The hackathon's colour camera (empty outside the hackathon variant), valid until the next
+  /// sensor update.
+  virtual std::span<const ColourPuckSighting> colour_pucks() const { return {}; }
+  /// The hackathon's task: safe area, its place, the colours; nullptr outside the variant.
+  virtual const RescueInfo* rescue() const { return nullptr; }
 
   /// A named place ("M3", "M3_left", "INS_2", ...); nullopt for unknown names.
   virtual std::optional<PlaceInfo> place(std::string_view name) const = 0;

@@ -10,6 +10,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <span>
@@ -125,6 +126,13 @@ class Game {
 
   GameSummary summary() const;
 
+  /// The hackathon variant's puck layout of this game (GameConfig::hackathon), or nullptr.
+  const HackathonLayout* hackathon_layout() const {
+    return hackathon_layout_ ? &*hackathon_layout_ : nullptr;
+  }
+  /// The hackathon score now (pucks released in the safe area), or nullopt outside the variant.
+  std::optional<HackathonScore> hackathon_score() const;
+
   /// Where a tick's time goes: steady-clock nanoseconds per tick step (1..9 of step()), summed
   /// over the ticks since profiling was enabled. For benchmarks; costs a few clock reads a tick.
   struct TickProfile {
@@ -182,6 +190,11 @@ class Game {
   std::vector<planner::DiscObstacle> discs_;
   std::vector<planner::DiscObstacle> others_;
   std::vector<core::Vec2> puck_positions_;
+  std::vector<int> puck_colours_;  // hackathon: colour index per entry of puck_positions_
+
+  // The hackathon variant.
+  std::optional<HackathonLayout> hackathon_layout_;
+  std::map<std::int32_t, int> puck_colour_by_id_;
   std::array<kinematic::SignalLights, kinematic::kDeviceCount> lights_{};
 
   // Counters.

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "llsf/comm/hub_config.h"
@@ -12,6 +13,7 @@
 #include "llsf/planner/config.h"
 #include "llsf/refbox/config.h"
 #include "llsf/refbox/protocol.h"
+#include "llsf/sim/hackathon.h"
 
 namespace llsf::sim {
 
@@ -118,6 +120,10 @@ struct GameConfig {
   SimTime beacon_period = SimTime::from_sec(1);
   /// Team name in the robots' beacons (empty: the refbox's team).
   std::string team;
+  /// The hackathon variant (docs/hackathon.md): when set, the Game adds its obstacles, replaces
+  /// the pucks by a coloured layout drawn from the seed, adds the safe place to the planner and
+  /// gives every robot the colour camera and the rescue interface.
+  std::optional<HackathonConfig> hackathon;
 
   /// Throws core::ConfigError "game.<field>: reason" for the first bad field (the world,
   /// refbox, protocol, hub and navigation configs are validated by their own validate()).

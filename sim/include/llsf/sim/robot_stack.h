@@ -36,6 +36,9 @@ struct RobotPercept {
   std::span<const kinematic::SignalLights> lights;
   /// Field positions of every puck on the field.
   std::span<const core::Vec2> pucks;
+  /// Hackathon: the colour (index into HackathonConfig::colours, -1 none) of each entry of
+  /// `pucks`; empty outside the variant.
+  std::span<const int> puck_colours;
 };
 
 /// Static description of a device for the light detection: its pose (heading = the facing, the
@@ -144,6 +147,10 @@ class RobotStack final : public lua::RobotApi {
   lua::LightReading light() const override { return light_; }
   std::span<const lua::PuckSighting> pucks() const override { return sightings_; }
   lua::LaserView laser() const override { return laser_; }
+  std::span<const lua::ColourPuckSighting> colour_pucks() const override {
+    return colour_sightings_;
+  }
+  const lua::RescueInfo* rescue() const override { return rescue_ ? &*rescue_ : nullptr; }
   std::optional<lua::PlaceInfo> place(std::string_view name) const override;
   bool symbolic() const override { return levels_.skill == SkillLevel::kSymbolic; }
   lua::TravelEstimate symbolic_travel(const core::Pose2D& goal) const override;
@@ -169,6 +176,7 @@ class RobotStack final : public lua::RobotApi {
   void sense_light(const RobotPercept& p);
   void sense_light_vision(const RobotPercept& p);
   void sense_pucks(const RobotPercept& p);
+  void sense_colour_pucks(const RobotPercept& p);
   /// The nearest device whose front is in front of `pose` (within the range and the heading
   /// cone, with the robot on the front's side); with `vision` the robot must also stand within
   /// the facing cone of the device. -1 if none.
@@ -228,6 +236,14 @@ class RobotStack final : public lua::RobotApi {
   std::vector<lua::PuckSighting> sightings_;
   std::vector<core::Vec2> scratch_;
   std::vector<int> cluster_;
+
+  // Hackathon: the colour camera and the task.
+  std::optional<ColourCameraConfig> camera_;
+  std::vector<std::string> colour_names_;
+  core::RandomStream colour_rng_;
+  SimTime colour_next_frame_;
+  std::vector<lua::ColourPuckSighting> colour_sightings_;
+  std::optional<lua::RescueInfo> rescue_;
 };
 
 }  // namespace llsf::sim

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -85,6 +86,8 @@ struct RunResult {
   std::vector<std::pair<std::string, double>> time_split;
   std::vector<RunAward> awards;  ///< every points award, in order
   std::string recording;         ///< RunHooks::record_path if the game was recorded
+  /// The hackathon score at the end (scenarios with `hackathon:` only).
+  std::optional<HackathonScore> hackathon;
   bool passed() const;
 };
 

@@ -45,6 +45,7 @@ enum class StartMode : std::uint8_t {
   kGame,         ///< SetGameState RUNNING in PRE_GAME: the refbox runs its phases
   kExploration,  ///< SetGamePhase EXPLORATION + RUNNING
   kProduction,   ///< SetGamePhase PRODUCTION + RUNNING
+  kNone,         ///< no command: the refbox stays in PRE_GAME (the hackathon's default)
 };
 
 /// A fully resolved scenario variant (one matrix cell).
@@ -73,6 +74,11 @@ struct ScenarioFile {
 /// file:line:column and the key for unknown keys, wrong types, impossible values, missing agent
 /// files or directories.
 ScenarioFile load_scenario(const std::string& path);
+
+/// Reads one scenario from a map with the keys of a scenario file (no `matrix`), e.g. a
+/// section of another YAML file (`llsfsim exercise`'s exercise.yaml); relative paths resolve
+/// against `file`'s directory. Throws core::ConfigError like load_scenario().
+Scenario read_scenario_map(const core::ConfigNode& root, const std::string& file);
 
 /// "points_at_least 30 by 720 s", for reports.
 std::string describe(const TestCase& t);
