@@ -336,10 +336,19 @@ void validate_robots(const WorldConfig& c) {
 
   const double r = m.radius_m;
   std::map<std::string, std::size_t> seen_names;
+  std::map<int, std::size_t> seen_jerseys;
   for (std::size_t i = 0; i < c.robots.size(); ++i) {
     const RobotStart& rs = c.robots[i];
     const std::string p = indexed("robots", i);
     if (rs.name.empty()) fail(p + ".name", "must not be empty");
+    if (rs.jersey < 0 || rs.jersey > 99) {
+      fail(p + ".jersey", "must be in 1..99, or 0 for the robot's index + 1 (got " +
+                              std::to_string(rs.jersey) + ")");
+    }
+    if (auto [it, fresh] = seen_jerseys.emplace(rs.jersey_or(static_cast<int>(i)), i); !fresh) {
+      fail(p + ".jersey", "duplicate jersey number " + std::to_string(it->first) +
+                              " (also worn by " + indexed("robots", it->second) + ")");
+    }
     if (auto [it, fresh] = seen_names.emplace(rs.name, i); !fresh) {
       fail(p + ".name", "duplicate robot name '" + rs.name + "' (also used by " +
                             indexed("robots", it->second) + ")");
@@ -651,7 +660,7 @@ class Loader {
     c.robots.clear();  // the list replaces the base's; null or [] means no robots
     if (list.is_null()) return;
     for (const ConfigNode& e : list.elements()) {
-      element(e, {"name", "x", "y", "ori", "ori_deg"}, "{name, x, y, ori_deg}");
+      element(e, {"name", "x", "y", "ori", "ori_deg", "jersey"}, "{name, x, y, ori_deg, jersey}");
       RobotStart r;
       r.name = e.at("name").as_string();
       remember(e.at("name"));
@@ -660,6 +669,7 @@ class Loader {
       read(e, "x", r.pose.x);
       read(e, "y", r.pose.y);
       read_orientation(e, r.pose.theta);
+      if (e["jersey"].defined()) read(e, "jersey", r.jersey);
       c.robots.push_back(std::move(r));
     }
   }

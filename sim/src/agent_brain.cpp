@@ -32,7 +32,7 @@ AgentBrain::AgentBrain(Game& game, int index, AgentBrainConfig config, clips::Lo
   const RobotStack& stack = game.robot(index);
   clips::AgentConfig ac;
   ac.robot_name = std::string(stack.name());
-  ac.robot_number = index + 1;
+  ac.robot_number = game.config().world.robots.at(static_cast<std::size_t>(index)).jersey_or(index);
   ac.team_name = !config.team.empty()          ? config.team
                  : !game.config().team.empty() ? game.config().team
                                                : game.config().refbox.team;

@@ -348,7 +348,8 @@ void Game::step() {
     b.set_seq(++beacon_seq_[static_cast<std::size_t>(i)]);
     b.set_team_name(config_.team.empty() ? config_.refbox.team : config_.team);
     b.set_peer_name(std::string(s.name()));
-    b.set_number(static_cast<std::uint32_t>(i + 1));
+    b.set_number(
+        static_cast<std::uint32_t>(config_.world.robots[static_cast<std::size_t>(i)].jersey_or(i)));
     const lua::PoseEstimate pe = s.pose();
     if (pe.valid) {
       llsf_msgs::Pose2D* p = b.mutable_pose();

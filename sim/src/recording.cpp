@@ -148,6 +148,11 @@ Recorder::Recorder(const std::string& path, const Game& game, const RecordingInf
     m.robot_names.emplace_back(game.robot(i).name());
     h += std::string(i ? ", " : "") + quote(game.robot(i).name());
   }
+  h += "], \"jerseys\": [";
+  for (int i = 0; i < game.robot_count(); ++i) {
+    h += std::string(i ? ", " : "") +
+         std::to_string(w.robots.at(static_cast<std::size_t>(i)).jersey_or(i));
+  }
   h += "], \"robot_radius\": " + num(w.robot.radius_m, 3) +
        ", \"puck_radius\": " + num(w.puck.radius_m, 4);
   // Extra obstacles and the hackathon's task (only when present; docs/recording.md).

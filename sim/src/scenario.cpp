@@ -189,7 +189,7 @@ void read_robots(const core::ConfigNode& n, const std::string& dir, Scenario& s)
     const core::ConfigNode r = each.at(i);
     if (r.is_null()) continue;
     r.require_map();
-    r.check_keys({"agent", "config", "name", "start"});
+    r.check_keys({"agent", "config", "name", "jersey", "start"});
     RobotSpec& spec = s.robots[static_cast<std::size_t>(i)];
     if (r["agent"].defined()) spec.agent = read_agent(r["agent"], dir);
     if (r["config"].defined()) {
@@ -198,6 +198,7 @@ void read_robots(const core::ConfigNode& n, const std::string& dir, Scenario& s)
     }
     kinematic::RobotStart& start = s.game.world.robots[static_cast<std::size_t>(i)];
     r.read("name", start.name);
+    r.read("jersey", start.jersey);
     if (r["start"].defined()) {
       const core::ConfigNode p = r["start"];
       p.require_map();

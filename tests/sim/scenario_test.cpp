@@ -8,6 +8,8 @@
 #include <string>
 
 #include "llsf/core/error.h"
+#include "llsf/sim/agent_brain.h"
+#include "llsf/sim/game.h"
 #include "llsf/sim/runner.h"
 #include "llsf/sim/scenario.h"
 
@@ -85,6 +87,35 @@ TEST_CASE("scenario errors name file, line and key") {
   CHECK(error_of(scenario_file("h.yaml", "name: [\n")).find("YAML syntax error") !=
         std::string::npos);
   CHECK(error_of("/no/such/file.yaml").find("cannot read") != std::string::npos);
+}
+
+TEST_CASE("jersey numbers: per robot in `each`, in the agent, the beacons and the recording") {
+  const ScenarioFile f = load_scenario(scenario_file(
+      "jersey.yaml", "name: j\nstart: production\nduration_s: 3\nrobots:\n  count: 2\n" + kAgent +
+                         "  each:\n    - {jersey: 7}\n    - {name: beta, jersey: 3}\n"));
+  const Scenario& s = f.variants[0];
+  CHECK(s.game.world.robots[0].jersey_or(0) == 7);
+  CHECK(s.game.world.robots[1].name == "beta");
+  Game game(s.game);
+  AgentBrainConfig c;
+  c.agent_files = s.robots[1].agent;
+  AgentBrain brain(game, 1, c);
+  brain.agent().start(SimTime{});  // (reset): the identity globals
+  CHECK(brain.agent().eval("?*ROBOT-NUMBER*").number() == doctest::Approx(3.0));
+  std::string header;
+  RunHooks hooks;
+  hooks.record_sink = [&](std::string_view line) {
+    if (header.empty()) header = line;
+  };
+  run_game(s, 1, hooks);
+  CHECK(header.find("\"jerseys\": [7, 3]") != std::string::npos);
+  // Unique; 1..99.
+  std::string e = error_of(
+      scenario_file("jersey2.yaml", "name: j\nrobots:\n  count: 2\n  each:\n    - {jersey: 2}\n"));
+  CHECK(e.find("duplicate jersey number 2") != std::string::npos);
+  e = error_of(scenario_file("jersey3.yaml",
+                             "name: j\nrobots:\n  count: 1\n  each:\n    - {jersey: 120}\n"));
+  CHECK(e.find("must be in 1..99") != std::string::npos);
 }
 
 TEST_CASE("run_game: a short production game, verdicts judged at their deadline, same hash") {

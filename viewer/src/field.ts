@@ -371,7 +371,8 @@ export function drawField(
     ctx.textAlign = "center";
     ctx.textBaseline = "bottom";
     ctx.fillStyle = color;
-    ctx.fillText(name, X(x), Y(y) - rr - 2);
+    const jersey = header.jerseys?.[i];
+    ctx.fillText(jersey !== undefined ? `${name} #${jersey}` : name, X(x), Y(y) - rr - 2);
     if (rs && rs.skill) {
       const short = rs.skill.length > 34 ? rs.skill.slice(0, 33) + "…" : rs.skill;
       ctx.font = `${fontPx - 1}px sans-serif`;

@@ -40,6 +40,8 @@ export interface Header {
   field: {width: number; height: number};
   devices: DeviceInfo[];
   robots: string[];
+  /// Jersey numbers, in the order of `robots` (recordings before they were added have none).
+  jerseys?: number[];
   robot_radius: number;
   puck_radius: number;
   obstacles?: ObstacleInfo[];

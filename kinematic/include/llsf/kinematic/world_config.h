@@ -142,6 +142,9 @@ struct RobotModelConfig {
 struct RobotStart {
   std::string name;
   Pose2D pose;
+  /// Jersey number (the beacons' `number`, the agent's ?*ROBOT-NUMBER*); 0: its index + 1.
+  int jersey = 0;
+  int jersey_or(int index) const { return jersey > 0 ? jersey : index + 1; }
 };
 
 /// Wheel odometry: integrates the commanded wheel motion (so it keeps counting while the robot
