@@ -40,6 +40,10 @@ interface ViewerHook {
   seek(t: number): void;
   play(on: boolean): void;
   devicesDrawn(): number;
+  /// Field renders so far (frames per second = its growth over wall time; bench/viewer_replay.mjs).
+  framesDrawn(): number;
+  /// Replay speed (0.25 .. 64 in the page's selector; any positive factor here).
+  setSpeed(x: number): void;
   robotsDrawn(): number;
   pucksDrawn(): number;
   obstaclesDrawn(): number;
@@ -166,6 +170,7 @@ class Replay {
   private lastPanel = -1;
   private panelVersion = -1;
   private lastStats = {devices: 0, robots: 0, pucks: 0, obstacles: 0};
+  private framesDrawn = 0;
   private timelineCache: HTMLCanvasElement | null = null;
   private timelineKey = "";
   private fpsFrames = 0;
@@ -299,6 +304,10 @@ class Replay {
       },
       play: (on: boolean) => this.setPlaying(on),
       devicesDrawn: () => this.lastStats.devices,
+      framesDrawn: () => this.framesDrawn,
+      setSpeed: (x: number) => {
+        this.speed = x;
+      },
       robotsDrawn: () => this.lastStats.robots,
       pucksDrawn: () => this.lastStats.pucks,
       obstaclesDrawn: () => this.lastStats.obstacles,
@@ -358,6 +367,7 @@ class Replay {
     if (!state) return;
     const poses = this.rec.posesAt(this.time);
     this.lastStats = drawField(this.canvas, h, state, poses, this.time);
+    ++this.framesDrawn;
     this.canvas.setAttribute("data-devices", String(this.lastStats.devices));
     this.canvas.setAttribute("data-robots", String(this.lastStats.robots));
     this.canvas.setAttribute("data-obstacles", String(this.lastStats.obstacles));
