@@ -46,6 +46,11 @@ int run(std::span<const std::string> args, std::ostream& out, std::ostream& err)
   }
   {
     CLI::App* sub = app.add_subcommand(
+        "exercise", "Play a hackathon exercise with your skill; print progress, score, PASS/FAIL");
+    commands.emplace_back(sub, add_exercise_command(*sub));
+  }
+  {
+    CLI::App* sub = app.add_subcommand(
         "serve", "Serve the browser viewer, stored batches and recordings over HTTP");
     commands.emplace_back(sub, add_serve_command(*sub));
   }

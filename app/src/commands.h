@@ -31,6 +31,8 @@ Action add_batch_command(CLI::App& app);
 Action add_report_command(CLI::App& app);
 /// `llsfsim check`: validate scenarios and their agent/skill files without playing.
 Action add_check_command(CLI::App& app);
+/// `llsfsim exercise`: a hackathon exercise (exercises/) played with the participant's skill.
+Action add_exercise_command(CLI::App& app);
 /// `llsfsim serve`: the browser viewer's HTTP/WebSocket server (server.h) until SIGINT/SIGTERM.
 Action add_serve_command(CLI::App& app);
 
