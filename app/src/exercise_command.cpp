@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "live.h"
 #include "llsf/app/cli.h"
 #include "llsf/core/config.h"
 #include "llsf/core/error.h"
@@ -336,11 +337,7 @@ struct ExerciseOptions {
   std::string skill_file;
   std::optional<std::uint64_t> seed;
   std::string root;
-  double speed = 0.0;
-  bool realtime = false;
-  bool serve = false;
-  int port = 8080;
-  bool serve_exit = false;
+  LiveOptions live;  ///< --speed, --realtime, --serve, --port, --serve-exit
   std::string record;
   bool quiet = false;
   bool list = false;
@@ -448,25 +445,19 @@ int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err)
   // Recording (--record, --serve) and the live viewer.
   LiveFeed feed;
   std::unique_ptr<Server> server;
-  if (o.serve) {
+  try {
     ServerOptions so;
-    so.port = o.port;
     so.db = "";
     so.recordings = default_recordings_dir(std::string(sim::StatsStore::kDefaultPath));
-    try {
-      server = std::make_unique<Server>(so, &feed);
-    } catch (const std::runtime_error& e) {
-      err << "llsfsim exercise: " << e.what() << "\n";
-      return kExitBadInput;
-    }
-    server->start();
-    out << "llsfsim serve: " << server->url() << "  (watch: " << server->url() << "#/live)"
-        << std::endl;
+    server = start_live_server(o.live, so, feed, out);
+  } catch (const std::runtime_error& e) {
+    err << "llsfsim exercise: " << e.what() << "\n";
+    return kExitBadInput;
   }
   std::unique_ptr<sim::Recorder> recorder;
-  if (o.serve || !o.record.empty()) {
+  if (o.live.serve || !o.record.empty()) {
     sim::LineSink sink;
-    if (o.serve) sink = [&feed](std::string_view line) { feed.publish(line); };
+    if (o.live.serve) sink = [&feed](std::string_view line) { feed.publish(line); };
     try {
       recorder = std::make_unique<sim::Recorder>(
           o.record, game, sim::RecordingInfo{ex.name, "", seed, "0.1.0"}, 10.0, sink);
@@ -502,8 +493,7 @@ int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err)
   }
 
   // Paced mode (the wall clock only paces the loop; it never enters the game).
-  const double speed = o.realtime ? 1.0 : o.speed;
-  const auto wall_start = std::chrono::steady_clock::now();
+  const Pacer pacer(o.live.pace());
 
   // Score so far, for progress lines and the verdict.
   auto robot_pose = [&](int i) {
@@ -540,11 +530,7 @@ int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err)
   while (game.time() < end) {
     game.step();
     if (recorder) recorder->frame(game);
-    if (speed > 0.0) {
-      std::this_thread::sleep_until(
-          wall_start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                           std::chrono::duration<double>(game.time().seconds() / speed)));
-    }
+    pacer.wait(game.time().seconds());
     bool running = false;
     for (std::size_t i = 0; i < brains.size(); ++i) {
       lua::SkillEngine& e = brains[i]->engine();
@@ -661,10 +647,7 @@ int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err)
   out << "score    " << score << "\n";
   if (!why_not.empty()) out << "why      " << why_not << "\n";
   out << "result   " << (passed ? "PASS" : "FAIL") << "\n";
-  if (server && !o.serve_exit) {
-    out << "game over; serving until Ctrl-C" << std::endl;
-    wait_for_stop_signal();
-  }
+  serve_until_stopped(o.live, server, out);
   return passed ? kExitOk : kExitFailed;
 }
 
@@ -682,20 +665,9 @@ Action add_exercise_command(CLI::App& app) {
   app.add_option("--exercises", o->root,
                  "Where the exercises are (default: $LLSF_EXERCISES_DIR, else exercises/ of the "
                  "source tree)");
-  auto* speed = app.add_option("--speed", o->speed,
-                               "Paced: play X game seconds per wall-clock second (e.g. 4)")
-                    ->check(CLI::PositiveNumber);
-  app.add_flag("--realtime", o->realtime, "Paced at real time (= --speed 1)")->excludes(speed);
-  auto* serve = app.add_flag("--serve", o->serve,
-                             "Serve the browser viewer with the game live at "
-                             "http://127.0.0.1:PORT/#/live (best with --realtime or --speed)");
-  app.add_option("--port", o->port, "With --serve: the port (0: any free port)")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 65535))
-      ->needs(serve);
-  app.add_flag("--serve-exit", o->serve_exit,
-               "With --serve: exit when the game ends (default: serve on until Ctrl-C)")
-      ->needs(serve);
+  add_live_options(app, o->live,
+                   "Serve the browser viewer with the game live at http://127.0.0.1:PORT/#/live "
+                   "(best with --realtime or --speed)");
   app.add_option("--record", o->record,
                  "Also write the game's recording to FILE (gzip JSON lines)");
   app.add_flag("-q,--quiet", o->quiet, "Only the score, errors and the verdict");

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "live.h"
 #include "llsf/app/cli.h"
 #include "llsf/clips/agent.h"
 #include "llsf/core/error.h"
@@ -40,11 +41,7 @@ struct RunOptions {
   bool no_db = false;
   std::string record;  ///< "" = default_recordings_dir(db)/recording_file_name(...)
   bool no_record = false;
-  double speed = 0.0;  ///< 0: as fast as possible; else game seconds per wall second
-  bool realtime = false;
-  bool serve = false;  ///< serve the viewer with the game live (server.h)
-  int port = 8080;
-  bool serve_exit = false;  ///< with serve: exit when the game ends instead of serving on
+  LiveOptions live;  ///< --speed, --realtime, --serve, --port, --serve-exit
 };
 
 const sim::Scenario* pick_variant(const sim::ScenarioFile& f, const std::string& name,
@@ -146,34 +143,25 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
   }
   // Paced mode: sleep between ticks so that game time runs `speed` times as fast as the wall
   // clock (the wall clock only paces; it never enters the game).
-  const double speed = o.realtime ? 1.0 : o.speed;
-  if (speed > 0.0) {
-    const auto wall_start = std::chrono::steady_clock::now();
-    hooks.tick = [speed, wall_start](const sim::Game& g) {
-      const auto due = wall_start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                        std::chrono::duration<double>(g.time().seconds() / speed));
-      std::this_thread::sleep_until(due);
+  if (o.live.pace() > 0.0) {
+    hooks.tick = [pacer = Pacer(o.live.pace())](const sim::Game& g) {
+      pacer.wait(g.time().seconds());
     };
   }
   // --serve: the viewer's server on a background thread, fed every recording line.
   std::ostream& note = o.json ? err : out;  // keep --json's stdout one JSON object
   LiveFeed feed;
   std::unique_ptr<Server> server;
-  if (o.serve) {
+  try {
     ServerOptions so;
-    so.port = o.port;
     so.db = o.no_db ? "" : o.db;
     so.recordings = default_recordings_dir(o.db);
-    try {
-      server = std::make_unique<Server>(so, &feed);
-    } catch (const std::runtime_error& e) {
-      err << "llsfsim run: " << e.what() << "\n";
-      return kExitBadInput;
-    }
-    server->start();
-    note << "llsfsim serve: " << server->url() << std::endl;
-    hooks.record_sink = [&feed](std::string_view line) { feed.publish(line); };
+    server = start_live_server(o.live, so, feed, note);
+  } catch (const std::runtime_error& e) {
+    err << "llsfsim run: " << e.what() << "\n";
+    return kExitBadInput;
   }
+  if (server) hooks.record_sink = [&feed](std::string_view line) { feed.publish(line); };
   const bool tty = isatty(STDERR_FILENO) != 0 && !o.quiet && !o.json;
   if (tty) {
     hooks.progress_every = core::SimTime::from_sec(10);
@@ -217,10 +205,7 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
     if (!r.recording.empty()) out << fmt::format("recording  {}\n", r.recording);
     if (!stored_as.empty()) out << fmt::format("database   {}\n", stored_as);
   }
-  if (server && !o.serve_exit) {
-    note << "game over; serving until Ctrl-C" << std::endl;
-    wait_for_stop_signal();
-  }
+  serve_until_stopped(o.live, server, note);
   return r.passed() ? kExitOk : kExitFailed;
 }
 
@@ -274,26 +259,15 @@ Action add_run_command(CLI::App& app) {
                             "Statistics store (SQLite) the run is written to (docs/statistics.md)")
                  ->capture_default_str();
   app.add_flag("--no-db", o->no_db, "Do not write the run to a statistics store")->excludes(db);
-  auto* speed = app.add_option("--speed", o->speed,
-                               "Paced: play X game seconds per wall-clock second (e.g. 4)")
-                    ->check(CLI::PositiveNumber);
-  app.add_flag("--realtime", o->realtime, "Paced at real time (= --speed 1)")->excludes(speed);
   auto* record =
       app.add_option("--record", o->record,
                      "Write the recording to FILE (gzip JSON lines, docs/recording.md; default: "
                      "llsfsim-recordings/<scenario>[-<variant>]-seed<N>.jsonl.gz, beside the --db "
                      "file and named after it)");
   app.add_flag("--no-record", o->no_record, "Do not record the game")->excludes(record);
-  auto* serve = app.add_flag("--serve", o->serve,
-                             "Serve the browser viewer with this game live (like `llsfsim serve`; "
-                             "best with --speed or --realtime)");
-  app.add_option("--port", o->port, "With --serve: the port (0: any free port)")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 65535))
-      ->needs(serve);
-  app.add_flag("--serve-exit", o->serve_exit,
-               "With --serve: exit when the game ends (default: serve on until Ctrl-C)")
-      ->needs(serve);
+  add_live_options(app, o->live,
+                   "Serve the browser viewer with this game live (like `llsfsim serve`; best with "
+                   "--speed or --realtime)");
   app.footer(
       "Plays one game headless and prints a summary and the test-case verdicts; stores the run "
       "in the statistics store (--db, default llsfsim.db; the latest game of each variant and "
