@@ -21,6 +21,7 @@ const sourceDir = resolve(dirname(fileURLToPath(import.meta.url)), "..");
 const viewerDir = join(sourceDir, "viewer");
 const llsfsim = resolve(process.argv[2] ?? join(sourceDir, "build", "release", "llsfsim"));
 const {chromium} = await import(join(viewerDir, "node_modules", "playwright-core", "index.mjs"));
+const {launch} = await import(join(viewerDir, "tests", "e2e_lib.mjs"));
 
 function report(metric, value, unit) {
   console.log(JSON.stringify({bench: "viewer_replay", metric, value: Number(value.toPrecision(6)), unit}));
@@ -52,11 +53,7 @@ try {
     });
     server.on("exit", (code) => fail(new Error(`llsfsim serve exited (${code})`)));
   });
-  browser = await chromium.launch({
-    executablePath: "/usr/bin/chromium",
-    args: ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-           "--disable-background-networking", "--disable-component-update", "--disable-sync"],
-  });
+  browser = await launch(chromium);
   const page = await browser.newPage({viewport: {width: 1280, height: 860}});
   const t0 = Date.now();
   await page.goto(`${url}#/file/default-seed1.jsonl.gz`);

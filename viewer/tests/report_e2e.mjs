@@ -9,51 +9,15 @@
 // two per variant in the per-phase plot, the tables. Saves a screenshot (and the page) to
 // ARTIFACT_DIR (default: the current directory). Exit code 0, or 1 with a message.
 import {execFileSync} from "node:child_process";
-import {copyFileSync, existsSync, mkdirSync, mkdtempSync, rmSync, writeFileSync} from "node:fs";
+import {copyFileSync, mkdirSync, mkdtempSync, rmSync, writeFileSync} from "node:fs";
 import {tmpdir} from "node:os";
-import {dirname, join, resolve} from "node:path";
-import {fileURLToPath, pathToFileURL} from "node:url";
+import {join} from "node:path";
+import {pathToFileURL} from "node:url";
+
+import {check, launch, prerequisites, sourceDir, viewerDir} from "./e2e_lib.mjs";
 
 const kName = "viewer_report_e2e";
-const viewerDir = resolve(dirname(fileURLToPath(import.meta.url)), "..");
-const sourceDir = resolve(viewerDir, "..");
-const chromiumPath = process.env.LLSF_CHROMIUM ?? "/usr/bin/chromium";
-const chromiumArgs = [
-  "--headless",
-  "--no-sandbox",
-  "--disable-gpu",
-  "--disable-quic",
-  "--no-first-run",
-  "--disable-background-networking",
-  "--disable-component-update",
-  "--disable-sync",
-];
-
-function fail(message) {
-  console.error(`${kName}: FAIL: ${message}`);
-  process.exit(1);
-}
-
-function check(condition, message) {
-  if (!condition) throw new Error(message);
-}
-
-// Arguments and prerequisites, each with the command that provides it.
-const [llsfsimArg, artifactArg] = process.argv.slice(2);
-if (!llsfsimArg) fail("usage: node report_e2e.mjs LLSFSIM [ARTIFACT_DIR]");
-const llsfsim = resolve(llsfsimArg);
-const artifacts = resolve(artifactArg ?? ".");
-if (!existsSync(llsfsim)) fail(`no llsfsim binary at ${llsfsim}`);
-if (!existsSync(join(viewerDir, "node_modules", "playwright-core"))) {
-  fail("viewer/node_modules is missing: run `make viewer` (scripts/build-viewer)");
-}
-if (!existsSync(join(viewerDir, "dist", "report.js"))) {
-  fail("viewer/dist/report.js is missing: run `make viewer` (scripts/build-viewer)");
-}
-if (!existsSync(chromiumPath)) {
-  fail(`no Chromium at ${chromiumPath}: run scripts/install-deps (Debian package chromium)`);
-}
-const {chromium} = await import("playwright-core");
+const {llsfsim, artifacts, chromium} = await prerequisites(kName, "report_e2e.mjs", ["report.js"]);
 
 // A short game: 60 s exploration + 240 s production, two robots with the 2013 team agent.
 const agents = join(sourceDir, "clips", "agents");
@@ -93,12 +57,7 @@ try {
   copyFileSync(join(tmp, "report.html"), join(artifacts, "report.html"));
 
   // The page in Chromium: nothing but file:// is loaded.
-  browser = await chromium.launch({
-    executablePath: chromiumPath,
-    headless: true,
-    args: chromiumArgs,
-    timeout: 60_000,
-  });
+  browser = await launch(chromium);
   const page = await browser.newPage({viewport: {width: 1100, height: 900}});
   const errors = [];
   page.on("pageerror", (e) => errors.push(`page error: ${e.message}`));

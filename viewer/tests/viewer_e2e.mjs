@@ -14,52 +14,14 @@
 // Screenshots go to ARTIFACT_DIR (default: the current directory). Exit code 0, or 1 with a
 // message. LLSF_CHROMIUM names another Chromium binary.
 import {execFileSync, spawn} from "node:child_process";
-import {existsSync, mkdirSync, mkdtempSync, rmSync, writeFileSync} from "node:fs";
+import {mkdirSync, mkdtempSync, rmSync, writeFileSync} from "node:fs";
 import {tmpdir} from "node:os";
-import {dirname, join, resolve} from "node:path";
-import {fileURLToPath} from "node:url";
+import {join} from "node:path";
+
+import {check, launch, prerequisites, sourceDir, viewerDir} from "./e2e_lib.mjs";
 
 const kName = "viewer_e2e";
-const viewerDir = resolve(dirname(fileURLToPath(import.meta.url)), "..");
-const sourceDir = resolve(viewerDir, "..");
-const chromiumPath = process.env.LLSF_CHROMIUM ?? "/usr/bin/chromium";
-const chromiumArgs = [
-  "--headless",
-  "--no-sandbox",
-  "--disable-gpu",
-  "--disable-quic",
-  "--no-first-run",
-  "--disable-background-networking",
-  "--disable-component-update",
-  "--disable-sync",
-];
-
-function fail(message) {
-  console.error(`${kName}: FAIL: ${message}`);
-  process.exit(1);
-}
-
-function check(condition, message) {
-  if (!condition) throw new Error(message);
-}
-
-const [llsfsimArg, artifactArg] = process.argv.slice(2);
-if (!llsfsimArg) fail("usage: node viewer_e2e.mjs LLSFSIM [ARTIFACT_DIR]");
-const llsfsim = resolve(llsfsimArg);
-const artifacts = resolve(artifactArg ?? ".");
-if (!existsSync(llsfsim)) fail(`no llsfsim binary at ${llsfsim}`);
-if (!existsSync(join(viewerDir, "node_modules", "playwright-core"))) {
-  fail("viewer/node_modules is missing: run `make viewer` (scripts/build-viewer)");
-}
-for (const f of ["index.html", "viewer.js"]) {
-  if (!existsSync(join(viewerDir, "dist", f))) {
-    fail(`viewer/dist/${f} is missing: run \`make viewer\` (scripts/build-viewer)`);
-  }
-}
-if (!existsSync(chromiumPath)) {
-  fail(`no Chromium at ${chromiumPath}: run scripts/install-deps (Debian package chromium)`);
-}
-const {chromium} = await import("playwright-core");
+const {llsfsim, artifacts, chromium} = await prerequisites(kName, "viewer_e2e.mjs", ["index.html", "viewer.js"]);
 
 // A short game: 30 s exploration + 60 s production, two robots with the 2013 team agent.
 const agents = join(sourceDir, "clips", "agents");
@@ -154,12 +116,7 @@ try {
   const run = runs.find((r) => r.recording);
   check(run, `no run of batch ${batch.id} has a recording`);
 
-  browser = await chromium.launch({
-    executablePath: chromiumPath,
-    headless: true,
-    args: chromiumArgs,
-    timeout: 60_000,
-  });
+  browser = await launch(chromium);
   const page = await browser.newPage({viewport: {width: 1280, height: 860}});
   const errors = [];
   page.on("pageerror", (e) => errors.push(`page error: ${e.message}`));

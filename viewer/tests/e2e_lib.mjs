@@ -1,0 +1,69 @@
+// SPDX-License-Identifier: MIT
+// What the browser tests (report_e2e.mjs, viewer_e2e.mjs) and bench/viewer_replay.mjs share:
+// the paths, the prerequisites with the command that provides each, and Chromium's launch.
+import {existsSync} from "node:fs";
+import {dirname, join, resolve} from "node:path";
+import {fileURLToPath} from "node:url";
+
+export const viewerDir = resolve(dirname(fileURLToPath(import.meta.url)), "..");
+export const sourceDir = resolve(viewerDir, "..");
+/// Debian's chromium (scripts/install-deps); LLSF_CHROMIUM names another binary.
+export const chromiumPath = process.env.LLSF_CHROMIUM ?? "/usr/bin/chromium";
+/// Headless, and nothing that reaches for the network (this machine's network is closed).
+export const chromiumArgs = [
+  "--headless",
+  "--no-sandbox",
+  "--disable-gpu",
+  "--disable-quic",
+  "--no-first-run",
+  "--disable-background-networking",
+  "--disable-component-update",
+  "--disable-sync",
+];
+
+/// fail(message): prints "NAME: FAIL: message" and exits 1.
+export function failer(name) {
+  return (message) => {
+    console.error(`${name}: FAIL: ${message}`);
+    process.exit(1);
+  };
+}
+
+export function check(condition, message) {
+  if (!condition) throw new Error(message);
+}
+
+/// Checks the arguments (LLSFSIM [ARTIFACT_DIR]) and that the built viewer files `dist`,
+/// playwright-core and Chromium are there; returns {llsfsim, artifacts, chromium} (chromium:
+/// playwright-core's browser type). Fails with the command to run otherwise.
+export async function prerequisites(name, script, dist) {
+  const fail = failer(name);
+  const [llsfsimArg, artifactArg] = process.argv.slice(2);
+  if (!llsfsimArg) fail(`usage: node ${script} LLSFSIM [ARTIFACT_DIR]`);
+  const llsfsim = resolve(llsfsimArg);
+  const artifacts = resolve(artifactArg ?? ".");
+  if (!existsSync(llsfsim)) fail(`no llsfsim binary at ${llsfsim}`);
+  if (!existsSync(join(viewerDir, "node_modules", "playwright-core"))) {
+    fail("viewer/node_modules is missing: run `make viewer` (scripts/build-viewer)");
+  }
+  for (const f of dist) {
+    if (!existsSync(join(viewerDir, "dist", f))) {
+      fail(`viewer/dist/${f} is missing: run \`make viewer\` (scripts/build-viewer)`);
+    }
+  }
+  if (!existsSync(chromiumPath)) {
+    fail(`no Chromium at ${chromiumPath}: run scripts/install-deps (Debian package chromium)`);
+  }
+  const {chromium} = await import(join(viewerDir, "node_modules", "playwright-core", "index.mjs"));
+  return {llsfsim, artifacts, chromium};
+}
+
+/// Headless Chromium (playwright-core's `chromium` browser type).
+export function launch(chromium) {
+  return chromium.launch({
+    executablePath: chromiumPath,
+    headless: true,
+    args: chromiumArgs,
+    timeout: 60_000,
+  });
+}
