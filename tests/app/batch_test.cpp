@@ -19,6 +19,7 @@
 #include "llsf/sim/batch.h"
 #include "llsf/sim/scenario.h"
 #include "llsf/sim/stats_store.h"
+#include "support/temp_dir.h"
 
 namespace {
 
@@ -28,19 +29,7 @@ using llsf::test::has;
 using llsf::test::llsfsim;
 using llsf::test::Run;
 
-/// A fresh directory, removed with everything in it at the end of the test.
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    static int counter = 0;
-    path = fs::temp_directory_path() /
-           ("llsf_batch_test_" + std::to_string(getpid()) + "_" + std::to_string(counter++));
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() { fs::remove_all(path); }
-  std::string file(const std::string& name) const { return (path / name).string(); }
-};
+using llsf::test::TempDir;
 
 /// A tiny scenario: 120 s of production (a few points each), two robots with the 2013 team agent, 2
 /// variants x 2 seeds. `tests` is the YAML of the test cases.

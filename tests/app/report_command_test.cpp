@@ -11,6 +11,7 @@
 
 #include "app/cli_fixture.h"
 #include "llsf/sim/stats_store.h"
+#include "support/temp_dir.h"
 
 namespace {
 
@@ -20,19 +21,7 @@ using llsf::test::has;
 using llsf::test::llsfsim;
 using llsf::test::Run;
 
-/// A fresh directory, removed with everything in it at the end of the test.
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    static int counter = 0;
-    path = fs::temp_directory_path() / ("llsf_report_command_test_" + std::to_string(getpid()) +
-                                        "_" + std::to_string(counter++));
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() { fs::remove_all(path); }
-  std::string file(const std::string& name) const { return (path / name).string(); }
-};
+using llsf::test::TempDir;
 
 /// A store with one batch of 2 variants x 2 runs (written directly: no game is played).
 std::string make_store(const TempDir& dir) {

@@ -26,6 +26,7 @@
 #include "llsf/sim/batch.h"
 #include "llsf/sim/scenario.h"
 #include "llsf/sim/stats_store.h"
+#include "support/temp_dir.h"
 
 namespace {
 
@@ -37,18 +38,7 @@ namespace websocket = beast::websocket;
 using tcp = asio::ip::tcp;
 using json = nlohmann::json;
 
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    static int counter = 0;
-    path = fs::temp_directory_path() /
-           ("llsf_server_test_" + std::to_string(getpid()) + "_" + std::to_string(counter++));
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() { fs::remove_all(path); }
-  std::string file(const std::string& name) const { return (path / name).string(); }
-};
+using llsf::test::TempDir;
 
 void write(const std::string& path, const std::string& text) {
   fs::create_directories(fs::path(path).parent_path());

@@ -10,6 +10,7 @@
 
 #include "llsf/core/error.h"
 #include "lua/fake_robot.h"
+#include "support/temp_dir.h"
 
 using namespace llsf;
 using lua::SkillStatus;
@@ -49,18 +50,7 @@ std::string load_error_of(const lua::SkillEngine& engine, const std::string& nam
 }
 
 // A scratch skill directory, removed at the end of the test.
-struct TempDir {
-  std::filesystem::path path;
-  TempDir() {
-    path = std::filesystem::temp_directory_path() / ("llsf_lua_test_" + std::to_string(::getpid()));
-    std::filesystem::remove_all(path);
-    std::filesystem::create_directories(path);
-  }
-  ~TempDir() { std::filesystem::remove_all(path); }
-  void write(const std::string& file, const std::string& text) const {
-    std::ofstream(path / file, std::ios::trunc) << text;
-  }
-};
+using llsf::test::TempDir;
 
 std::string hello_skill(const std::string& greeting) {
   return "name = 'hot'\n"

@@ -13,17 +13,17 @@
 #include "llsf/sim/recording.h"
 #include "llsf/sim/runner.h"
 #include "llsf/sim/scenario.h"
+#include "support/temp_dir.h"
 
 using namespace llsf;
 using namespace llsf::sim;
 
 namespace {
 
+// One directory for the binary's run, removed at exit.
 std::filesystem::path temp_dir() {
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("llsf_recording_test_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  return dir;
+  static const llsf::test::TempDir dir("llsf_recording_test");
+  return dir.path;
 }
 
 }  // namespace

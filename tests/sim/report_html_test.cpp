@@ -14,6 +14,7 @@
 
 #include "llsf/sim/report.h"
 #include "llsf/sim/stats_store.h"
+#include "support/temp_dir.h"
 
 using namespace llsf;
 using namespace llsf::sim;
@@ -23,19 +24,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-/// A fresh directory, removed with everything in it at the end of the test.
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    static int counter = 0;
-    path = fs::temp_directory_path() / ("llsf_report_html_test_" + std::to_string(::getpid()) +
-                                        "_" + std::to_string(counter++));
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() { fs::remove_all(path); }
-  std::string file(const std::string& name) const { return (path / name).string(); }
-};
+using llsf::test::TempDir;
 
 /// A store with one batch: variants "b" and "a</script>" x seeds 3, 1, 2 (stored in that order),
 /// points 10 * seed (+100 for "b"); one run's real-time factor is infinite.

@@ -12,6 +12,7 @@
 #include "llsf/sim/game.h"
 #include "llsf/sim/runner.h"
 #include "llsf/sim/scenario.h"
+#include "support/temp_dir.h"
 
 using namespace llsf;
 using namespace llsf::sim;
@@ -20,10 +21,8 @@ namespace {
 
 /// Writes `text` to a scenario file in a temp directory next to links to the agents.
 std::string scenario_file(const std::string& name, const std::string& text) {
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("llsf_scenario_test_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  const std::filesystem::path p = dir / name;
+  static const llsf::test::TempDir dir("llsf_scenario_test");  // removed at exit
+  const std::filesystem::path p = dir.path / name;
   std::ofstream(p) << text;
   return p.string();
 }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // StatsStore: schema, a run written and read back, one transaction per run, batch identity.
 #include "llsf/sim/stats_store.h"
+#include "support/temp_dir.h"
 
 #include <doctest/doctest.h>
 #include <sqlite3.h>
@@ -18,19 +19,7 @@ using llsf::sim::RunResult;
 using llsf::sim::StatsError;
 using llsf::sim::StatsStore;
 
-/// A fresh directory, removed with everything in it at the end of the test.
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    static int counter = 0;
-    path = fs::temp_directory_path() /
-           ("llsf_stats_test_" + std::to_string(getpid()) + "_" + std::to_string(counter++));
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() { fs::remove_all(path); }
-  std::string file(const std::string& name) const { return (path / name).string(); }
-};
+using llsf::test::TempDir;
 
 RunResult sample_run(const std::string& variant, std::uint64_t seed) {
   RunResult r;
