@@ -253,10 +253,12 @@ VelocityCommand Navigator::update(core::SimTime now, const Pose2D& pose,
   auto held = [&](double step) -> bool {
     stats_.blocked_s += step;
     if (stats_.blocked_s > config_.blocked_timeout_s) {
-      char buf[96];
-      std::snprintf(buf, sizeof buf, "held back by robot %d for %.1f s", blocker_,
-                    stats_.blocked_s);
-      finish(NavOutcome::kBlocked, buf, blocker_);
+      const std::string who = blocker_ >= 0 && blocker_ < static_cast<int>(names_.size())
+                                  ? names_[static_cast<std::size_t>(blocker_)]
+                                  : "robot " + std::to_string(blocker_);
+      char buf[48];
+      std::snprintf(buf, sizeof buf, " for %.1f s", stats_.blocked_s);
+      finish(NavOutcome::kBlocked, "held back by " + who + buf, blocker_);
       return true;
     }
     return false;

@@ -87,6 +87,7 @@ RobotStack::RobotStack(std::string name, int index, const core::Pose2D& start,
       loc_rng_(rng.stream("sim/" + name_ + "/localization")),
       light_rng_(rng.stream("sim/" + name_ + "/light")),
       colour_rng_(rng.stream("sim/" + name_ + "/colour")) {
+  nav_.set_obstacle_names(robot_names_);  // "held back by robot2"
   pose_.pose = start;
   est_ref_ = start;
   odo_ref_ = start;

@@ -151,10 +151,21 @@ TEST_CASE("a robot holding the goal: blocked, naming it, after the timeout") {
   const NavStatus& st = scene.nav(0).status();
   CHECK(st.outcome == NavOutcome::kBlocked);
   CHECK(st.blocked_by == 1);
-  CHECK(st.message.rfind("held back by robot 1 for ", 0) == 0);
+  CHECK(st.message.rfind("held back by robot 1 for ", 0) == 0);  // no names given
   CHECK(t < 30.0);
   CHECK(scene.nav(0).stats().blocked_s > 6.0);
   CHECK(scene.robot_contacts() == 0);
+}
+
+TEST_CASE("a blocked navigation names the robot when the names are known") {
+  const Pose2D m3{2.80, 0.56 + 0.14 + 0.2225, -core::kPi / 2};
+  ControllerConfig cc;
+  cc.blocked_timeout_s = 3.0;
+  NavScene scene(test_world({{0.8, 0.5, 0.0}, m3}), 2, PlannerConfig{}, cc);
+  scene.nav(0).set_obstacle_names({"alpha", "beta"});
+  scene.nav(0).go_to_place("M3");
+  scene.run(60.0);
+  CHECK(scene.nav(0).status().message.rfind("held back by beta for ", 0) == 0);
 }
 
 TEST_CASE("pushing against an obstacle the map does not know: stuck") {

@@ -61,6 +61,9 @@ class Navigator {
   void go_to_place(std::string_view name, bool forward = false);
   /// Stops: the next updates brake, the outcome is kAborted.
   void abort();
+  /// Names of the DiscObstacle ids (robots) for messages ("held back by robot2"); without a
+  /// name an id is shown as "robot <id>".
+  void set_obstacle_names(std::vector<std::string> names) { names_ = std::move(names); }
 
   /// One control step at simulated time `now` for the robot at `pose`, with the other robots
   /// (not this one) as discs; call it every physics step or at any steady rate. Returns the
@@ -76,6 +79,7 @@ class Navigator {
   const Pose2D& goal() const { return goal_; }
 
  private:
+  std::vector<std::string> names_;
   void finish(NavOutcome outcome, std::string message, int blocked_by = -1);
   bool plan_from(const Pose2D& pose, std::span<const DiscObstacle> others, bool around_others);
   double blocking_arc(const Pose2D& pose, std::span<const DiscObstacle> others, int& who) const;
