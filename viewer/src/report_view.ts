@@ -158,6 +158,11 @@ function pointsPlot(data: ReportData, names: Naming, width: number): Node {
   const inset = Math.max(4, facetWidth * 0.2);
   const longest = Math.max(...domain.map((d) => d.length));
   const rotate = longest * 7 > facetWidth * 0.9;
+  // Every run with the same points: a scale of zero extent draws nothing readable; give it room.
+  const values = rows.map((r) => r.points).filter((p): p is number => p !== null);
+  const lo = Math.min(...values);
+  const hi = Math.max(...values);
+  const flat = values.length > 0 && hi - lo < 1;
   return mark(
     Plot.plot({
       width,
@@ -175,7 +180,9 @@ function pointsPlot(data: ReportData, names: Naming, width: number): Node {
         tickRotate: rotate ? -25 : 0,
       },
       x: {axis: null, domain: [-1, 1]},
-      y: {label: "points", grid: true, nice: true},
+      y: flat
+        ? {label: "points", grid: true, nice: true, domain: [lo - 10, hi + 10]}
+        : {label: "points", grid: true, nice: true},
       marks: [
         Plot.frame({stroke: "#ddd", anchor: "bottom"}),
         Plot.boxY(rows, {
