@@ -127,7 +127,9 @@ Game::Game(GameConfig config) : config_(std::move(config)), rng_(config_.seed) {
         {h.safe_place,
          hackathon_safe_pose(h, config_.world, config_.planner.places.held_puck_offset_m)});
     for (const HackathonPuck& p : hackathon_layout_->pucks) {
-      puck_colour_by_id_.emplace(p.id.value(), p.colour);
+      const auto id = static_cast<std::size_t>(p.id.value());
+      if (id >= puck_colour_by_id_.size()) puck_colour_by_id_.resize(id + 1, -1);
+      puck_colour_by_id_[id] = p.colour;
     }
   }
   world_ = std::make_unique<kinematic::World>(config_.world, rng_);
@@ -411,8 +413,8 @@ void Game::step() {
     if (!world_->has_puck(p)) continue;
     puck_positions_.push_back(world_->puck_position(p));
     if (hackathon_layout_) {
-      const auto it = puck_colour_by_id_.find(p.value());
-      puck_colours_.push_back(it == puck_colour_by_id_.end() ? -1 : it->second);
+      const auto id = static_cast<std::size_t>(p.value());
+      puck_colours_.push_back(id < puck_colour_by_id_.size() ? puck_colour_by_id_[id] : -1);
     }
   }
   for (int i = 0; i < n; ++i) {

@@ -504,10 +504,6 @@ void RobotStack::sense_pucks(const RobotPercept& p) {
   }
 }
 
-}  // namespace llsf::sim
-
-namespace llsf::sim {
-
 // The hackathon's flashlight camera: a cone ahead of the robot, one frame every 1/frame_rate_hz;
 // per puck in the cone three draws (miss, false colour, which colour) and two for the position
 // noise, whatever the outcome, so that one puck's luck does not shift the others'.

@@ -10,7 +10,6 @@
 #include <array>
 #include <cstdint>
 #include <functional>
-#include <map>
 #include <memory>
 #include <optional>
 #include <span>
@@ -194,7 +193,7 @@ class Game {
 
   // The hackathon variant.
   std::optional<HackathonLayout> hackathon_layout_;
-  std::map<std::int32_t, int> puck_colour_by_id_;
+  std::vector<int> puck_colour_by_id_;  // indexed by puck id; -1: no colour
   std::array<kinematic::SignalLights, kinematic::kDeviceCount> lights_{};
 
   // Counters.
