@@ -531,6 +531,7 @@ int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err)
     game.step();
     if (recorder) recorder->frame(game);
     pacer.wait(game.time().seconds());
+    if (!game.skills_cycled()) continue;  // skill states change only in the skill cycle
     bool running = false;
     for (std::size_t i = 0; i < brains.size(); ++i) {
       lua::SkillEngine& e = brains[i]->engine();

@@ -432,7 +432,8 @@ void Game::step() {
   mark(5);
 
   // 7. Skills.
-  if (now >= next_skill_) {
+  skills_cycled_ = now >= next_skill_;
+  if (skills_cycled_) {
     next_skill_ += skill_period_;
     for (auto& s : stacks_) {
       if (s->brain() != nullptr) s->brain()->on_skill_cycle(*s);

@@ -89,6 +89,8 @@ class Game {
 
   /// Simulated time (of the last tick).
   SimTime time() const { return world_->time(); }
+  /// True if the last step() ran the robots' skill cycle (skill states can only change then).
+  bool skills_cycled() const { return skills_cycled_; }
   std::int64_t ticks() const { return ticks_; }
   const GameConfig& config() const { return config_; }
   /// The scenario seed's random streams (components draw from named streams of it).
@@ -177,6 +179,7 @@ class Game {
   std::int64_t ticks_ = 0;
   bool lights_applied_ = false;
   SimTime next_skill_;
+  bool skills_cycled_ = false;
   SimTime next_agent_;
   SimTime skill_period_;
   SimTime agent_period_;
