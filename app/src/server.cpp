@@ -345,15 +345,11 @@ Reply ServerImpl::handle_api(const std::vector<std::string>& path) {
     const std::optional<std::int64_t> id = parse_id(at(2));
     if (!id) return error_reply(http::status::bad_request, "bad run id '" + at(2) + "'");
     if (sim::StatsStore* s = stats()) {
-      for (const sim::StoredBatch& b : s->batches()) {
-        for (const sim::StoredRun& r : s->runs(b.id)) {
-          if (r.id != *id) continue;
-          if (r.recording.empty()) {
-            return error_reply(http::status::not_found,
-                               fmt::format("run {} has no recording", *id));
-          }
-          return recording_reply(r.recording, r.recording);
+      if (const std::optional<sim::StoredRun> r = s->run(*id)) {
+        if (r->recording.empty()) {
+          return error_reply(http::status::not_found, fmt::format("run {} has no recording", *id));
         }
+        return recording_reply(r->recording, r->recording);
       }
     }
     return error_reply(http::status::not_found, fmt::format("no run {}", *id));

@@ -255,7 +255,7 @@ struct StatsStore::Impl {
   std::unique_ptr<Statement> list_batches;
   std::unique_ptr<Statement> find_batch, insert_batch, finish_batch, get_batch, delete_run,
       insert_run, insert_stat, insert_order, insert_test, insert_award, insert_event, select_runs,
-      select_stats, select_awards;
+      select_run, select_stats, select_awards;
 
   explicit Impl(std::string p) : path(std::move(p)) {
     sqlite3* raw = nullptr;
@@ -333,10 +333,11 @@ struct StatsStore::Impl {
     insert_event = prep(
         "INSERT INTO events (run_id, idx, time_s, kind, name, value, detail) "
         "VALUES (?, ?, ?, ?, ?, ?, ?)");
-    select_runs = prep(
+    static constexpr const char* kRunColumns =
         "SELECT id, batch_id, scenario, variant, seed, llsfsim_version, result_hash, passed, "
-        "points, game_time_s, cpu_s, real_time_factor, recording FROM runs WHERE batch_id = ? "
-        "ORDER BY id");
+        "points, game_time_s, cpu_s, real_time_factor, recording FROM runs ";
+    select_runs = prep(std::string(kRunColumns) + "WHERE batch_id = ? ORDER BY id");
+    select_run = prep(std::string(kRunColumns) + "WHERE id = ?");
     select_stats = prep("SELECT name, value FROM statistics WHERE run_id = ? ORDER BY name");
     select_awards = prep(
         "SELECT time_s, game_time_s, phase, points, reason, coalesce(device, ''), "
@@ -541,26 +542,41 @@ std::int64_t StatsStore::add_run(std::int64_t batch_id, const RunResult& r, bool
   return run_id;
 }
 
+namespace {
+// One row of Impl::select_runs / select_run.
+StoredRun read_run(const Statement& q, const std::string& db_path) {
+  StoredRun s;
+  s.id = q.int64(0);
+  s.batch_id = q.int64(1);
+  s.scenario = q.text(2);
+  s.variant = q.text(3);
+  s.seed = static_cast<std::uint64_t>(q.int64(4));
+  s.llsfsim_version = q.text(5);
+  s.result_hash = parse_hex16(q.text(6));
+  s.passed = q.int64(7) != 0;
+  s.points = static_cast<int>(q.int64(8));
+  s.game_time_s = q.real(9);
+  s.cpu_s = q.real(10);
+  s.real_time_factor = q.real(11);
+  s.recording = q.null(12) ? std::string() : resolved_recording_path(db_path, q.text(12));
+  return s;
+}
+}  // namespace
+
 std::vector<StoredRun> StatsStore::runs(std::int64_t batch_id) const {
   Statement& q = *impl_->select_runs;
   q.start().bind(batch_id);
   std::vector<StoredRun> out;
-  while (q.step()) {
-    StoredRun& s = out.emplace_back();
-    s.id = q.int64(0);
-    s.batch_id = q.int64(1);
-    s.scenario = q.text(2);
-    s.variant = q.text(3);
-    s.seed = static_cast<std::uint64_t>(q.int64(4));
-    s.llsfsim_version = q.text(5);
-    s.result_hash = parse_hex16(q.text(6));
-    s.passed = q.int64(7) != 0;
-    s.points = static_cast<int>(q.int64(8));
-    s.game_time_s = q.real(9);
-    s.cpu_s = q.real(10);
-    s.real_time_factor = q.real(11);
-    s.recording = q.null(12) ? std::string() : resolved_recording_path(impl_->path, q.text(12));
-  }
+  while (q.step()) out.push_back(read_run(q, impl_->path));
+  return out;
+}
+
+std::optional<StoredRun> StatsStore::run(std::int64_t run_id) const {
+  Statement& q = *impl_->select_run;
+  q.start().bind(run_id);
+  std::optional<StoredRun> out;
+  if (q.step()) out = read_run(q, impl_->path);
+  q.finish();
   return out;
 }
 

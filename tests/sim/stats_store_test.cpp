@@ -153,6 +153,13 @@ TEST_CASE("StatsStore writes a run and reads it back") {
   CHECK(runs[0].points == 28);
   CHECK(runs[0].game_time_s == 60.0);
   CHECK(runs[0].llsfsim_version == llsf::sim::llsfsim_version());
+  // The same run by its id; an unknown id: none.
+  const auto one = store.run(id);
+  REQUIRE(one);
+  CHECK(one->variant == "config=a");
+  CHECK(one->seed == 7);
+  CHECK(one->batch_id == batch);
+  CHECK_FALSE(store.run(id + 1000));
 
   // Every numeric statistic, by name.
   const auto stats = store.statistics(id);

@@ -114,6 +114,8 @@ class StatsStore {
 
   /// The runs of a batch, by id.
   std::vector<StoredRun> runs(std::int64_t batch_id) const;
+  /// One run by its id, if stored.
+  std::optional<StoredRun> run(std::int64_t run_id) const;
   /// The (variant, seed) pairs of a batch's stored runs.
   std::vector<std::pair<std::string, std::uint64_t>> run_keys(std::int64_t batch_id) const;
   /// A run's statistics (name, value), by name.
