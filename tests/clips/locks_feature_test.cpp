@@ -93,9 +93,38 @@ struct Team {
     auto f = hosts[i]->facts("lock-role");
     return f.size() == 1 ? f[0].fields().at(0).text : "";
   }
-  void assert_lock(std::size_t i, const char* type, const char* resource) {
-    hosts[i]->assert_fact(std::string("(lock (type ") + type + ") (agent " +
-                          hosts[i]->config().robot_name + ") (resource " + resource + "))");
+  /// Asserts the lock fact as an agent's rule does; false if an identical fact exists (CLIPS
+  /// then asserts nothing and no rule sees it).
+  bool assert_lock(std::size_t i, const char* type, const char* resource) {
+    return !hosts[i]
+                ->eval(std::string("(assert (lock (type ") + type + ") (agent " +
+                       hosts[i]->config().robot_name + ") (resource " + resource + ")))")
+                .is_symbol("FALSE");
+  }
+
+  std::string lock_state(std::size_t i, const char* resource) {
+    const Value v = hosts[i]->eval(std::string("(lock-state ") + resource + ")");
+    return v.type == Value::Type::kSymbol ? v.text : "?";
+  }
+  /// Runs until exactly one host has (lock-role MASTER) and the others SLAVE; its index.
+  std::size_t elect() {
+    std::size_t master = 0;
+    const bool one = run_until(
+        [&] {
+          int masters = 0;
+          for (std::size_t i = 0; i < hosts.size(); ++i) {
+            if (role(i) == "MASTER") {
+              ++masters;
+              master = i;
+            }
+          }
+          return masters == 1 && role((master + 1) % 3) == "SLAVE" &&
+                 role((master + 2) % 3) == "SLAVE";
+        },
+        SimTime::from_sec(20));
+    REQUIRE(one);
+    tick();
+    return master;
   }
 
   comm::MessageRegistry reg;
@@ -112,21 +141,7 @@ struct Team {
 TEST_CASE("lock facts: GET -> ACCEPT/REFUSE, RELEASE after 0.5 m -> RELEASE_RVCD") {
   Team t;
   // One master emerges: (lock-role MASTER) on one host, SLAVE on the others, and it may grant.
-  std::size_t master = 0;
-  REQUIRE(t.run_until(
-      [&] {
-        int masters = 0;
-        for (std::size_t i = 0; i < 3; ++i) {
-          if (t.role(i) == "MASTER") {
-            ++masters;
-            master = i;
-          }
-        }
-        return masters == 1 && t.role((master + 1) % 3) == "SLAVE" &&
-               t.role((master + 2) % 3) == "SLAVE";
-      },
-      SimTime::from_sec(20)));
-  t.tick();
+  const std::size_t master = t.elect();
   const std::size_t a = (master + 1) % 3, b = (master + 2) % 3;
   const std::string master_name = t.hosts[master]->config().robot_name;
   CHECK(t.hosts[a]->eval("(lock-master)").is_symbol(master_name));
@@ -225,4 +240,194 @@ TEST_CASE("locks are off by default") {
   f.agent().eval("(lock-request M1)");
   CHECK(f.agent().runtime_errors() == 1);
   CHECK(f.logged("locks are off"));
+}
+
+// The lock trap (issue #15): CLIPS ignores the assert of a fact identical to an existing one, so
+// a (lock (type RELEASE) ...) fact left behind after a GET took the lock back would swallow the
+// robot's next RELEASE, and the resource would stay locked for the rest of the game. These tests
+// follow the facts an agent asserts, in the orders that could leave a GET or RELEASE behind.
+namespace {
+
+// Robot i, standing at `here`, has released resource r (RELEASE pending); it goes away 0.6 m:
+// the release must complete, and another robot j must get the resource.
+void leave_and_hand_over(Team& t, std::size_t i, std::size_t j, const char* r, core::Pose2D here) {
+  CHECK(t.lock_state(i, r) == "RELEASING");
+  CHECK(t.has_lock(i, "RELEASE", r));
+  t.hosts[i]->set_pose({here.x, here.y + 0.6, 0.0});
+  const std::string probe =
+      std::string("(any-factp ((?f released)) (eq (nth$ 1 ?f:implied) ") + r + "))";
+  const bool released = t.run_until([&] { return t.has(i, probe.c_str()); }, SimTime::from_sec(3));
+  CHECK(released);
+  CHECK(t.lock_state(i, r) == "NONE");
+  CHECK(t.hosts[i]->find_facts("lock", {{"resource", Value::symbol(r)}}).empty());
+  t.assert_lock(j, "GET", r);
+  CHECK(t.run_until([&] { return t.has_lock(j, "ACCEPT", r); }, SimTime::from_sec(3)));
+}
+
+// Robot i holds r (ACCEPT shown) at `here`; it releases r, goes away, and j gets it.
+void release_and_hand_over(Team& t, std::size_t i, std::size_t j, const char* r,
+                           core::Pose2D here) {
+  CHECK(t.assert_lock(i, "RELEASE", r));  // a new fact, not swallowed by an old one
+  t.tick();
+  leave_and_hand_over(t, i, j, r, here);
+}
+
+}  // namespace
+
+TEST_CASE("lock trap: a GET takes back a pending RELEASE, the next RELEASE still goes out") {
+  Team t;
+  const std::size_t master = t.elect();
+  // The same facts for a slave (lock over the radio) and for the master (served locally).
+  std::size_t i = 0;
+  SUBCASE("slave") { i = (master + 1) % 3; }
+  SUBCASE("master") { i = master; }
+  const std::size_t j = (i + 1) % 3;  // the next one to want M1
+  const std::string name = t.hosts[i]->config().robot_name;
+
+  t.assert_lock(i, "GET", "M1");
+  REQUIRE(t.run_until([&] { return t.has_lock(i, "ACCEPT", "M1"); }, SimTime::from_sec(10)));
+
+  // Done at M1: RELEASE while still there; it waits until the robot is 0.5 m away.
+  t.assert_lock(i, "RELEASE", "M1");
+  t.run_until([] { return false; }, SimTime::from_sec(1));
+  CHECK(t.lock_state(i, "M1") == "RELEASING");
+  CHECK(t.has_lock(i, "RELEASE", "M1"));
+
+  // It needs M1 once more before leaving: the GET takes the lock back, and the pending RELEASE
+  // fact goes with it (nothing will answer it).
+  t.assert_lock(i, "GET", "M1");
+  t.tick();
+  CHECK(t.lock_state(i, "M1") == "ACCEPTED");
+  CHECK(t.has_lock(i, "ACCEPT", "M1"));
+  CHECK_FALSE(t.has_lock(i, "GET", "M1"));
+  CHECK_FALSE(t.has_lock(i, "RELEASE", "M1"));
+  t.run_until([] { return false; }, SimTime::from_sec(5));  // held past several leases
+  CHECK(t.lock_state(i, "M1") == "ACCEPTED");
+
+  // Now the RELEASE is a new fact again: it goes out 0.5 m away and the other robot gets M1.
+  release_and_hand_over(t, i, j, "M1", {});
+  CHECK(t.lock_events[name] ==
+        std::vector<std::string>{"M1 NONE>REQUESTED", "M1 REQUESTED>ACCEPTED",
+                                 "M1 ACCEPTED>RELEASING", "M1 RELEASING>ACCEPTED",
+                                 "M1 ACCEPTED>RELEASING", "M1 RELEASING>NONE"});
+  for (std::size_t k = 0; k < 3; ++k) CHECK(t.hosts[k]->runtime_errors() == 0);
+}
+
+TEST_CASE("lock trap: a GET after the RELEASE went out, before its RELEASE_RVCD") {
+  Team t;
+  const std::size_t master = t.elect();
+  const std::size_t a = (master + 1) % 3, b = (master + 2) % 3;
+  const std::string name = t.hosts[a]->config().robot_name;
+  t.assert_lock(a, "GET", "M1");
+  REQUIRE(t.run_until([&] { return t.has_lock(a, "ACCEPT", "M1"); }, SimTime::from_sec(10)));
+  t.assert_lock(a, "RELEASE", "M1");
+  t.tick();
+
+  // In one cycle the robot is 0.5 m away (the RELEASE goes out before the rules run) and asks
+  // for M1 again: a new request, whose GET waits until the RELEASE has reached the master. The
+  // master's RELEASE_RVCD answers a release the robot no longer makes: no RELEASE_RVCD fact.
+  t.hosts[a]->set_pose({0.0, 0.6, 0.0});
+  t.assert_lock(a, "GET", "M1");
+  t.tick();
+  CHECK(t.lock_state(a, "M1") == "REQUESTED");
+  CHECK_FALSE(t.has_lock(a, "RELEASE", "M1"));
+  REQUIRE(t.run_until([&] { return t.has_lock(a, "ACCEPT", "M1"); }, SimTime::from_sec(3)));
+  CHECK_FALSE(t.has_lock(a, "GET", "M1"));
+  CHECK_FALSE(t.has_lock(a, "RELEASE", "M1"));
+  CHECK_FALSE(t.has(a, "(any-factp ((?f released)) TRUE)"));
+
+  release_and_hand_over(t, a, b, "M1", {0.0, 0.6, 0.0});
+  CHECK(t.lock_events[name] ==
+        std::vector<std::string>{"M1 NONE>REQUESTED", "M1 REQUESTED>ACCEPTED",
+                                 "M1 ACCEPTED>RELEASING", "M1 RELEASING>REQUESTED",
+                                 "M1 REQUESTED>ACCEPTED", "M1 ACCEPTED>RELEASING",
+                                 "M1 RELEASING>NONE"});
+  for (std::size_t k = 0; k < 3; ++k) CHECK(t.hosts[k]->runtime_errors() == 0);
+}
+
+TEST_CASE("lock trap: GET and RELEASE of one resource in one cycle; the fact left is the state") {
+  // A rule that changes its mind within one firing. The host hands the facts over in the order
+  // the rules fire (newest first by CLIPS' default depth strategy); the first one handed over
+  // consumes the other, so the fact that stays always says what the manager does.
+  constexpr const char* kChangeMind =
+      "(defrule get-then-release ?f <- (get-then-release ?r) => (retract ?f)\n"
+      "  (assert (lock (type GET) (agent ?*ROBOT-NAME*) (resource ?r)))\n"
+      "  (assert (lock (type RELEASE) (agent ?*ROBOT-NAME*) (resource ?r))))\n"
+      "(defrule release-then-get ?f <- (release-then-get ?r) => (retract ?f)\n"
+      "  (assert (lock (type RELEASE) (agent ?*ROBOT-NAME*) (resource ?r)))\n"
+      "  (assert (lock (type GET) (agent ?*ROBOT-NAME*) (resource ?r))))\n";
+  Team t;
+  const std::size_t master = t.elect();
+  const std::size_t a = (master + 1) % 3, b = (master + 2) % 3;
+  t.hosts[a]->load_string(kChangeMind, "change-mind.clp");
+  t.assert_lock(a, "GET", "M1");
+  REQUIRE(t.run_until([&] { return t.has_lock(a, "ACCEPT", "M1"); }, SimTime::from_sec(10)));
+
+  // RELEASE asserted last: it is handed over and the GET goes; the lock is being released.
+  t.hosts[a]->assert_fact("(get-then-release M1)");
+  t.tick();
+  CHECK(t.lock_state(a, "M1") == "RELEASING");
+  CHECK(t.has_lock(a, "RELEASE", "M1"));
+  CHECK_FALSE(t.has_lock(a, "GET", "M1"));
+  CHECK_FALSE(t.has_lock(a, "ACCEPT", "M1"));
+
+  // GET asserted last: the lock is taken back and the RELEASE goes.
+  t.hosts[a]->assert_fact("(release-then-get M1)");
+  t.tick();
+  CHECK(t.lock_state(a, "M1") == "ACCEPTED");
+  CHECK(t.has_lock(a, "ACCEPT", "M1"));
+  CHECK_FALSE(t.has_lock(a, "RELEASE", "M1"));
+  CHECK_FALSE(t.has_lock(a, "GET", "M1"));
+
+  release_and_hand_over(t, a, b, "M1", {});
+  for (std::size_t k = 0; k < 3; ++k) CHECK(t.hosts[k]->runtime_errors() == 0);
+}
+
+TEST_CASE("lock facts: repeated GETs and RELEASEs are harmless") {
+  Team t;
+  const std::size_t master = t.elect();
+  const std::size_t a = (master + 1) % 3, b = (master + 2) % 3;
+  const std::string name = t.hosts[a]->config().robot_name;
+
+  // A GET while the same GET is pending is the same fact: one request, one ACCEPT.
+  t.assert_lock(a, "GET", "M1");
+  t.tick();
+  CHECK(t.has_lock(a, "GET", "M1"));  // the new master is still quiet
+  CHECK_FALSE(t.assert_lock(a, "GET", "M1"));
+  REQUIRE(t.run_until([&] { return t.has_lock(a, "ACCEPT", "M1"); }, SimTime::from_sec(10)));
+  // A GET for a held lock is answered at once, even when the agent retracted its ACCEPT.
+  t.assert_lock(a, "GET", "M1");
+  t.tick();
+  CHECK_FALSE(t.has_lock(a, "GET", "M1"));
+  t.hosts[a]->eval("(do-for-all-facts ((?l lock)) (eq ?l:type ACCEPT) (retract ?l))");
+  t.assert_lock(a, "GET", "M1");
+  t.tick();
+  CHECK(t.has_lock(a, "ACCEPT", "M1"));
+  CHECK_FALSE(t.has_lock(a, "GET", "M1"));
+
+  // A RELEASE while the same RELEASE is pending: one release.
+  t.assert_lock(a, "RELEASE", "M1");
+  t.tick();
+  CHECK_FALSE(t.assert_lock(a, "RELEASE", "M1"));
+  t.tick();
+  leave_and_hand_over(t, a, b, "M1", {});
+
+  // A RELEASE of nothing held is answered at once and leaves no fact behind; the next GET and
+  // RELEASE work as usual.
+  t.hosts[a]->eval("(do-for-all-facts ((?f released)) TRUE (retract ?f))");
+  t.assert_lock(a, "RELEASE", "M2");
+  t.tick();
+  CHECK(t.has(a, "(any-factp ((?f released)) TRUE)"));
+  CHECK(t.hosts[a]->find_facts("lock", {{"resource", Value::symbol("M2")}}).empty());
+  t.hosts[a]->eval("(do-for-all-facts ((?f released)) TRUE (retract ?f))");
+  t.assert_lock(a, "GET", "M2");
+  REQUIRE(t.run_until([&] { return t.has_lock(a, "ACCEPT", "M2"); }, SimTime::from_sec(3)));
+  release_and_hand_over(t, a, b, "M2", {0.0, 0.6, 0.0});
+
+  CHECK(t.lock_events[name] ==
+        std::vector<std::string>{"M1 NONE>REQUESTED", "M1 REQUESTED>ACCEPTED",
+                                 "M1 ACCEPTED>RELEASING", "M1 RELEASING>NONE", "M2 NONE>REQUESTED",
+                                 "M2 REQUESTED>ACCEPTED", "M2 ACCEPTED>RELEASING",
+                                 "M2 RELEASING>NONE"});
+  for (std::size_t k = 0; k < 3; ++k) CHECK(t.hosts[k]->runtime_errors() == 0);
 }
