@@ -5,6 +5,8 @@
 #include <llsf_msgs/MachineReport.pb.h>
 
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "llsf/clips/testing.h"
 #include "llsf/comm/registry.h"
@@ -18,7 +20,8 @@ using clips::Value;
 namespace {
 
 struct Rules {
-  Rules() : f(config(), &registry_for_tests()) {
+  explicit Rules(clips::ConfigEntries extra = {})
+      : f(config(std::move(extra)), &registry_for_tests()) {
     for (const std::string& file : sim::agent_files(
              {LLSF_SOURCE_DIR "/clips/agents/common", LLSF_SOURCE_DIR "/clips/agents/llsf2013"})) {
       f.load_file(file);
@@ -34,10 +37,11 @@ struct Rules {
         "test-helpers.clp");
     f.step();  // (reset) and the deffacts
   }
-  static clips::AgentConfig config() {
+  static clips::AgentConfig config(clips::ConfigEntries extra) {
     clips::AgentConfig c;
     c.robot_name = "robot1";
     c.robot_number = 1;
+    c.config = std::move(extra);
     return c;
   }
   static const comm::MessageRegistry& registry_for_tests() {
@@ -163,4 +167,69 @@ TEST_CASE("exploration: the read code is matched to a type and reported to the r
   CHECK(reported);
   // The next machine along the ring.
   CHECK(r.last_call() == "explore_machine{place=\"M4\"}");
+}
+
+namespace {
+
+/// What a robot did in a minute of an empty storage.
+struct EmptyStorage {
+  std::vector<std::string> calls;  ///< the skills it called
+  int get_consumed_tasks = 0;      ///< cycles with a GET_CONSUMED task
+  int wait_tasks = 0;              ///< cycles with a WAIT task
+};
+
+/// Plays 60 s of a P3 robot holding nothing whose every get_s0 finds the storage empty, with a
+/// consumed puck lying beside M4.
+EmptyStorage empty_storage_minute(Rules& r) {
+  r.production("P3", "NONE");
+  r.eval("(do-for-fact ((?m machine)) (eq ?m:name M4) (modify ?m (consumed 1)))");
+  r.f.agent().set_pose({2.0, 1.0, 0.0});
+  EmptyStorage out;
+  for (int i = 0; i < 600; ++i) {
+    r.f.step();
+    if (!r.f.find("task", {{"kind", Value::symbol("GET_S0")}, {"state", Value::symbol("RUNNING")}})
+             .empty()) {
+      r.f.skills().set_status(SkillStatus::kFailed, "get_s0: no puck seen at INS_1, INS_2");
+    }
+    if (!r.f.find("task", {{"kind", Value::symbol("GET_CONSUMED")}}).empty()) {
+      ++out.get_consumed_tasks;
+    }
+    if (!r.f.find("task", {{"kind", Value::symbol("WAIT")}}).empty()) ++out.wait_tasks;
+    REQUIRE(r.f.agent().runtime_errors() == 0);
+  }
+  out.calls = r.f.skills().calls();
+  return out;
+}
+
+int calls_of(const EmptyStorage& e, const std::string& skill_call) {
+  int n = 0;
+  for (const std::string& c : e.calls) n += c.rfind(skill_call, 0) == 0 ? 1 : 0;
+  return n;
+}
+
+}  // namespace
+
+TEST_CASE("recycle never: no consumed puck is taken, also when the storage looks empty") {
+  SUBCASE("recycle-when-empty unset (default FALSE): the robot waits and looks again in 30 s") {
+    Rules r({clips::ConfigEntry::of("/clips-agent/recycle", "never")});
+    const EmptyStorage e = empty_storage_minute(r);
+    CHECK(e.get_consumed_tasks == 0);
+    CHECK(calls_of(e, "get_consumed") == 0);
+    CHECK(e.wait_tasks > 250);            // the empty storage was seen and waited out ...
+    CHECK(calls_of(e, "get_s0{}") >= 2);  // ... and looked at again
+  }
+  SUBCASE("recycle-when-empty FALSE") {
+    Rules r({clips::ConfigEntry::of("/clips-agent/recycle", "never"),
+             clips::ConfigEntry::of("/clips-agent/recycle-when-empty", false)});
+    const EmptyStorage e = empty_storage_minute(r);
+    CHECK(e.get_consumed_tasks == 0);
+    CHECK(calls_of(e, "get_s0{}") >= 2);
+  }
+  SUBCASE("recycle-when-empty TRUE: the consumed puck beside M4 instead of waiting") {
+    Rules r({clips::ConfigEntry::of("/clips-agent/recycle", "never"),
+             clips::ConfigEntry::of("/clips-agent/recycle-when-empty", true)});
+    const EmptyStorage e = empty_storage_minute(r);
+    CHECK(calls_of(e, "get_consumed{place=\"M4\"}") == 1);
+    CHECK(e.get_consumed_tasks > 0);
+  }
 }

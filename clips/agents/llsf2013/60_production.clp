@@ -6,10 +6,12 @@
 ;   holding a product -> deliver;  holding a consumed puck -> the nearer recycler
 ; Roles: P3 (S0 -> T5 -> deliver), P1 (T3), P2 (T4), P1P2 (T3 or T4, whichever lies farther
 ; from the T5). Configuration (confval, /clips-agent/...): roles (list by robot
-; number), recycle (never | ifpossible | afterdeliver), role-change/after-complex-delivery,
+; number), recycle (never | ifpossible | afterdeliver), recycle-when-empty (TRUE: a consumed
+; puck when the storage looked empty, whatever recycle says), role-change/after-complex-delivery,
 ; role-change/time-left (s), role-change/failures (in a row). See docs/agent-llsf2013.md.
 
-; The storage looked empty (get_s0 saw no puck): until then recycle or wait instead.
+; The storage looked empty (get_s0 saw no puck): until then wait (or, with recycle-when-empty,
+; take a consumed puck) instead.
 (deftemplate storage-empty (slot until (type FLOAT)))
 
 (deffunction robot-x () (bind ?p (find-fact ((?f pose)) TRUE))
@@ -101,7 +103,10 @@
     (case NONE then
       (bind ?mode (cfg "/clips-agent/recycle" "never"))
       (bind ?empty (any-factp ((?e storage-empty)) (> ?e:until (now))))
-      (if (or ?empty (eq ?mode "ifpossible")
+      ; The storage looked empty: a consumed puck instead only if recycle-when-empty says so
+      ; (default FALSE: recycle "never" never recycles).
+      (bind ?when-empty (and ?empty (eq (cfg "/clips-agent/recycle-when-empty" FALSE) TRUE)))
+      (if (or ?when-empty (eq ?mode "ifpossible")
               (and (eq ?mode "afterdeliver") (any-factp ((?rp recycle-pending)) TRUE))) then
         (bind ?cm (nearest-consumed ?x ?y))
         (if (neq ?cm NONE) then (return (create$ GET_CONSUMED ?cm ?cm))))
@@ -301,7 +306,8 @@
   (if (str-index "rejected the puck" ?e) then (set-holding UNKNOWN))
   (if (str-index "is down (red)" ?e) then (machine-update ?m down-until (+ (now) 30.0)))
   (if (and (eq ?k GET_S0) (str-index "no puck seen" ?e)) then
-    ; Look again in 30 s (pucks may be pushed back, late-order pucks arrive); recycle meanwhile.
+    ; Look again in 30 s (pucks may be pushed back, late-order pucks arrive); meanwhile wait, or
+    ; recycle with recycle-when-empty.
     (assert (storage-empty (until (+ (now) 30.0)))))
   (if (and (eq ?k GET_CONSUMED) (str-index "no puck beside" ?e)) then
     (machine-update ?m consumed-set 0))
