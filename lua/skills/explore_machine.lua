@@ -8,8 +8,9 @@ depends_interfaces = {
    {v = "light",     type = "RobotinoLightInterface", id = "Light"},
 }
 documentation      = [==[Drives to a device's look position and reads a stable light code. The
-result is "<device> red=<L> yellow=<L> green=<L>" with L one of ON, OFF, BLINKING, e.g.
-"M3 red=ON yellow=OFF green=BLINKING" (the exploration phase's type code).
+result is "<device> red=<L> yellow=<L> green=<L>" with L one of ON, OFF, BLINK (the 2013
+refbox's LightState names, as in its ExplorationInfo signals), e.g.
+"M3 red=ON yellow=OFF green=BLINK" (the exploration phase's type code).
 @param place   the device: "M1".."M10" (also "R1", "R2", "TST", "D1".."D3")
 @param stable  seconds the reading must hold unchanged (default 1.2: a blink period and more)
 @param timeout seconds to wait for a stable reading at the look position (default 8)
@@ -57,9 +58,17 @@ function READ:init()
    self.fsm.vars.since = clock.now()
 end
 
+-- A lamp's state by the refbox's LightState name (the light interface says BLINKING, as in
+-- Fawkes' RobotinoLightInterface; the refbox says BLINK).
+local function refbox_name(v)
+   if v == light.BLINKING then return "BLINK" end
+   return v
+end
+
 function READ:exit()
    if stable(self, self.fsm.vars) then
       self.fsm.result = string.format("%s red=%s yellow=%s green=%s", self.fsm.vars.place,
-                                      light:red(), light:yellow(), light:green())
+                                      refbox_name(light:red()), refbox_name(light:yellow()),
+                                      refbox_name(light:green()))
    end
 end

@@ -128,8 +128,8 @@ TEST_CASE("a finished skill fact carries the runner's result") {
   f.step();
   f.assert_fact("(start)");
   f.steps(2);
-  f.skills().set_result("M3 red=ON yellow=OFF green=BLINKING");
+  f.skills().set_result("M3 red=ON yellow=OFF green=BLINK");
   f.skills().set_status(SkillStatus::kFinal);
   f.step();
-  CHECK(f.has("(code \"M3 red=ON yellow=OFF green=BLINKING\")"));
+  CHECK(f.has("(code \"M3 red=ON yellow=OFF green=BLINK\")"));
 }

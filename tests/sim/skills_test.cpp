@@ -188,13 +188,11 @@ TEST_CASE("a T2 chain leaves a consumed puck beside the machine; recycle makes i
 
 namespace {
 
-/// "M3 red=ON yellow=OFF green=BLINKING" for the refbox's exploration code of machine `i`.
+/// "M3 red=ON yellow=OFF green=BLINK" for the refbox's exploration code of machine `i`.
 std::string expected_code(const Game& g, int i) {
   const refbox::Lights l = g.refbox().machine(core::DeviceId(i)).lights;
   auto name = [](refbox::LightState s) {
-    return s == refbox::LightState::kOn      ? "ON"
-           : s == refbox::LightState::kBlink ? "BLINKING"
-                                             : "OFF";
+    return s == refbox::LightState::kOn ? "ON" : s == refbox::LightState::kBlink ? "BLINK" : "OFF";
   };
   return machine_name(i) + " red=" + name(l.red) + " yellow=" + name(l.yellow) +
          " green=" + name(l.green);

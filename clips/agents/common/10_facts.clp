@@ -17,7 +17,7 @@
 ; The exploration code of a machine type (from the refbox's ExplorationInfo).
 (deftemplate signal
   (slot type (type SYMBOL))
-  (slot code (type STRING))   ; "red=ON yellow=OFF green=BLINKING", as explore_machine reports
+  (slot code (type STRING))   ; "red=ON yellow=OFF green=BLINK", as explore_machine reports
 )
 
 ; An active order (from OrderInfo).

@@ -14,11 +14,6 @@
              (time ?secs))
 )
 
-(deffunction light-state-name (?s)
-  (if (eq ?s BLINK) then (return BLINKING))
-  (return ?s)
-)
-
 (defrule refbox-exploration-info
   (declare (salience ?*PRIORITY-REFBOX*))
   ?pf <- (protobuf-msg (type "llsf_msgs.ExplorationInfo") (ptr ?p))
@@ -28,7 +23,7 @@
   (foreach ?s (pb-field-list ?p "signals")
     (bind ?red OFF) (bind ?yellow OFF) (bind ?green OFF)
     (foreach ?l (pb-field-list ?s "lights")
-      (bind ?st (light-state-name (pb-field-value ?l "state")))
+      (bind ?st (pb-field-value ?l "state"))   ; ON, OFF, BLINK: explore_machine's names
       (switch (pb-field-value ?l "color")
         (case RED then (bind ?red ?st))
         (case YELLOW then (bind ?yellow ?st))
