@@ -2,17 +2,14 @@
 // `llsfsim batch`: every matrix variant of scenarios x N seeds on worker threads, stored in the
 // statistics store run by run; resumable; a progress bar and a per-variant summary.
 #include <fmt/format.h>
-#include <unistd.h>
 
-#include <atomic>
-#include <csignal>
-#include <iostream>
 #include <memory>
 #include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
 
+#include "batch_progress.h"
 #include "commands.h"
 #include "llsf/app/cli.h"
 #include "llsf/clips/agent.h"
@@ -25,9 +22,6 @@ namespace llsf::app {
 
 namespace {
 
-/// Exit code of a batch stopped by Ctrl-C (128 + SIGINT, the shell's convention).
-constexpr int kExitInterrupted = 130;
-
 struct BatchCommandOptions {
   std::vector<std::string> scenarios;
   std::optional<int> runs;
@@ -37,41 +31,6 @@ struct BatchCommandOptions {
   bool no_record = false;
   bool quiet = false;
 };
-
-// Set by the SIGINT handler; a lock-free atomic may be written from a signal handler.
-std::atomic<bool> g_interrupted{false};
-static_assert(std::atomic<bool>::is_always_lock_free);
-
-extern "C" void on_sigint(int) { g_interrupted.store(true); }
-
-// Installs on_sigint for the batch's lifetime. SA_RESETHAND: a second Ctrl-C gets the default
-// action and ends the process at once (SQLite rolls back the run being written).
-class SigintGuard {
- public:
-  SigintGuard() {
-    g_interrupted = false;
-    struct sigaction sa {};
-    sa.sa_handler = &on_sigint;
-    sigemptyset(&sa.sa_mask);
-    sa.sa_flags = SA_RESETHAND;
-    installed_ = sigaction(SIGINT, &sa, &old_) == 0;
-  }
-  ~SigintGuard() {
-    if (installed_) sigaction(SIGINT, &old_, nullptr);
-  }
-  SigintGuard(const SigintGuard&) = delete;
-  SigintGuard& operator=(const SigintGuard&) = delete;
-
- private:
-  struct sigaction old_ {};
-  bool installed_ = false;
-};
-
-std::string duration(double s) {
-  const long t = static_cast<long>(s + 0.5);
-  if (t >= 3600) return fmt::format("{}h{:02}m", t / 3600, t / 60 % 60);
-  return fmt::format("{}m{:02}s", t / 60, t % 60);
-}
 
 struct Loaded {
   std::string path;
@@ -131,9 +90,9 @@ int batch(const BatchCommandOptions& o, std::ostream& out, std::ostream& err) {
     return kExitBadInput;
   }
 
-  // A bar on a terminal; otherwise (logs, tests) one line per stored run.
-  const bool bar = &err == &std::cerr && isatty(STDERR_FILENO) != 0 && !o.quiet;
   const SigintGuard sigint;
+  // A bar on a terminal; otherwise (logs, tests) one line per stored run.
+  BatchProgressPrinter progress("llsfsim batch", err, o.quiet);
   bool all_passed = true;
   for (const Loaded& l : loaded) {
     sim::BatchOptions options;
@@ -141,33 +100,7 @@ int batch(const BatchCommandOptions& o, std::ostream& out, std::ostream& err) {
     options.jobs = o.jobs.value_or(0);
     if (!o.no_record)
       options.recordings_dir = o.recordings.empty() ? default_recordings_dir(o.db) : o.recordings;
-    sim::BatchHooks hooks;
-    hooks.stop = &g_interrupted;
-    bool told = false;
-    hooks.stored = [&](const sim::RunResult& r, const sim::BatchProgress& p) {
-      if (o.quiet) return;
-      const double eta = p.done > 0 ? p.elapsed_s / p.done * (p.to_play - p.done) : 0.0;
-      if (bar) {
-        constexpr int kWidth = 30;
-        const int filled = p.to_play > 0 ? kWidth * p.done / p.to_play : kWidth;
-        err << fmt::format("\r[{}{}] {}/{} runs, {} failed, {} elapsed, ETA {}   ",
-                           std::string(static_cast<std::size_t>(filled), '#'),
-                           std::string(static_cast<std::size_t>(kWidth - filled), '.'), p.done,
-                           p.to_play, p.failed, duration(p.elapsed_s), duration(eta));
-        if (p.done == p.to_play) err << "\n";
-      } else {
-        err << fmt::format("[{}/{}] {}{}seed {}: {} points, {}, result {:016x}, ETA {}\n", p.done,
-                           p.to_play, r.variant, r.variant.empty() ? "" : " ", r.seed, r.points,
-                           r.passed() ? "PASS" : "FAIL", r.result_hash, duration(eta));
-      }
-      if (g_interrupted && !told) {
-        err << (bar ? "\n" : "")
-            << "llsfsim batch: interrupted; storing the running games (Ctrl-C again abandons "
-               "them)\n";
-        told = true;
-      }
-      err.flush();
-    };
+    const sim::BatchHooks hooks = progress.hooks();
     sim::BatchResult b;
     try {
       b = sim::run_batch(l.file, l.hash, *store, options, hooks);
@@ -178,7 +111,7 @@ int batch(const BatchCommandOptions& o, std::ostream& out, std::ostream& err) {
       err << "llsfsim batch: " << e.what() << "\n";
       return kExitBadInput;
     }
-    if (bar && b.interrupted) err << "\n";
+    if (progress.bar() && b.interrupted) err << "\n";
     if (!o.quiet) print_summary(l, b, o.db, options.recordings_dir, out);
     if (b.interrupted) return kExitInterrupted;
     all_passed = all_passed && b.all_passed();

@@ -36,6 +36,12 @@ int run(std::span<const std::string> args, std::ostream& out, std::ostream& err)
   }
   {
     CLI::App* sub = app.add_subcommand(
+        "experiment",
+        "Play an experiment's batches; check its targets and findings; report the verdicts");
+    commands.emplace_back(sub, add_experiment_command(*sub));
+  }
+  {
+    CLI::App* sub = app.add_subcommand(
         "check", "Validate scenarios and their agent and skill files without playing");
     commands.emplace_back(sub, add_check_command(*sub));
   }

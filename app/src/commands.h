@@ -27,6 +27,8 @@ Action add_skill_command(CLI::App& app);
 Action add_run_command(CLI::App& app);
 /// `llsfsim batch`: every variant x N seeds on worker threads, stored in the statistics store.
 Action add_batch_command(CLI::App& app);
+/// `llsfsim experiment`: an experiment's batches played, its findings checked and reported.
+Action add_experiment_command(CLI::App& app);
 /// `llsfsim report`: statistics of a stored batch, differences between variants, CSV.
 Action add_report_command(CLI::App& app);
 /// `llsfsim check`: validate scenarios and their agent/skill files without playing.

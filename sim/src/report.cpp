@@ -12,6 +12,7 @@
 #include <numeric>
 #include <sstream>
 
+#include "llsf/core/assert.h"
 #include "llsf/core/rng.h"
 
 namespace llsf::sim {
@@ -39,7 +40,40 @@ StatSummary summarize(const std::string& name, std::vector<double> v) {
   return s;
 }
 
+double mean_of(const std::vector<double>& x) {
+  return std::accumulate(x.begin(), x.end(), 0.0) / static_cast<double>(x.size());
+}
+
+// The estimator of one resample (sorted in place for the median).
+double estimate(std::vector<double>& x, Estimator e) {
+  if (e == Estimator::kMean) return mean_of(x);
+  std::sort(x.begin(), x.end());
+  return quantile(x, 0.5);
+}
+
 }  // namespace
+
+Interval bootstrap_interval(const std::vector<double>& a, const std::vector<double>& b,
+                            Estimator estimator, core::RandomStream& rng, int resamples) {
+  LLSF_DEMAND(!a.empty());
+  LLSF_DEMAND(resamples > 0);
+  auto resample = [&rng](const std::vector<double>& from, std::vector<double>& to) {
+    to.resize(from.size());
+    const auto last = static_cast<std::int64_t>(from.size()) - 1;
+    for (double& x : to) x = from[static_cast<std::size_t>(rng.uniform_int(0, last))];
+  };
+  std::vector<double> values;
+  values.reserve(static_cast<std::size_t>(resamples));
+  std::vector<double> ra, rb;
+  for (int k = 0; k < resamples; ++k) {
+    resample(a, ra);
+    resample(b, rb);
+    const double ea = estimate(ra, estimator);
+    values.push_back(b.empty() ? ea : ea - estimate(rb, estimator));
+  }
+  std::sort(values.begin(), values.end());
+  return {quantile(values, 0.025), quantile(values, 0.975)};
+}
 
 double quantile(const std::vector<double>& sorted, double q) {
   if (sorted.empty()) return 0.0;
@@ -86,7 +120,6 @@ BatchReport make_report(const StatsStore& store, std::int64_t batch_id, std::uin
   // Differences of means against the first variant, percentile bootstrap.
   if (order.size() < 2) return r;
   core::RandomStream rng(seed);
-  constexpr int kResamples = 2000;
   const auto& base = values[order.front()];
   for (std::size_t i = 1; i < order.size(); ++i) {
     const auto& other = values[order[i]];
@@ -94,31 +127,14 @@ BatchReport make_report(const StatsStore& store, std::int64_t batch_id, std::uin
       const auto it = other.find(name);
       if (it == other.end() || b.empty() || it->second.empty()) continue;
       const std::vector<double>& a = it->second;
-      auto mean = [](const std::vector<double>& x) {
-        return std::accumulate(x.begin(), x.end(), 0.0) / static_cast<double>(x.size());
-      };
-      std::vector<double> diffs;
-      diffs.reserve(kResamples);
-      for (int k = 0; k < kResamples; ++k) {
-        double sa = 0.0, sb = 0.0;
-        for (std::size_t j = 0; j < a.size(); ++j) {
-          sa += a[static_cast<std::size_t>(
-              rng.uniform_int(0, static_cast<std::int64_t>(a.size()) - 1))];
-        }
-        for (std::size_t j = 0; j < b.size(); ++j) {
-          sb += b[static_cast<std::size_t>(
-              rng.uniform_int(0, static_cast<std::int64_t>(b.size()) - 1))];
-        }
-        diffs.push_back(sa / static_cast<double>(a.size()) - sb / static_cast<double>(b.size()));
-      }
-      std::sort(diffs.begin(), diffs.end());
+      const Interval ci = bootstrap_interval(a, b, Estimator::kMean, rng);
       Difference d;
       d.variant = order[i];
       d.baseline = order.front();
       d.statistic = name;
-      d.diff = mean(a) - mean(b);
-      d.ci_low = quantile(diffs, 0.025);
-      d.ci_high = quantile(diffs, 0.975);
+      d.diff = mean_of(a) - mean_of(b);
+      d.ci_low = ci.low;
+      d.ci_high = ci.high;
       r.differences.push_back(std::move(d));
     }
   }

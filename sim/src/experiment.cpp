@@ -1,0 +1,1133 @@
+// SPDX-License-Identifier: MIT
+#include "llsf/sim/experiment.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <numeric>
+#include <set>
+#include <stdexcept>
+#include <tuple>
+
+#include "llsf/core/assert.h"
+#include "llsf/core/config.h"
+#include "llsf/core/error.h"
+#include "llsf/core/rng.h"
+#include "llsf/sim/batch.h"
+#include "llsf/sim/report.h"
+
+namespace llsf::sim {
+
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Loading
+
+/// "file:line:column: path" of a node, the prefix of errors found after loading.
+std::string where_of(const core::ConfigNode& n) {
+  return n.location() + ": " + (n.path().empty() ? std::string("(top level)") : n.path());
+}
+
+std::string join(const std::vector<std::string>& v, const std::string& sep) {
+  std::string out;
+  for (const std::string& s : v) out += (out.empty() ? "" : sep) + s;
+  return out;
+}
+
+bool contains(const std::vector<std::string>& v, const std::string& x) {
+  return std::find(v.begin(), v.end(), x) != v.end();
+}
+
+/// The names every stored run has (StatsStore writes numeric_statistics()).
+const std::vector<std::string>& known_statistics() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out;
+    for (const auto& [name, value] : numeric_statistics(RunResult{})) out.push_back(name);
+    return out;
+  }();
+  return names;
+}
+
+std::string required_string(const core::ConfigNode& map, std::string_view key) {
+  const core::ConfigNode n = map[key];
+  if (!n.defined()) map.fail("missing key '" + std::string(key) + "'");
+  const std::string s = n.as_string();
+  if (s.empty()) n.fail("must not be empty");
+  return s;
+}
+
+std::string optional_string(const core::ConfigNode& map, std::string_view key) {
+  std::string s;
+  map.read(key, s);
+  return s;
+}
+
+/// A variant name's value of each axis ("config=P3-P3,loss=20" with axes config, loss).
+std::vector<std::string> split_variant(const std::string& variant,
+                                       const std::vector<std::string>& axes) {
+  std::vector<std::string> out;
+  std::size_t pos = 0;
+  for (std::size_t a = 0; a < axes.size(); ++a) {
+    pos += axes[a].size() + 1;  // "axis="
+    std::size_t end = variant.size();
+    if (a + 1 < axes.size()) {
+      end = variant.find("," + axes[a + 1] + "=", pos);
+      LLSF_DEMAND(end != std::string::npos);
+    }
+    out.push_back(variant.substr(pos, end - pos));
+    pos = end + 1;
+  }
+  return out;
+}
+
+const ExperimentBatch& batch_of(const Experiment& e, const core::ConfigNode& node, int* index) {
+  const std::string name = required_string(node, "batch");
+  for (std::size_t i = 0; i < e.batches.size(); ++i) {
+    if (e.batches[i].name == name) {
+      *index = static_cast<int>(i);
+      return e.batches[i];
+    }
+  }
+  std::vector<std::string> names;
+  for (const ExperimentBatch& b : e.batches) names.push_back(b.name);
+  node["batch"].fail("unknown batch '" + name + "' (batches: " + join(names, ", ") + ")");
+}
+
+/// Checks that `axis` is one of the batch's axes.
+void require_axis(const ExperimentBatch& b, const std::string& axis, const core::ConfigNode& at) {
+  if (b.axis_index(axis) >= 0) return;
+  at.fail("batch '" + b.name + "' has no axis '" + axis + "' (" +
+          (b.scenario.axes.empty() ? std::string("its scenario has no matrix")
+                                   : "axes: " + join(b.scenario.axes, ", ")) +
+          ")");
+}
+
+void require_value(const ExperimentBatch& b, const std::string& axis, const std::string& value,
+                   const core::ConfigNode& at) {
+  const auto& values = b.axis_values[static_cast<std::size_t>(b.axis_index(axis))];
+  if (contains(values, value)) return;
+  at.fail("axis '" + axis + "' of batch '" + b.name + "' has no value '" + value +
+          "' (values: " + join(values, ", ") + ")");
+}
+
+/// `{axis: value, ...}`: every axis of the batch, every value of its axis, not the group axis.
+AxisFilter read_filter(const Experiment& e, const ExperimentBatch& b, const core::ConfigNode& n) {
+  AxisFilter out;
+  if (!n.defined() || n.is_null()) return out;
+  n.require_map();
+  for (const std::string& axis : n.keys()) {
+    const core::ConfigNode v = n[axis];
+    if (!v.is_scalar()) v.fail("expected an axis value");
+    require_axis(b, axis, v);
+    if (axis == e.group_by) {
+      v.fail("'" + axis +
+             "' is the group_by axis: every check is evaluated per group; choose "
+             "groups with `groups: [...]`");
+    }
+    require_value(b, axis, v.as_string(), v);
+    out.emplace_back(axis, v.as_string());
+  }
+  return out;
+}
+
+std::string read_statistic(const core::ConfigNode& map) {
+  const std::string s = required_string(map, "statistic");
+  if (!contains(known_statistics(), s)) {
+    map["statistic"].fail("unknown statistic '" + s +
+                          "' (docs/statistics.md; e.g. points, production_points, deliveries, "
+                          "first_complex_s, storage_empty_s, role_changes, jams)");
+  }
+  return s;
+}
+
+std::pair<double, double> read_range(const core::ConfigNode& n) {
+  if (!n.is_sequence() || n.size() != 2) n.fail("expected a range [low, high]");
+  const double lo = n.at(0).as_double();
+  const double hi = n.at(1).as_double();
+  if (!(lo <= hi)) n.fail("the range's low end is above its high end");
+  return {lo, hi};
+}
+
+double read_share(const core::ConfigNode& n) {
+  const double v = n.as_double();
+  if (!(v >= 0.0 && v <= 1.0)) n.fail("a share must be in 0..1");
+  return v;
+}
+
+std::vector<std::string> read_groups(const Experiment& e, const core::ConfigNode& map) {
+  std::vector<std::string> out;
+  const core::ConfigNode n = map["groups"];
+  if (!n.defined()) return out;
+  if (e.group_by.empty()) n.fail("groups need `group_by` at the top level");
+  if (!n.is_sequence() || n.size() == 0) n.fail("expected a list of group values");
+  for (const core::ConfigNode& g : n.elements()) {
+    const std::string v = g.as_string();
+    if (!contains(e.groups, v)) {
+      g.fail("unknown group '" + v + "' (values of '" + e.group_by + "': " + join(e.groups, ", ") +
+             ")");
+    }
+    if (!contains(out, v)) out.push_back(v);
+  }
+  return out;
+}
+
+/// ignore_below and above of a selection; `above` only where a share is taken.
+void read_selection_options(const core::ConfigNode& map, bool share, Selection& sel) {
+  if (map["ignore_below"].defined()) sel.ignore_below = map["ignore_below"].as_double();
+  if (map["above"].defined()) {
+    if (!share) map["above"].fail("only share_at_most and share_at_least take `above`");
+    sel.above = map["above"].as_double();
+  }
+}
+
+bool is_share(Check::Kind k) {
+  return k == Check::Kind::kShareAtMost || k == Check::Kind::kShareAtLeast;
+}
+
+bool is_comparison(Check::Kind k) {
+  return k == Check::Kind::kGreater || k == Check::Kind::kNotGreater ||
+         k == Check::Kind::kDifferenceIn;
+}
+
+std::optional<Check::Kind> kind_of(const std::string& s) {
+  for (const Check::Kind k :
+       {Check::Kind::kGreater, Check::Kind::kNotGreater, Check::Kind::kDifferenceIn,
+        Check::Kind::kMeanIn, Check::Kind::kMedianIn, Check::Kind::kShareAtMost,
+        Check::Kind::kShareAtLeast}) {
+    if (to_string(k) == s) return k;
+  }
+  return std::nullopt;
+}
+
+/// Sets a check's bound from the node of its range or share value.
+void read_bound(Check& c, const core::ConfigNode& n) {
+  if (is_share(c.kind)) {
+    const double v = read_share(n);
+    c.low = c.kind == Check::Kind::kShareAtLeast ? v : 0.0;
+    c.high = c.kind == Check::Kind::kShareAtMost ? v : 1.0;
+  } else {
+    std::tie(c.low, c.high) = read_range(n);
+  }
+}
+
+CalibrationTarget read_target(const Experiment& e, const core::ConfigNode& n) {
+  n.require_map();
+  n.check_keys({"name", "source", "batch", "where", "groups", "statistic", "ignore_below", "above",
+                "mean_in", "median_in", "share_at_most", "share_at_least"});
+  CalibrationTarget t;
+  t.name = required_string(n, "name");
+  t.source = optional_string(n, "source");
+  Check& c = t.check;
+  c.where = where_of(n);
+  const ExperimentBatch& b = batch_of(e, n, &c.sel.batch);
+  c.a = read_filter(e, b, n["where"]);
+  c.sel.statistic = read_statistic(n);
+  int kinds = 0;
+  for (const char* key : {"mean_in", "median_in", "share_at_most", "share_at_least"}) {
+    if (!n[key].defined()) continue;
+    ++kinds;
+    c.kind = *kind_of(key);
+    read_bound(c, n[key]);
+  }
+  if (kinds != 1) {
+    n.fail("give exactly one of mean_in, median_in, share_at_most, share_at_least");
+  }
+  read_selection_options(n, is_share(c.kind), c.sel);
+  t.groups = read_groups(e, n);
+  if (!t.groups.empty() && b.axis_index(e.group_by) < 0) {
+    n["groups"].fail("batch '" + b.name + "' has no axis '" + e.group_by + "'");
+  }
+  return t;
+}
+
+Check read_check(const Experiment& e, const core::ConfigNode& entry) {
+  entry.require_map();
+  if (entry.size() != 1) {
+    entry.fail(
+        "a check is one of greater, not_greater, difference_in, mean_in, median_in, "
+        "share_at_most, share_at_least: {batch: ..., ...}");
+  }
+  const std::string key = entry.keys().front();
+  const std::optional<Check::Kind> kind = kind_of(key);
+  const core::ConfigNode n = entry[key];
+  if (!kind) {
+    n.fail("unknown check '" + key +
+           "' (checks: greater, not_greater, difference_in, mean_in, median_in, share_at_most, "
+           "share_at_least)");
+  }
+  n.require_map();
+  if (n.is_null()) n.fail("expected {batch: ..., statistic: ..., ...}");
+  Check c;
+  c.kind = *kind;
+  c.where = where_of(n);
+  if (is_comparison(c.kind)) {
+    if (c.kind == Check::Kind::kDifferenceIn) {
+      n.check_keys({"batch", "statistic", "a", "b", "ignore_below", "range"});
+    } else {
+      n.check_keys({"batch", "statistic", "a", "b", "ignore_below"});
+    }
+  } else if (is_share(c.kind)) {
+    n.check_keys({"batch", "where", "statistic", "ignore_below", "above", "value"});
+  } else {
+    n.check_keys({"batch", "where", "statistic", "ignore_below", "range"});
+  }
+  const ExperimentBatch& b = batch_of(e, n, &c.sel.batch);
+  c.sel.statistic = read_statistic(n);
+  read_selection_options(n, is_share(c.kind), c.sel);
+  if (is_comparison(c.kind)) {
+    if (!n["a"].defined()) n.fail("missing key 'a' (the axis values of the first side)");
+    if (!n["b"].defined()) n.fail("missing key 'b' (the axis values of the second side)");
+    c.a = read_filter(e, b, n["a"]);
+    c.b = read_filter(e, b, n["b"]);
+    if (c.a == c.b) n.fail("'a' and 'b' select the same runs");
+    if (c.kind == Check::Kind::kDifferenceIn) {
+      if (!n["range"].defined()) n.fail("missing key 'range' ([low, high])");
+      read_bound(c, n["range"]);
+    }
+  } else {
+    c.a = read_filter(e, b, n["where"]);
+    const char* bound = is_share(c.kind) ? "value" : "range";
+    if (!n[bound].defined()) {
+      n.fail(std::string("missing key '") + bound + "'" +
+             (is_share(c.kind) ? " (the share, 0..1)" : " ([low, high])"));
+    }
+    read_bound(c, n[bound]);
+  }
+  return c;
+}
+
+Finding read_finding(const Experiment& e, const core::ConfigNode& n) {
+  n.require_map();
+  n.check_keys({"id", "claim", "source", "groups", "checks"});
+  Finding f;
+  f.id = required_string(n, "id");
+  f.claim = required_string(n, "claim");
+  f.source = optional_string(n, "source");
+  f.groups = read_groups(e, n);
+  const core::ConfigNode checks = n["checks"];
+  if (!checks.defined()) n.fail("missing key 'checks'");
+  if (!checks.is_sequence() || checks.size() == 0) checks.fail("expected a list of checks");
+  for (const core::ConfigNode& c : checks.elements()) f.checks.push_back(read_check(e, c));
+  const bool grouped = std::any_of(f.checks.begin(), f.checks.end(), [&](const Check& c) {
+    return e.batches[static_cast<std::size_t>(c.sel.batch)].axis_index(e.group_by) >= 0;
+  });
+  if (!f.groups.empty() && !grouped) {
+    n["groups"].fail("none of the checks' batches has an axis '" + e.group_by + "'");
+  }
+  return f;
+}
+
+Sweep read_sweep(const Experiment& e, const core::ConfigNode& n) {
+  n.require_map();
+  n.check_keys({"name", "source", "batch", "axis", "compare", "statistic", "baseline", "where",
+                "groups", "ignore_below"});
+  Sweep s;
+  s.name = required_string(n, "name");
+  s.source = optional_string(n, "source");
+  s.where = where_of(n);
+  const ExperimentBatch& b = batch_of(e, n, &s.sel.batch);
+  s.sel.statistic = read_statistic(n);
+  read_selection_options(n, false, s.sel);
+  s.axis = required_string(n, "axis");
+  require_axis(b, s.axis, n["axis"]);
+  s.compare = required_string(n, "compare");
+  require_axis(b, s.compare, n["compare"]);
+  if (s.compare == s.axis) n["compare"].fail("must be another axis than `axis`");
+  for (const char* key : {"axis", "compare"}) {
+    if (n[key].as_string() == e.group_by) {
+      n[key].fail("'" + e.group_by + "' is the group_by axis (sweeps are evaluated per group)");
+    }
+  }
+  const auto& rows = b.axis_values[static_cast<std::size_t>(b.axis_index(s.axis))];
+  s.baseline = rows.front();
+  if (n["baseline"].defined()) {
+    s.baseline = n["baseline"].as_string();
+    require_value(b, s.axis, s.baseline, n["baseline"]);
+  }
+  s.fixed = read_filter(e, b, n["where"]);
+  for (const auto& [axis, value] : s.fixed) {
+    if (axis == s.axis || axis == s.compare) {
+      n["where"][axis].fail("'" + axis + "' is swept or compared; it cannot be fixed");
+    }
+  }
+  // Every other axis must be fixed: a ranking over pooled variants would mean nothing.
+  for (const std::string& axis : b.scenario.axes) {
+    if (axis == s.axis || axis == s.compare || axis == e.group_by) continue;
+    const bool fixed =
+        std::any_of(s.fixed.begin(), s.fixed.end(), [&](const auto& f) { return f.first == axis; });
+    if (!fixed) {
+      n.fail("axis '" + axis + "' of batch '" + b.name +
+             "' is neither swept, compared nor fixed: give it in `where: {" + axis + ": ...}`");
+    }
+  }
+  s.groups = read_groups(e, n);
+  if (!s.groups.empty() && b.axis_index(e.group_by) < 0) {
+    n["groups"].fail("batch '" + b.name + "' has no axis '" + e.group_by + "'");
+  }
+  return s;
+}
+
+ExperimentBatch read_batch(const std::string& name, const core::ConfigNode& n,
+                           const std::filesystem::path& dir) {
+  ExperimentBatch b;
+  b.name = name;
+  b.where = n.location();
+  if (!n.is_scalar()) n.fail("expected a scenario file");
+  b.file_as_given = n.as_string();
+  if (b.file_as_given.empty()) n.fail("expected a scenario file");
+  const std::filesystem::path p(b.file_as_given);
+  b.file = p.is_absolute() ? p.string() : (dir / p).lexically_normal().string();
+  try {
+    b.scenario = load_scenario(b.file);
+    b.hash = file_content_hash(b.file);
+  } catch (const std::exception& err) {
+    n.fail(err.what());
+  }
+  b.axis_values.resize(b.scenario.axes.size());
+  for (const Scenario& s : b.scenario.variants) {
+    b.variant_axes.push_back(split_variant(s.variant, b.scenario.axes));
+    for (std::size_t a = 0; a < b.scenario.axes.size(); ++a) {
+      if (!contains(b.axis_values[a], b.variant_axes.back()[a]))
+        b.axis_values[a].push_back(b.variant_axes.back()[a]);
+    }
+  }
+  return b;
+}
+
+}  // namespace
+
+int ExperimentBatch::axis_index(const std::string& axis) const {
+  for (std::size_t i = 0; i < scenario.axes.size(); ++i) {
+    if (scenario.axes[i] == axis) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+const ExperimentBatch* Experiment::batch(const std::string& n) const {
+  for (const ExperimentBatch& b : batches) {
+    if (b.name == n) return &b;
+  }
+  return nullptr;
+}
+
+std::string to_string(Check::Kind k) {
+  switch (k) {
+    case Check::Kind::kGreater:
+      return "greater";
+    case Check::Kind::kNotGreater:
+      return "not_greater";
+    case Check::Kind::kDifferenceIn:
+      return "difference_in";
+    case Check::Kind::kMeanIn:
+      return "mean_in";
+    case Check::Kind::kMedianIn:
+      return "median_in";
+    case Check::Kind::kShareAtMost:
+      return "share_at_most";
+    case Check::Kind::kShareAtLeast:
+      return "share_at_least";
+  }
+  return "?";
+}
+
+Experiment load_experiment(const std::string& path) {
+  const core::ConfigNode root = core::ConfigNode::load_file(path);
+  if (!root.is_map()) root.fail("an experiment file is a map (name, batches, findings, ...)");
+  root.check_keys(
+      {"name", "description", "batches", "group_by", "calibration", "findings", "sweeps"});
+  Experiment e;
+  e.file = path;
+  e.name = required_string(root, "name");
+  for (const char c : e.name) {
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.')) {
+      root["name"].fail("use letters, digits, '-', '_' and '.' (it names the report's markers)");
+    }
+  }
+  e.description = optional_string(root, "description");
+
+  // The batches: every scenario file loaded now, so that a bad one costs no playing time.
+  const core::ConfigNode batches = root["batches"];
+  if (!batches.defined()) root.fail("missing key 'batches' (name: scenario file)");
+  if (!batches.is_map() || batches.size() == 0) {
+    batches.fail("expected a map of batch names to scenario files");
+  }
+  const std::filesystem::path dir = std::filesystem::path(path).parent_path();
+  for (const std::string& name : batches.keys()) {
+    e.batches.push_back(read_batch(name, batches[name], dir));
+  }
+
+  // The groups: the values of the group_by axis over every batch that has it.
+  if (root["group_by"].defined()) {
+    e.group_by = root["group_by"].as_string();
+    for (const ExperimentBatch& b : e.batches) {
+      const int a = b.axis_index(e.group_by);
+      if (a < 0) continue;
+      for (const std::string& v : b.axis_values[static_cast<std::size_t>(a)]) {
+        if (!contains(e.groups, v)) e.groups.push_back(v);
+      }
+    }
+    if (e.groups.empty()) root["group_by"].fail("no batch has an axis '" + e.group_by + "'");
+  }
+
+  auto list = [&](std::string_view key) {
+    const core::ConfigNode n = root[key];
+    if (!n.defined() || n.is_null()) return std::vector<core::ConfigNode>{};
+    if (!n.is_sequence()) n.fail("expected a list");
+    return n.elements();
+  };
+  std::set<std::string> names;
+  for (const core::ConfigNode& n : list("calibration")) {
+    e.calibration.push_back(read_target(e, n));
+    if (!names.insert(e.calibration.back().name).second)
+      n["name"].fail("a second target of this name");
+  }
+  names.clear();
+  for (const core::ConfigNode& n : list("findings")) {
+    e.findings.push_back(read_finding(e, n));
+    if (!names.insert(e.findings.back().id).second) n["id"].fail("a second finding of this id");
+  }
+  names.clear();
+  for (const core::ConfigNode& n : list("sweeps")) {
+    e.sweeps.push_back(read_sweep(e, n));
+    if (!names.insert(e.sweeps.back().name).second) n["name"].fail("a second sweep of this name");
+  }
+  if (e.calibration.empty() && e.findings.empty() && e.sweeps.empty()) {
+    root.fail("nothing to evaluate: give calibration targets, findings or sweeps");
+  }
+  return e;
+}
+
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Evaluation
+
+/// One batch's stored runs, grouped by variant, each variant's runs in seed order.
+struct BatchData {
+  const ExperimentBatch* batch = nullptr;
+  std::vector<int> expected;  ///< per variant: runs of a complete batch
+  std::vector<std::vector<std::map<std::string, double>>> runs;  ///< per variant
+  std::set<std::string> statistics;                              ///< every name a run has
+};
+
+BatchData load_batch_data(const ExperimentBatch& b, const StatsStore& store,
+                          const EvaluateOptions& o, BatchState& state) {
+  BatchData d;
+  d.batch = &b;
+  d.runs.resize(b.scenario.variants.size());
+  std::map<std::string, std::size_t> index;
+  for (std::size_t v = 0; v < b.scenario.variants.size(); ++v) {
+    const Scenario& s = b.scenario.variants[v];
+    index[s.variant] = v;
+    d.expected.push_back(static_cast<int>(batch_seeds(s, o.runs).size()));
+  }
+  state.name = b.name;
+  state.file_as_given = b.file_as_given;
+  state.scenario_name = b.scenario.variants.front().name;
+  state.variants = static_cast<int>(b.scenario.variants.size());
+  state.runs_per_variant = d.expected.front();
+  state.expected = std::accumulate(d.expected.begin(), d.expected.end(), 0);
+  for (const StoredBatch& sb : store.batches()) {
+    if (sb.kind != "batch" || sb.scenario_hash != b.hash) continue;
+    if (sb.runs_per_variant == state.runs_per_variant) {
+      state.batch_id = sb.id;
+    } else {
+      state.other_runs_per_variant.push_back(sb.runs_per_variant);
+    }
+  }
+  if (state.batch_id == 0) return d;
+  // Seed order within a variant: the bootstrap's draws must not depend on the storing order.
+  std::vector<StoredRun> runs = store.runs(state.batch_id);
+  std::sort(runs.begin(), runs.end(), [](const StoredRun& x, const StoredRun& y) {
+    return x.variant != y.variant ? x.variant < y.variant : x.seed < y.seed;
+  });
+  for (const StoredRun& run : runs) {
+    const auto it = index.find(run.variant);
+    if (it == index.end()) continue;
+    std::map<std::string, double> values;
+    for (const auto& [name, value] : store.statistics(run.id)) {
+      values[name] = value;
+      d.statistics.insert(name);
+    }
+    d.runs[it->second].push_back(std::move(values));
+    ++state.stored;
+  }
+  return d;
+}
+
+bool matches(const ExperimentBatch& b, std::size_t variant, const AxisFilter& filter) {
+  for (const auto& [axis, value] : filter) {
+    const int a = b.axis_index(axis);
+    if (a < 0 || b.variant_axes[variant][static_cast<std::size_t>(a)] != value) return false;
+  }
+  return true;
+}
+
+/// The values of `sel`'s statistic over the runs of the variants `filter` selects.
+std::vector<double> collect(const BatchData& d, const Selection& sel, const AxisFilter& filter,
+                            SampleCounts& n) {
+  std::vector<double> out;
+  for (std::size_t v = 0; v < d.runs.size(); ++v) {
+    if (!matches(*d.batch, v, filter)) continue;
+    n.expected += d.expected[v];
+    for (const auto& run : d.runs[v]) {
+      ++n.stored;
+      const auto it = run.find(sel.statistic);
+      if (it == run.end()) continue;
+      if (sel.ignore_below && it->second < *sel.ignore_below) continue;
+      out.push_back(it->second);
+    }
+  }
+  n.used = static_cast<int>(out.size());
+  return out;
+}
+
+/// `filter` plus the group's axis value, if the batch has the group axis.
+AxisFilter with_group(const Experiment& e, const ExperimentBatch& b, AxisFilter filter,
+                      const std::string& group) {
+  if (!group.empty() && b.axis_index(e.group_by) >= 0) filter.emplace_back(e.group_by, group);
+  return filter;
+}
+
+double mean_of(const std::vector<double>& v) {
+  return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+}
+
+/// Wilson score 95 % interval of k successes in n trials.
+Interval wilson(int k, int n) {
+  const double z = 1.959963984540054;
+  const double nn = n;
+  const double p = k / nn;
+  const double denom = 1.0 + z * z / nn;
+  const double centre = (p + z * z / (2.0 * nn)) / denom;
+  const double half = z / denom * std::sqrt(p * (1.0 - p) / nn + z * z / (4.0 * nn * nn));
+  return {std::max(0.0, centre - half), std::min(1.0, centre + half)};
+}
+
+// Numbers as the reports print them: fewer decimals for larger values.
+std::string num(double v) {
+  if (v == 0.0) return "0";
+  char buf[48];
+  const double a = std::fabs(v);
+  std::snprintf(buf, sizeof buf, a >= 10.0 ? "%.1f" : a >= 1.0 ? "%.2f" : "%.3f", v);
+  std::string s = buf;
+  if (s == "-0.0" || s == "-0.00" || s == "-0.000") s.erase(0, 1);
+  return s;
+}
+
+std::string signed_num(double v) {
+  const std::string s = num(v);
+  return s.front() == '-' || s == "0" ? s : "+" + s;
+}
+
+/// A number as written in the experiment file ("540", "0.02", "-0.5").
+std::string bound(double v) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+std::string filter_text(const AxisFilter& f) {
+  if (f.empty()) return "all runs";
+  std::string out;
+  for (const auto& [axis, value] : f) out += (out.empty() ? "" : ",") + axis + "=" + value;
+  return out;
+}
+
+std::string counts_text(const SampleCounts& c) {
+  std::string s = "n " + std::to_string(c.used);
+  if (c.used != c.stored) s += " of " + std::to_string(c.stored);
+  if (c.stored != c.expected) {
+    s += " (" + std::to_string(c.stored) + " of " + std::to_string(c.expected) + " runs)";
+  }
+  return s;
+}
+
+std::string describe(const Check& c) {
+  const std::string& stat = c.sel.statistic;
+  std::string s;
+  switch (c.kind) {
+    case Check::Kind::kGreater:
+      s = stat + ": " + filter_text(c.a) + " > " + filter_text(c.b);
+      break;
+    case Check::Kind::kNotGreater:
+      s = stat + ": " + filter_text(c.a) + " not > " + filter_text(c.b);
+      break;
+    case Check::Kind::kDifferenceIn:
+      s = stat + ": " + filter_text(c.a) + " - " + filter_text(c.b) + " in [" + bound(c.low) +
+          ", " + bound(c.high) + "]";
+      break;
+    case Check::Kind::kMeanIn:
+    case Check::Kind::kMedianIn:
+      s = stat + ": " + (c.kind == Check::Kind::kMeanIn ? "mean" : "median") +
+          (c.a.empty() ? "" : " of " + filter_text(c.a)) + " in [" + bound(c.low) + ", " +
+          bound(c.high) + "]";
+      break;
+    case Check::Kind::kShareAtMost:
+    case Check::Kind::kShareAtLeast:
+      s = "share of " + filter_text(c.a) + " with " + stat + " > " + bound(c.sel.above) +
+          (c.kind == Check::Kind::kShareAtMost ? " at most " : " at least ") +
+          bound(c.kind == Check::Kind::kShareAtMost ? c.high : c.low);
+      break;
+  }
+  if (c.sel.ignore_below) s += " (values below " + bound(*c.sel.ignore_below) + " left out)";
+  return s;
+}
+
+/// Evaluates one check in one group, drawing its bootstrap from `rng`.
+CheckResult evaluate_check(const Experiment& e, const std::vector<BatchData>& data, const Check& c,
+                           const std::string& group, core::RandomStream rng) {
+  const BatchData& d = data[static_cast<std::size_t>(c.sel.batch)];
+  const ExperimentBatch& b = *d.batch;
+  if (d.statistics.size() > 0 && d.statistics.count(c.sel.statistic) == 0) {
+    throw core::ConfigError(c.where + ": no stored run of batch '" + b.name +
+                            "' has the statistic '" + c.sel.statistic + "'");
+  }
+  CheckResult r;
+  r.description = describe(c);
+  const std::vector<double> a = collect(d, c.sel, with_group(e, b, c.a, group), r.a);
+  if (is_comparison(c.kind)) {
+    const std::vector<double> bv = collect(d, c.sel, with_group(e, b, c.b, group), r.b);
+    if (a.empty() || bv.empty()) {
+      r.measured = "no runs (" + counts_text(r.a) + " vs " + counts_text(r.b) + ")";
+      return r;
+    }
+    r.value = mean_of(a) - mean_of(bv);
+    const Interval ci = bootstrap_interval(a, bv, Estimator::kMean, rng);
+    r.ci_low = ci.low;
+    r.ci_high = ci.high;
+    r.measured = "difference " + signed_num(r.value) + ", 95 % CI [" + signed_num(ci.low) + ", " +
+                 signed_num(ci.high) + "]; " + counts_text(r.a) + " vs " +
+                 counts_text(r.b).substr(2);
+    bool holds = false;
+    if (c.kind == Check::Kind::kGreater) holds = ci.low > 0.0;
+    if (c.kind == Check::Kind::kNotGreater) holds = ci.low <= 0.0;
+    if (c.kind == Check::Kind::kDifferenceIn) holds = r.value >= c.low && r.value <= c.high;
+    r.outcome = holds ? CheckResult::Outcome::kHolds : CheckResult::Outcome::kFails;
+    return r;
+  }
+  if (a.empty()) {
+    r.measured = "no runs (" + counts_text(r.a) + ")";
+    return r;
+  }
+  if (is_share(c.kind)) {
+    const auto k = static_cast<int>(
+        std::count_if(a.begin(), a.end(), [&](double v) { return v > c.sel.above; }));
+    const int n = static_cast<int>(a.size());
+    r.value = static_cast<double>(k) / n;
+    const Interval ci = wilson(k, n);
+    r.ci_low = ci.low;
+    r.ci_high = ci.high;
+    char buf[128];
+    std::snprintf(buf, sizeof buf, "share %.3f (%d of %d), Wilson 95 %% CI [%.3f, %.3f]; ", r.value,
+                  k, n, ci.low, ci.high);
+    r.measured = buf + counts_text(r.a);
+  } else {
+    const Estimator est = c.kind == Check::Kind::kMeanIn ? Estimator::kMean : Estimator::kMedian;
+    std::vector<double> sorted = a;
+    std::sort(sorted.begin(), sorted.end());
+    r.value = est == Estimator::kMean ? mean_of(a) : quantile(sorted, 0.5);
+    const Interval ci = bootstrap_interval(a, {}, est, rng);
+    r.ci_low = ci.low;
+    r.ci_high = ci.high;
+    r.measured = std::string(est == Estimator::kMean ? "mean " : "median ") + num(r.value) +
+                 ", 95 % CI [" + num(ci.low) + ", " + num(ci.high) + "]; " + counts_text(r.a);
+  }
+  r.outcome = r.value >= c.low && r.value <= c.high ? CheckResult::Outcome::kHolds
+                                                    : CheckResult::Outcome::kFails;
+  return r;
+}
+
+/// The groups an item is evaluated in: {""} unless one of its batches has the group axis.
+std::vector<std::string> groups_of(const Experiment& e, const std::vector<int>& batches,
+                                   const std::vector<std::string>& chosen) {
+  const bool grouped =
+      !e.group_by.empty() && std::any_of(batches.begin(), batches.end(), [&](int b) {
+        return e.batches[static_cast<std::size_t>(b)].axis_index(e.group_by) >= 0;
+      });
+  if (!grouped) return {""};
+  return chosen.empty() ? e.groups : chosen;
+}
+
+core::RandomStream stream(const EvaluateOptions& o, const std::string& name) {
+  return core::Rng(o.seed).stream(name);
+}
+
+SweepResult evaluate_sweep(const Experiment& e, const std::vector<BatchData>& data, const Sweep& s,
+                           const std::string& group, const EvaluateOptions& o) {
+  const BatchData& d = data[static_cast<std::size_t>(s.sel.batch)];
+  const ExperimentBatch& b = *d.batch;
+  if (d.statistics.size() > 0 && d.statistics.count(s.sel.statistic) == 0) {
+    throw core::ConfigError(s.where + ": no stored run of batch '" + b.name +
+                            "' has the statistic '" + s.sel.statistic + "'");
+  }
+  SweepResult r;
+  r.sweep = &s;
+  r.group = group;
+  r.compare_values = b.axis_values[static_cast<std::size_t>(b.axis_index(s.compare))];
+  const auto& rows = b.axis_values[static_cast<std::size_t>(b.axis_index(s.axis))];
+  std::vector<std::string> baseline_order;
+  for (const std::string& value : rows) {
+    SweepRow row;
+    row.value = value;
+    std::vector<std::vector<double>> samples;
+    for (const std::string& cv : r.compare_values) {
+      AxisFilter f = s.fixed;
+      f.emplace_back(s.axis, value);
+      f.emplace_back(s.compare, cv);
+      SampleCounts n;
+      samples.push_back(collect(d, s.sel, with_group(e, b, f, group), n));
+      row.means.push_back(samples.back().empty() ? 0.0 : mean_of(samples.back()));
+      row.n.push_back(n);
+    }
+    // Best mean first; equal means keep the file order.
+    std::vector<std::size_t> idx;
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+      if (!samples[i].empty()) idx.push_back(i);
+    }
+    std::stable_sort(idx.begin(), idx.end(),
+                     [&](std::size_t x, std::size_t y) { return row.means[x] > row.means[y]; });
+    for (std::size_t k = 0; k < idx.size(); ++k) {
+      row.order.push_back(r.compare_values[idx[k]]);
+      if (k > 0) row.ranking += row.means[idx[k]] == row.means[idx[k - 1]] ? " = " : " > ";
+      row.ranking += r.compare_values[idx[k]];
+    }
+    if (idx.size() >= 2) {
+      row.has_top_two = true;
+      row.top_diff = row.means[idx[0]] - row.means[idx[1]];
+      core::RandomStream rng = stream(o, "sweep/" + s.name + "/" + group + "/" + value);
+      const Interval ci =
+          bootstrap_interval(samples[idx[0]], samples[idx[1]], Estimator::kMean, rng);
+      row.top_low = ci.low;
+      row.top_high = ci.high;
+      row.separated = ci.low > 0.0 || ci.high < 0.0;
+    }
+    if (value == s.baseline) baseline_order = row.order;
+    r.rows.push_back(std::move(row));
+  }
+  for (SweepRow& row : r.rows) row.differs = row.value != s.baseline && row.order != baseline_order;
+  return r;
+}
+
+}  // namespace
+
+ExperimentResult evaluate(const Experiment& e, const StatsStore& store, const EvaluateOptions& o) {
+  ExperimentResult r;
+  r.experiment = &e;
+  r.command = "llsfsim experiment " + e.file + (o.runs ? " --runs " + std::to_string(*o.runs) : "");
+  std::vector<BatchData> data;
+  for (const ExperimentBatch& b : e.batches) {
+    r.batches.emplace_back();
+    data.push_back(load_batch_data(b, store, o, r.batches.back()));
+  }
+
+  for (const CalibrationTarget& t : e.calibration) {
+    for (const std::string& g : groups_of(e, {t.check.sel.batch}, t.groups)) {
+      TargetResult tr;
+      tr.target = &t;
+      tr.group = g;
+      tr.check = evaluate_check(e, data, t.check, g, stream(o, "calibration/" + t.name + "/" + g));
+      tr.verdict = tr.check.outcome == CheckResult::Outcome::kHolds   ? Verdict::kHolds
+                   : tr.check.outcome == CheckResult::Outcome::kFails ? Verdict::kFails
+                                                                      : Verdict::kNoData;
+      r.calibration.push_back(std::move(tr));
+    }
+  }
+
+  for (const Finding& f : e.findings) {
+    FindingResult fr;
+    fr.finding = &f;
+    std::vector<int> batches;
+    for (const Check& c : f.checks) batches.push_back(c.sel.batch);
+    for (const std::string& g : groups_of(e, batches, f.groups)) {
+      FindingGroupResult gr;
+      gr.group = g;
+      bool no_data = false;
+      for (std::size_t i = 0; i < f.checks.size(); ++i) {
+        gr.checks.push_back(
+            evaluate_check(e, data, f.checks[i], g,
+                           stream(o, "finding/" + f.id + "/" + std::to_string(i + 1) + "/" + g)));
+        const CheckResult::Outcome out = gr.checks.back().outcome;
+        if (out == CheckResult::Outcome::kFails) gr.failed.push_back(static_cast<int>(i) + 1);
+        no_data = no_data || out == CheckResult::Outcome::kNoData;
+      }
+      gr.verdict = !gr.failed.empty() ? Verdict::kFails
+                   : no_data          ? Verdict::kNoData
+                                      : Verdict::kHolds;
+      fr.groups.push_back(std::move(gr));
+    }
+    r.findings.push_back(std::move(fr));
+  }
+
+  for (const Sweep& s : e.sweeps) {
+    for (const std::string& g : groups_of(e, {s.sel.batch}, s.groups)) {
+      r.sweeps.push_back(evaluate_sweep(e, data, s, g, o));
+    }
+  }
+  return r;
+}
+
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Rendering
+
+std::string target_verdict(Verdict v) {
+  return v == Verdict::kHolds ? "met" : v == Verdict::kFails ? "not met" : "no data";
+}
+
+std::string finding_verdict(const FindingGroupResult& g) {
+  if (g.verdict == Verdict::kHolds) return "reproduced";
+  if (g.verdict == Verdict::kNoData) return "no data";
+  std::vector<std::string> nums;
+  for (const int i : g.failed) nums.push_back(std::to_string(i));
+  return std::string("not reproduced (check") + (g.failed.size() > 1 ? "s " : " ") +
+         join(nums, ", ") + " failed)";
+}
+
+std::string outcome_text(CheckResult::Outcome o) {
+  return o == CheckResult::Outcome::kHolds   ? "holds"
+         : o == CheckResult::Outcome::kFails ? "fails"
+                                             : "no data";
+}
+
+std::string group_label(const std::string& g) { return g.empty() ? "all" : g; }
+
+std::string batch_line(const BatchState& b) {
+  std::string s = std::to_string(b.stored) + " of " + std::to_string(b.expected) + " runs";
+  if (b.batch_id == 0) {
+    s += ", not in the store";
+    if (!b.other_runs_per_variant.empty()) {
+      std::vector<std::string> v;
+      for (const int n : b.other_runs_per_variant) v.push_back(std::to_string(n));
+      s += " (stored with --runs " + join(v, ", ") + ")";
+    }
+  } else if (b.stored < b.expected) {
+    s += ", incomplete";
+  }
+  return s;
+}
+
+std::string sweep_cell(const SweepRow& row, std::size_t i) {
+  if (row.n[i].used == 0) return "-";
+  return num(row.means[i]) + " (n " + std::to_string(row.n[i].used) + ")";
+}
+
+std::string top_two(const SweepRow& row) {
+  if (!row.has_top_two) return "-";
+  return std::string(row.separated ? "separated" : "not separated") + ": " +
+         signed_num(row.top_diff) + " [" + signed_num(row.top_low) + ", " +
+         signed_num(row.top_high) + "]";
+}
+
+std::string vs_baseline(const SweepRow& row, const Sweep& s) {
+  if (row.value == s.baseline) return "baseline";
+  return row.differs ? "differs" : "same";
+}
+
+/// A table cell: no line breaks, `|` escaped.
+std::string cell(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    if (c == '|') {
+      out += "\\|";
+    } else if (c == '\n' || c == '\r') {
+      out += ' ';
+    } else {
+      out += c;
+    }
+  }
+  return out.empty() ? " " : out;
+}
+
+std::string row(const std::vector<std::string>& cells) {
+  std::string out = "|";
+  for (const std::string& c : cells) out += " " + cell(c) + " |";
+  return out + "\n";
+}
+
+std::string pad(const std::string& s, std::size_t width) {
+  return s.size() >= width ? s + " " : s + std::string(width - s.size(), ' ');
+}
+
+}  // namespace
+
+std::string to_text(const ExperimentResult& r) {
+  const Experiment& e = *r.experiment;
+  std::string out = "experiment " + e.name + " (" + e.file + ")\n";
+  out += "command    " + r.command + "\n";
+  for (const BatchState& b : r.batches) {
+    out += "batch      " + pad(b.name, 16) + pad(b.file_as_given, 24) +
+           (b.batch_id ? "#" + std::to_string(b.batch_id) + "  " : "") + batch_line(b) + "\n";
+  }
+
+  if (!r.calibration.empty()) out += "\ncalibration\n";
+  for (const TargetResult& t : r.calibration) {
+    out += "  " + pad(target_verdict(t.verdict), 9) + t.target->name +
+           (t.group.empty() ? "" : " [" + t.group + "]") + "\n";
+    out += "           " + t.check.description + "\n";
+    out += "           " + t.check.measured + "\n";
+  }
+
+  if (!r.findings.empty()) out += "\nfindings\n";
+  for (const FindingResult& f : r.findings) {
+    out += "  " + f.finding->id + "  " + f.finding->claim + "\n";
+    for (const FindingGroupResult& g : f.groups) {
+      out += "    " + group_label(g.group) + ": " + finding_verdict(g) + "\n";
+      for (std::size_t i = 0; i < g.checks.size(); ++i) {
+        const CheckResult& c = g.checks[i];
+        out += "      " + std::to_string(i + 1) + " " + pad(outcome_text(c.outcome), 8) +
+               c.description + "\n";
+        out += "                 " + c.measured + "\n";
+      }
+    }
+  }
+
+  if (!r.sweeps.empty()) out += "\nsweeps\n";
+  for (const SweepResult& s : r.sweeps) {
+    const Sweep& sw = *s.sweep;
+    out += "  " + sw.name + (s.group.empty() ? "" : " [" + s.group + "]") + ": " +
+           sw.sel.statistic + " by " + sw.compare + " per " + sw.axis + " (batch " +
+           e.batches[static_cast<std::size_t>(sw.sel.batch)].name +
+           (sw.fixed.empty() ? "" : ", " + filter_text(sw.fixed)) + ")\n";
+    std::size_t w = sw.axis.size();
+    for (const SweepRow& row : s.rows) w = std::max(w, row.value.size());
+    std::vector<std::size_t> cw;
+    for (std::size_t i = 0; i < s.compare_values.size(); ++i) {
+      std::size_t c = s.compare_values[i].size();
+      for (const SweepRow& row : s.rows) c = std::max(c, sweep_cell(row, i).size());
+      cw.push_back(c + 2);
+    }
+    out += "    " + pad(sw.axis, w + 2);
+    for (std::size_t i = 0; i < s.compare_values.size(); ++i)
+      out += pad(s.compare_values[i], cw[i]);
+    out += "ranking\n";
+    for (const SweepRow& row : s.rows) {
+      out += "    " + pad(row.value, w + 2);
+      for (std::size_t i = 0; i < s.compare_values.size(); ++i)
+        out += pad(sweep_cell(row, i), cw[i]);
+      out += (row.ranking.empty() ? "-" : row.ranking) + "  (" + vs_baseline(row, sw) +
+             "; top two " + top_two(row) + ")\n";
+    }
+  }
+  return out;
+}
+
+std::string to_markdown(const ExperimentResult& r) {
+  const Experiment& e = *r.experiment;
+  std::string out = "## Experiment " + e.name + "\n\n";
+  if (!e.description.empty()) out += e.description + "\n\n";
+  out += "Reproduce: `" + r.command + "`\n\n";
+  out += "| batch | scenario file | variants | runs per variant | runs stored |\n";
+  out += "|---|---|---:|---:|---|\n";
+  for (const BatchState& b : r.batches) {
+    out += row({b.name, "`" + b.file_as_given + "`", std::to_string(b.variants),
+                std::to_string(b.runs_per_variant), batch_line(b)});
+  }
+
+  if (!r.calibration.empty()) {
+    out += "\n### Calibration\n\n";
+    out += "| target | source | group | condition | measured | verdict |\n";
+    out += "|---|---|---|---|---|---|\n";
+    for (const TargetResult& t : r.calibration) {
+      out += row({t.target->name, t.target->source, group_label(t.group), t.check.description,
+                  t.check.measured, "**" + target_verdict(t.verdict) + "**"});
+    }
+  }
+
+  if (!r.findings.empty()) {
+    out += "\n### Findings\n\n";
+    out += "| finding | claim | verdict |\n|---|---|---|\n";
+    for (const FindingResult& f : r.findings) {
+      std::vector<std::string> verdicts;
+      for (const FindingGroupResult& g : f.groups) {
+        verdicts.push_back((g.group.empty() ? "" : g.group + ": ") + finding_verdict(g));
+      }
+      out += row({f.finding->id, f.finding->claim, join(verdicts, "; ")});
+    }
+    for (const FindingResult& f : r.findings) {
+      out += "\n#### " + f.finding->id + ": " + f.finding->claim + "\n\n";
+      if (!f.finding->source.empty()) out += "Source: " + f.finding->source + "\n\n";
+      out += "| group | check | measured | holds |\n|---|---|---|---|\n";
+      for (const FindingGroupResult& g : f.groups) {
+        for (std::size_t i = 0; i < g.checks.size(); ++i) {
+          const CheckResult& c = g.checks[i];
+          out += row({group_label(g.group), std::to_string(i + 1) + ". " + c.description,
+                      c.measured, outcome_text(c.outcome)});
+        }
+        out += row({group_label(g.group), "**verdict**", "", "**" + finding_verdict(g) + "**"});
+      }
+    }
+  }
+
+  if (!r.sweeps.empty()) out += "\n### Sweeps\n";
+  for (const SweepResult& s : r.sweeps) {
+    const Sweep& sw = *s.sweep;
+    out += "\n#### " + sw.name + (s.group.empty() ? "" : " (" + s.group + ")") + "\n\n";
+    if (!sw.source.empty()) out += "Source: " + sw.source + "\n\n";
+    out +=
+        "Mean `" + sw.sel.statistic + "` per `" + sw.compare + "` for each `" + sw.axis +
+        "` of batch `" + e.batches[static_cast<std::size_t>(sw.sel.batch)].name + "`" +
+        (sw.fixed.empty() ? "" : " (" + filter_text(sw.fixed) + ")") +
+        (sw.sel.ignore_below ? ", values below " + bound(*sw.sel.ignore_below) + " left out" : "") +
+        "; baseline `" + sw.baseline +
+        "`. Top two: the bootstrap 95 % interval of the best minus the second mean.\n\n";
+    std::vector<std::string> head{sw.axis};
+    std::string align = "|---|";
+    for (const std::string& cv : s.compare_values) {
+      head.push_back(cv);
+      align += "---:|";
+    }
+    for (const char* h : {"ranking", "vs baseline", "top two"}) {
+      head.push_back(h);
+      align += "---|";
+    }
+    out += row(head) + align + "\n";
+    for (const SweepRow& rw : s.rows) {
+      std::vector<std::string> cells{rw.value};
+      for (std::size_t i = 0; i < s.compare_values.size(); ++i) cells.push_back(sweep_cell(rw, i));
+      cells.push_back(rw.ranking.empty() ? "-" : rw.ranking);
+      cells.push_back(rw.differs ? "**differs**" : vs_baseline(rw, sw));
+      cells.push_back(top_two(rw));
+      out += row(cells);
+    }
+  }
+  return out;
+}
+
+std::string replace_between_markers(const std::string& text, const std::string& name,
+                                    const std::string& replacement) {
+  // A marker counts as a whole line (a trailing '\r' allowed).
+  auto find_line = [&](const std::string& marker) {
+    std::vector<std::size_t> at;
+    std::size_t pos = 0;
+    while ((pos = text.find(marker, pos)) != std::string::npos) {
+      const bool starts = pos == 0 || text[pos - 1] == '\n';
+      std::size_t end = pos + marker.size();
+      if (end < text.size() && text[end] == '\r') ++end;
+      const bool ends = end == text.size() || text[end] == '\n';
+      if (starts && ends) at.push_back(pos);
+      pos += marker.size();
+    }
+    if (at.empty()) throw std::invalid_argument("no line '" + marker + "'");
+    if (at.size() > 1) throw std::invalid_argument("the line '" + marker + "' appears twice");
+    return at.front();
+  };
+  const std::string begin = "<!-- experiment " + name + " begin -->";
+  const std::string end = "<!-- experiment " + name + " end -->";
+  const std::size_t b = find_line(begin);
+  const std::size_t en = find_line(end);
+  if (en < b) throw std::invalid_argument("'" + end + "' comes before '" + begin + "'");
+  const std::size_t after = text.find('\n', b);
+  if (after == std::string::npos || after + 1 > en) {
+    throw std::invalid_argument("'" + end + "' comes before '" + begin + "'");
+  }
+  std::string out = text.substr(0, after + 1) + replacement;
+  if (!replacement.empty() && replacement.back() != '\n') out += '\n';
+  return out + text.substr(en);
+}
+
+}  // namespace llsf::sim
