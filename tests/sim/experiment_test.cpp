@@ -5,6 +5,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <functional>
 #include <string>
 #include <vector>
@@ -88,8 +89,8 @@ void store_runs(StatsStore& store, const std::string& file, int runs_per_variant
 bool variant_has(const RunResult& r, const std::string& part) { return has(r.variant, part); }
 
 // conf: in `ideal` A scores ~100 and B ~50 (A clearly better); in `real` both score the same on
-// average. first_complex_s of ideal/A: 600, 620, -1 (never), 640. storage_empty_s: -1 except
-// one run (real/B, seed 2) at 300 s.
+// average. lock_wait_max_s of ideal/A: 600, 620, -1 (never), 640. exploration_points: -1 except
+// one run (real/B, seed 2): 300.
 void fill_conf(RunResult& r) {
   const int s = static_cast<int>(r.seed);
   const bool ideal = variant_has(r, "profile=ideal");
@@ -99,9 +100,10 @@ void fill_conf(RunResult& r) {
   } else {
     r.points = a ? 60 + s : 65 - s;
   }
-  r.first_complex_s = -1.0;
-  if (ideal && a) r.first_complex_s = s == 3 ? -1.0 : 580.0 + 20.0 * s - (s == 4 ? 20.0 : 0.0);
-  r.storage_empty_s = (!ideal && !a && s == 2) ? 300.0 : -1.0;
+  // (Statistics of every store version: the values are made up, only the names are real.)
+  r.lock_wait_max_s = -1.0;
+  if (ideal && a) r.lock_wait_max_s = s == 3 ? -1.0 : 580.0 + 20.0 * s - (s == 4 ? 20.0 : 0.0);
+  r.exploration_points = (!ideal && !a && s == 2) ? 300 : -1;
   // Irregular values: resamples of them have many distinct means.
   r.lock_wait_s = std::sqrt(7.3 * s + (ideal ? 1.1 : 2.9) + (a ? 0.0 : 13.7));
 }
@@ -131,15 +133,27 @@ std::vector<std::string> sweep_variants() {
   return out;
 }
 
+/// A store holding the complete batches of both scenario files, written once (a batch is found
+/// by its file's content, not its path: fixtures copy it).
+const std::string& template_db() {
+  static const TempDir dir{"llsf_experiment_template"};
+  static const std::string db = [] {
+    write_scenarios(dir);
+    StatsStore store(dir.file("study.db"));
+    store_runs(store, dir.file("conf.yaml"), 4, kConfVariants, 4, fill_conf);
+    store_runs(store, dir.file("sweep.yaml"), 3, sweep_variants(), 3, fill_sweep);
+    return dir.file("study.db");
+  }();
+  return db;
+}
+
 /// A directory with both scenario files and a store holding their complete batches.
 struct StudyFixture {
   TempDir dir{"llsf_experiment"};
   std::string db = dir.file("study.db");
   StudyFixture() {
     write_scenarios(dir);
-    StatsStore store(db);
-    store_runs(store, dir.file("conf.yaml"), 4, kConfVariants, 4, fill_conf);
-    store_runs(store, dir.file("sweep.yaml"), 3, sweep_variants(), 3, fill_sweep);
+    std::filesystem::copy_file(template_db(), db);
   }
   /// Writes exp.yaml: the header (batches, group_by) and then `body`.
   std::string experiment(const std::string& body, bool group_by = true) const {
@@ -369,24 +383,24 @@ TEST_CASE("experiment targets: mean_in with ignore_below, median_in, shares, gro
       "    batch: conf\n"
       "    where: {config: A}\n"
       "    groups: [ideal]\n"
-      "    statistic: first_complex_s\n"
+      "    statistic: lock_wait_max_s\n"
       "    ignore_below: 0\n"
       "    mean_in: [600, 640]\n"
       "  - name: First complex too early\n"
       "    batch: conf\n"
       "    where: {config: A}\n"
       "    groups: [ideal]\n"
-      "    statistic: first_complex_s\n"
+      "    statistic: lock_wait_max_s\n"
       "    ignore_below: 0\n"
       "    median_in: [0, 500]\n"
       "  - name: Storage runs empty\n"
       "    batch: conf\n"
-      "    statistic: storage_empty_s\n"
+      "    statistic: exploration_points\n"
       "    above: -0.5\n"
       "    share_at_most: 0.2\n"
       "  - name: Storage always lasts\n"
       "    batch: conf\n"
-      "    statistic: storage_empty_s\n"
+      "    statistic: exploration_points\n"
       "    above: -0.5\n"
       "    share_at_least: 0.1\n",
       e);
@@ -407,7 +421,7 @@ TEST_CASE("experiment targets: mean_in with ignore_below, median_in, shares, gro
   CHECK(median.check.value == doctest::Approx(620.0));
   CHECK(has(median.check.measured, "median 620.0"));
 
-  // storage_empty_s > -0.5 in one run of real (real/B seed 2) and none of ideal.
+  // exploration_points > -0.5 in one run of real (real/B seed 2) and none of ideal.
   const TargetResult& most_ideal = r.calibration[2];
   CHECK(most_ideal.group == "ideal");
   CHECK(most_ideal.check.value == 0.0);
@@ -424,7 +438,7 @@ TEST_CASE("experiment targets: mean_in with ignore_below, median_in, shares, gro
   const std::string md = to_markdown(r);
   CHECK(has(md, "| target | source | group | condition | measured | verdict |"));
   CHECK(has(md,
-            "| First complex | thesis 5.3.3 | ideal | first_complex_s: mean of config=A in "
+            "| First complex | thesis 5.3.3 | ideal | lock_wait_max_s: mean of config=A in "
             "[600, 640] (values below 0 left out) | mean 620.0, 95 % CI ["));
   CHECK(has(md, "| **met** |"));
   CHECK(has(md, "| **not met** |"));
