@@ -646,6 +646,12 @@ std::string counts_text(const SampleCounts& c) {
   return s;
 }
 
+/// A side without values: nothing stored, or every value left out.
+std::string missing_text(const SampleCounts& c) {
+  if (c.stored == 0) return "0 of " + std::to_string(c.expected) + " runs stored";
+  return counts_text(c);
+}
+
 std::string describe(const Check& c) {
   const std::string& stat = c.sel.statistic;
   std::string s;
@@ -692,7 +698,7 @@ CheckResult evaluate_check(const Experiment& e, const std::vector<BatchData>& da
   if (is_comparison(c.kind)) {
     const std::vector<double> bv = collect(d, c.sel, with_group(e, b, c.b, group), r.b);
     if (a.empty() || bv.empty()) {
-      r.measured = "no runs (" + counts_text(r.a) + " vs " + counts_text(r.b) + ")";
+      r.measured = "no data: " + missing_text(r.a) + " vs " + missing_text(r.b);
       return r;
     }
     r.value = mean_of(a) - mean_of(bv);
@@ -710,7 +716,7 @@ CheckResult evaluate_check(const Experiment& e, const std::vector<BatchData>& da
     return r;
   }
   if (a.empty()) {
-    r.measured = "no runs (" + counts_text(r.a) + ")";
+    r.measured = "no data: " + missing_text(r.a);
     return r;
   }
   if (is_share(c.kind)) {
@@ -808,7 +814,10 @@ SweepResult evaluate_sweep(const Experiment& e, const std::vector<BatchData>& da
     if (value == s.baseline) baseline_order = row.order;
     r.rows.push_back(std::move(row));
   }
-  for (SweepRow& row : r.rows) row.differs = row.value != s.baseline && row.order != baseline_order;
+  for (SweepRow& row : r.rows) {
+    row.comparable = !row.order.empty() && !baseline_order.empty();
+    row.differs = row.comparable && row.value != s.baseline && row.order != baseline_order;
+  }
   return r;
 }
 
@@ -925,6 +934,7 @@ std::string top_two(const SweepRow& row) {
 
 std::string vs_baseline(const SweepRow& row, const Sweep& s) {
   if (row.value == s.baseline) return "baseline";
+  if (!row.comparable) return "-";
   return row.differs ? "differs" : "same";
 }
 

@@ -475,7 +475,8 @@ TEST_CASE("experiment: an incomplete or missing batch is evaluated with what is 
   const Experiment e = load_experiment(f.experiment(
       "findings:\n  - id: F1\n    claim: A beats B\n    checks:\n"
       "      - greater: {batch: conf, statistic: points, a: {config: A}, b: {config: B}}\n"
-      "      - mean_in: {batch: sweep, statistic: points, range: [0, 1000]}\n"));
+      "      - mean_in: {batch: sweep, statistic: points, range: [0, 1000]}\n"
+      "sweeps:\n  - {name: S, batch: sweep, axis: speed, compare: config, statistic: points}\n"));
   const StatsStore store(db);
   const ExperimentResult r = evaluate(e, store);
   REQUIRE(r.batches.size() == 2);
@@ -489,11 +490,17 @@ TEST_CASE("experiment: an incomplete or missing batch is evaluated with what is 
   CHECK(has(ideal.checks[0].measured, "n 2 (2 of 4 runs) vs 2 (2 of 4 runs)"));
   CHECK(ideal.checks[0].holds());
   CHECK(ideal.checks[1].outcome == CheckResult::Outcome::kNoData);
+  CHECK(ideal.checks[1].measured == "no data: 0 of 27 runs stored");
   CHECK(ideal.verdict == Verdict::kNoData);
   const std::string text = to_text(r);
   CHECK(has(text, "8 of 16 runs, incomplete"));
   CHECK(has(text, "0 of 27 runs, not in the store (stored with --runs 2)"));
   CHECK(has(text, "ideal: no data"));
+  REQUIRE(r.sweeps.size() == 1);
+  REQUIRE(r.sweeps[0].rows.size() == 3);
+  CHECK(!r.sweeps[0].rows[1].comparable);
+  CHECK(!r.sweeps[0].rows[1].differs);
+  CHECK(has(text, "    mid    -  -  -  -  (-; top two -)\n"));
 }
 
 TEST_CASE("experiment sweeps: rankings per row, flips against the baseline, top two") {

@@ -198,7 +198,8 @@ struct SweepRow {
   std::vector<SampleCounts> n;     ///< likewise
   std::string ranking;             ///< "P3-P3 > P1P2-P3 > P1P2-P3-R" (only values with runs)
   std::vector<std::string> order;  ///< compare values with runs, best first
-  bool differs = false;            ///< the ranking differs from the baseline row's
+  bool comparable = false;         ///< this row and the baseline row both have a ranking
+  bool differs = false;            ///< comparable, and the ranking differs from the baseline row's
   bool separated = false;          ///< the top two's 95 % interval of the difference excludes 0
   double top_diff = 0.0, top_low = 0.0, top_high = 0.0;  ///< mean(first) - mean(second)
   bool has_top_two = false;
