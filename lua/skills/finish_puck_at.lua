@@ -118,7 +118,10 @@ fsm:define_states{ export_to=_M,
    {"WAIT_LIGHT", JumpState},
    {"DECIDE",   JumpState},
    {"ASIDE",    SkillJumpState, skills={{motor_move}}, final_to="LEAVE", fail_to="FAILED"},
-   {"LEAVE",    SkillJumpState, skills={{leave_puck}}, final_to="FINAL", fail_to="FAILED"},
+   -- Its own arguments: leave_puck must not take this skill's place (it would read it as where to
+   -- carry the puck); the puck stays beside the machine.
+   {"LEAVE",    SkillJumpState, skills={{leave_puck, distance=0.25}}, final_to="FINAL",
+    fail_to="FAILED"},
    -- Keeping the puck: back off a few cm slowly enough for the holder to keep it, so that the
    -- robot can turn away from the machine face with the puck.
    {"CLEAR",    SkillJumpState, skills={{motor_move}}, final_to="CLEARED", fail_to="CLEARED"},

@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -31,6 +32,9 @@ struct AgentGame {
           std::make_unique<AgentBrain>(game, i, c, [this, print](const clips::LogRecord& r) {
             if (r.level >= clips::LogLevel::kWarn) ++warnings;
             const std::string_view text = r.text;
+            if (text.find("task GET_S0 failed") != std::string_view::npos) {
+              get_s0_failures.emplace_back(text);
+            }
             if (text.find("role change") != std::string_view::npos) ++role_changes;
             if (text.find("took a consumed puck") != std::string_view::npos) ++consumed_taken;
             if (print || r.level == clips::LogLevel::kError) {
@@ -53,6 +57,7 @@ struct AgentGame {
   Game game;
   std::vector<std::unique_ptr<AgentBrain>> brains;
   int warnings = 0;
+  std::vector<std::string> get_s0_failures;  ///< "task GET_S0 failed: ..." of every robot
   int role_changes = 0;
   int consumed_taken = 0;
 };
@@ -177,4 +182,84 @@ TEST_CASE("with the lock protocol the robots share machines, storage and gates")
                                     clips::Value::symbol("MASTER"));
   }
   CHECK(masters == 1);
+}
+
+namespace {
+
+/// What one P3 robot did in the first 150 s of production with a puck where it should not be.
+struct StrayPuck {
+  int already_holding = 0;  ///< get_s0 failures "already holding a puck"
+  int get_s0_failures = 0;
+  bool had_s0 = false;         ///< the agent held an S0 at some time
+  core::Vec2 stray{0.0, 0.0};  ///< where the stray puck lies at the end
+};
+
+constexpr core::PuckId kStray{30};
+
+/// Plays 150 s of production with one P3 robot (robot1, whose get_s0 starts at INS_1);
+/// `stray(game, INS_1, second)` puts puck kStray somewhere before the start (second 0) or after
+/// each second of play. Prints the agent's log with LLSF_AGENT_LOG.
+StrayPuck stray_puck_game(const std::function<void(Game&, const planner::Place&, int)>& stray) {
+  AgentGame g(1, 7, {clips::ConfigEntry::list("/clips-agent/roles", {"P3"})},
+              std::getenv("LLSF_AGENT_LOG") != nullptr);
+  const planner::Place* ins1 = g.game.planner().place("INS_1");
+  REQUIRE(ins1 != nullptr);
+  stray(g.game, *ins1, 0);
+  test::start_phase(g.game, refbox::GamePhase::kProduction);
+  StrayPuck out;
+  for (int s = 1; s <= 150; ++s) {
+    g.game.run_until(g.game.time() + SimTime::from_sec(1));
+    stray(g.game, *ins1, s);
+    out.had_s0 =
+        out.had_s0 ||
+        !g.brains[0]->agent().find_facts("holding", {{"puck", clips::Value::symbol("S0")}}).empty();
+  }
+  CHECK(g.runtime_errors() == 0);
+  for (const std::string& e : g.get_s0_failures) {
+    MESSAGE(e);
+    ++out.get_s0_failures;
+    if (e.find("already holding a puck") != std::string::npos) ++out.already_holding;
+  }
+  out.stray = g.game.world().puck_position(kStray);
+  return out;
+}
+
+/// True if `p` lies in the input storage or in front of it, where robots stand to take an S0.
+bool at_the_storage(const core::Vec2& p) { return p.x() < 1.3 && p.y() > 2.0 && p.y() < 3.6; }
+
+}  // namespace
+
+TEST_CASE("a stray puck picked up on the way to the storage does not lock get_s0 up") {
+  // Driving to the storage from the middle of the field, the robot sweeps a stray puck into its
+  // holder (as robots do with pucks beside machines) and arrives with it at INS_1's look
+  // position, where get_s0 finds its holder full. Left where the robot stands, the puck is taken
+  // up again by every later get_s0 driving to that look position.
+  const StrayPuck r = stray_puck_game([](Game& game, const planner::Place&, int second) {
+    if (second == 0) game.world().teleport_robot(core::RobotId(0), {3.4, 2.2, core::kPi});
+    if (second != 2) return;
+    const core::Pose2D at = game.world().robot_pose(core::RobotId(0));
+    game.world().add_puck(kStray, at.to_parent({0.2225, 0.0}));
+  });
+  CHECK(r.had_s0);
+  CHECK(r.already_holding <= 1);
+  CHECK(r.get_s0_failures <= 2);
+  INFO("stray puck at ", r.stray.x(), ", ", r.stray.y());
+  CHECK_FALSE(at_the_storage(r.stray));
+}
+
+TEST_CASE("a puck pressed into the storage's wall does not lock get_s0 up") {
+  // Pushed by robots, a puck can end pressed into the wall at the back of the storage (x 0.01,
+  // seen in whole games): the holder's arms touch the wall before the puck is in, take_puck is
+  // blocked with the puck half in the holder. The storage's front pucks near INS_1 are gone.
+  const StrayPuck r = stray_puck_game([](Game& game, const planner::Place& ins1, int second) {
+    if (second != 0) return;
+    const std::vector<core::PuckId> ids(game.world().pucks().begin(), game.world().pucks().end());
+    for (const core::PuckId id : ids) {
+      if (game.world().puck_position(id).y() < 2.9) game.world().remove_puck(id);
+    }
+    game.world().add_puck(kStray, {0.01, ins1.target.y()});
+  });
+  CHECK(r.had_s0);
+  CHECK(r.already_holding <= 1);
+  CHECK(r.get_s0_failures <= 2);
 }

@@ -64,11 +64,20 @@
   (modify ?t (state LOCKING) (since (now)))
 )
 
+; A LEAVE task carries the puck it leaves out of the way (leave_puck place AWAY: a dump spot at a
+; wall): left where the robot stands -- in front of the storage or a machine -- it would be
+; swept into the holder of the next robot driving there, over and over.
+(deffunction task-place (?kind ?place)
+  (if (and (eq ?kind LEAVE) (eq ?place NONE)) then (return AWAY))
+  (return ?place)
+)
+
 (defrule task-start
   (declare (salience ?*PRIORITY-TASK*))
-  ?t <- (task (state START) (kind ?k&~WAIT) (place ?p))
+  ?t <- (task (state START) (kind ?k&~WAIT) (place ?place))
   =>
   (bind ?skill (task-skill ?k))
+  (bind ?p (task-place ?k ?place))
   (if (eq ?p NONE)
    then (skill-call ?skill)
    else (skill-call ?skill place ?p))
