@@ -88,6 +88,21 @@ void print_summary(const sim::RunResult& r, std::ostream& out) {
         "locks      {} grants, {} refusals; {} waits, {:.1f} s waited in all, longest {:.1f} s\n",
         r.lock_grants, r.lock_refusals, r.lock_waits, r.lock_wait_s, r.lock_wait_max_s);
   }
+  out << fmt::format(
+      "production first complex product {}, {} role changes{}, storage low {} pucks{}\n",
+      r.first_complex_s < 0 ? std::string("none") : fmt::format("at {:.0f} s", r.first_complex_s),
+      r.role_changes,
+      r.first_role_change_s < 0 ? std::string()
+                                : fmt::format(" (first at {:.0f} s)", r.first_role_change_s),
+      r.storage_min,
+      r.storage_empty_s < 0 ? std::string()
+                            : fmt::format(" (empty at {:.0f} s)", r.storage_empty_s));
+  if (r.profile != "ideal" || r.jams > 0) {
+    out << fmt::format(
+        "profile    {}: {} jams, {} robots jammed at the end, {} failures of one "
+        "skill in a row at most\n",
+        r.profile, r.jams, r.jammed_at_end, r.skill_failure_streak_max);
+  }
   out << fmt::format("radio      {} copies sent, {} dropped\n", r.messages_sent,
                      r.messages_dropped);
   out << fmt::format("speed      {:.0f} s of game in {:.2f} s CPU: {:.0f}x real time\n",

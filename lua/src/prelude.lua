@@ -43,6 +43,11 @@ end
 base.S_INACTIVE, base.S_FINAL, base.S_RUNNING, base.S_FAILED =
   S_INACTIVE, S_FINAL, S_RUNNING, S_FAILED
 base.robot_name = native.robot_name
+-- The robot profile (docs/profiles.md): profile.name, profile.stuck_detection; read-only.
+base.profile = setmetatable({}, {
+  __index = native.profile,
+  __newindex = function() error("profile is read-only", 2) end,
+  __metatable = false})
 -- Fawkes skill files start with `module(..., skillenv.module_init)` and call
 -- `skillenv.skill_module(_M)` after their declarations; here declarations are checked as they
 -- are assigned, so both are accepted and do nothing.

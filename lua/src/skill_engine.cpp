@@ -292,6 +292,12 @@ void SkillEngine::Impl::build() {
   luaL_setfuncs(L, natives, 0);
   lua_pushlstring(L, robot.name().data(), robot.name().size());
   lua_setfield(L, -2, "robot_name");
+  lua_createtable(L, 0, 2);
+  lua_pushstring(L, config.profile.c_str());
+  lua_setfield(L, -2, "name");
+  lua_pushboolean(L, config.stuck_detection ? 1 : 0);
+  lua_setfield(L, -2, "stuck_detection");
+  lua_setfield(L, -2, "profile");
   push_interfaces(L);  // sets native.interfaces, interface_names, clock
   arm_budget();
   if (lua_pcall(L, 1, 1, 0) != LUA_OK) LLSF_DEMAND_MSG(false, "prelude: " + pop_message(L));

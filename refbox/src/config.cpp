@@ -218,8 +218,14 @@ RefboxConfig load_refbox_config(const ConfigNode& node) {
     return c;
   }
   node.check_keys({"rules", "team", "skip_setup", "setup_s", "exploration_s", "production_s",
-                   "pucks", "learn_unknown_pucks", "params", "mode", "overtime_s"});
+                   "pucks", "learn_unknown_pucks", "params", "mode", "overtime_s",
+                   "recycle_points"});
   node.read("rules", c.rules);
+  if (node["recycle_points"].defined()) {
+    const std::int64_t v = node["recycle_points"].as_int();
+    if (v < 0 || v > 100) node["recycle_points"].fail("must be in 0..100");
+    c.recycle_points = static_cast<int>(v);
+  }
   node.read("team", c.team);
   node.read("skip_setup", c.skip_setup);
   c.setup_duration = read_seconds(node, "setup_s", c.setup_duration);

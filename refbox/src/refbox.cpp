@@ -110,6 +110,7 @@ Refbox::Refbox(RefboxConfig config, const core::Rng& rng)
     : config_(std::move(config)), rng_(rng.stream("refbox")), seed_(rng.seed()) {
   config_.validate();
   rules_ = make_rules_variant(config_.rules);
+  if (config_.recycle_points) rules_.recycle_points = *config_.recycle_points;
   team_ = config_.team;
   for (int i = 0; i < kDeviceCount; ++i) {
     Machine& m = machines_[i];

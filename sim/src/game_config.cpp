@@ -96,6 +96,15 @@ void GameConfig::validate() const {
     fail("agent_rate_hz", "must not exceed the physics rate " + num(physics_hz) + " Hz (got " +
                               num(agent_rate_hz) + ")");
   }
+  // Handling (robot profiles).
+  non_negative("handling.align_s", handling.align_s);
+  if (handling.align_s > 60.0) fail("handling.align_s", "must be at most 60 s");
+  non_negative("handling.motor_max_speed_mps", handling.motor_max_speed_mps);
+  non_negative("handling.motor_max_omega_rps", handling.motor_max_omega_rps);
+  probability("handling.jam_probability", handling.jam_probability);
+  non_negative("handling.jam_zone_m", handling.jam_zone_m);
+  non_negative("handling.jam_recovery_s", handling.jam_recovery_s);
+  non_negative("handling.align_min_drive_m", handling.align_min_drive_m);
   // The modules' own configs.
   world.validate();
   refbox.validate();

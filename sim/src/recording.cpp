@@ -91,6 +91,7 @@ struct Recorder::Impl {
   std::int64_t dropped = 0;
   std::vector<std::string> robot_names;
   std::vector<std::vector<core::Vec2>> paths;  // per robot, as last written
+  std::vector<int> jam_device;                 // per robot, as last written (-1: not jammed)
   std::vector<std::int64_t> robot_dropped;     // per robot: its copies dropped so far
   HackathonScore score;                        // hackathon: as last written
   bool score_known = false;
@@ -122,6 +123,7 @@ Recorder::Recorder(const std::string& path, const Game& game, const RecordingInf
     if (m.file == nullptr) throw std::runtime_error(path + ": cannot create the recording");
   }
   m.paths.resize(static_cast<std::size_t>(game.robot_count()));
+  m.jam_device.assign(static_cast<std::size_t>(game.robot_count()), -1);
   m.robot_dropped.assign(static_cast<std::size_t>(game.robot_count()), 0);
   m.period = SimTime::period_of_hz(pose_rate_hz);
   m.next_frame = game.time();
@@ -302,6 +304,19 @@ void Recorder::frame(const Game& game) {
       s += ", \"other\": " + quote(kinematic::device_name(c.device));
     }
     m.write(s + "}");
+  }
+
+  // Jams of the robot profiles: when a robot jams at a device and when it gets free.
+  for (int i = 0; i < game.robot_count(); ++i) {
+    const int d = game.robot(i).jam_device();
+    int& last = m.jam_device[static_cast<std::size_t>(i)];
+    if (d == last) continue;
+    const int device = d >= 0 ? d : last;
+    last = d;
+    m.write(m.head(t, "jam") +
+            ", \"robot\": " + quote(m.robot_names.at(static_cast<std::size_t>(i))) +
+            ", \"d\": " + quote(kinematic::device_name(core::DeviceId(device))) +
+            ", \"jammed\": " + (d >= 0 ? "true" : "false") + "}");
   }
 
   if (t < m.next_frame) return;

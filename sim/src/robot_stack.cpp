@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "llsf/sim/robot_stack.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <utility>
@@ -84,6 +85,8 @@ RobotStack::RobotStack(std::string name, int index, const core::Pose2D& start,
       devices_(std::move(devices)),
       planner_(&planner),
       nav_(planner, config.controller, rng.stream("planner/" + name_)),
+      handling_(config.handling),
+      jam_rng_(rng.stream("sim/" + name_ + "/jam")),
       loc_rng_(rng.stream("sim/" + name_ + "/localization")),
       light_rng_(rng.stream("sim/" + name_ + "/light")),
       colour_rng_(rng.stream("sim/" + name_ + "/colour")) {
@@ -127,23 +130,82 @@ kinematic::MotorCommand RobotStack::actuate(SimTime now,
   switch (drive_) {
     case Drive::kNavigator: {
       const planner::VelocityCommand c = nav_.update(now, pose_.pose, others);
-      return {c.vx_mps, c.vy_mps, c.omega_rps};
+      if (!arrived_at_ && nav_.status().outcome == planner::NavOutcome::kArrived) {
+        // Only the end of a real drive is aligned again (robot profiles): a short push is not.
+        const bool drove =
+            (true_pose_.position() - goal_from_).norm() >= handling_.align_min_drive_m;
+        arrived_at_ = drove ? now : now - SimTime::from_seconds(handling_.align_s);
+      }
+      return handle({c.vx_mps, c.vy_mps, c.omega_rps}, false);
     }
     case Drive::kMotor:
-      return velocity_;
+      return handle(velocity_, true);
     case Drive::kIdle:
       break;
   }
   return {};
 }
 
+kinematic::MotorCommand RobotStack::handle(kinematic::MotorCommand c, bool motor) {
+  const HandlingConfig& h = handling_;
+  if (motor && h.motor_max_speed_mps > 0.0) {
+    const double v = std::hypot(c.vx_mps, c.vy_mps);
+    if (v > h.motor_max_speed_mps) {
+      c.vx_mps *= h.motor_max_speed_mps / v;
+      c.vy_mps *= h.motor_max_speed_mps / v;
+    }
+  }
+  if (motor && h.motor_max_omega_rps > 0.0) {
+    c.omega_rps = std::clamp(c.omega_rps, -h.motor_max_omega_rps, h.motor_max_omega_rps);
+  }
+  // A new run of motor commands near a device may jam (one draw per approach, only near one).
+  if (motor && motor_started_ && jam_device_ < 0 && h.jam_probability > 0.0) {
+    motor_started_ = false;
+    int nearest = -1;
+    double best = h.jam_zone_m;
+    for (std::size_t i = 0; i < devices_.size(); ++i) {
+      const double d = (devices_[i].front - true_pose_.position()).norm();
+      if (d <= best) {
+        best = d;
+        nearest = static_cast<int>(i);
+      }
+    }
+    if (nearest >= 0 && jam_rng_.bernoulli(h.jam_probability)) {
+      jam_device_ = nearest;
+      jammed_since_ = now_;
+      ++jams_;
+    }
+  }
+  if (jam_device_ < 0) return c;
+  if (h.stuck_detection && now_ >= jammed_since_ + SimTime::from_seconds(h.jam_recovery_s)) {
+    jam_device_ = -1;  // the skills' recovery got it free
+    return c;
+  }
+  // Jammed: only a motion away from the device's front gets the robot free.
+  const core::Vec2 to_device =
+      devices_[static_cast<std::size_t>(jam_device_)].front - true_pose_.position();
+  const double cs = std::cos(true_pose_.theta), sn = std::sin(true_pose_.theta);
+  const core::Vec2 v_field(cs * c.vx_mps - sn * c.vy_mps, sn * c.vx_mps + cs * c.vy_mps);
+  const double n = to_device.norm();
+  const double towards = n > 1e-9 ? v_field.dot(to_device) / n : 0.0;
+  if (towards < -0.02) {
+    jam_device_ = -1;
+    return c;
+  }
+  return {};
+}
+
 void RobotStack::goto_place(std::string_view place, bool forward_only) {
+  arrived_at_.reset();
+  goal_from_ = true_pose_.position();
   nav_.go_to_place(place, forward_only);
   drive_ = Drive::kNavigator;
   ++goal_id_;
 }
 
 void RobotStack::goto_pose(const core::Pose2D& pose, bool forward_only) {
+  arrived_at_.reset();
+  goal_from_ = true_pose_.position();
   nav_.go_to(pose, forward_only);
   drive_ = Drive::kNavigator;
   ++goal_id_;
@@ -153,6 +215,11 @@ lua::NavState RobotStack::navigator() const {
   const planner::NavStatus& s = nav_.status();
   lua::NavState out;
   out.status = to_api(s.outcome);
+  // The fine alignment after an arrival (robot profiles): still running until it is done.
+  if (s.outcome == planner::NavOutcome::kArrived && handling_.align_s > 0.0 &&
+      (!arrived_at_ || now_ < *arrived_at_ + SimTime::from_seconds(handling_.align_s))) {
+    out.status = lua::NavStatus::kRunning;
+  }
   out.error = s.message;
   if (s.blocked_by >= 0 && s.blocked_by < static_cast<int>(robot_names_.size())) {
     out.blocked_by = robot_names_[static_cast<std::size_t>(s.blocked_by)];
@@ -169,6 +236,7 @@ void RobotStack::stop() {
 
 void RobotStack::set_velocity(double vx_mps, double vy_mps, double omega_rps) {
   if (nav_.status().outcome == planner::NavOutcome::kRunning) nav_.abort();
+  if (drive_ != Drive::kMotor) motor_started_ = true;
   drive_ = Drive::kMotor;
   velocity_ = {vx_mps, vy_mps, omega_rps};
 }
@@ -259,6 +327,7 @@ void RobotStack::sense(const RobotPercept& p) {
   LLSF_ASSERT(p.sensors != nullptr);
   now_ = p.now;
   radio_.now_ = p.now;
+  true_pose_ = p.true_pose;
   const kinematic::RobotSensors& s = *p.sensors;
   puck_in_holder_ = s.ir.puck_detected;
   ir_distance_m_ = s.ir.distance_m;

@@ -20,6 +20,14 @@ namespace llsf::sim {
 
 namespace {
 
+std::string fmt_s(double v) {
+  std::ostringstream o;
+  o.setf(std::ios::fixed);
+  o.precision(1);
+  o << v;
+  return o.str();
+}
+
 double cpu_seconds() {
   timespec ts{};
   // A measurement only, never a game input. The thread's clock: a game runs on one thread, and
@@ -119,6 +127,75 @@ class LockWaits {
   double total_s_ = 0.0, max_s_ = 0.0;
 };
 
+// Lock holds: from a grant to the release (RELEASING or NONE) or the end of the game. A hold that
+// ends while its robot is jammed (robot profiles) is the jam's doing and is not counted.
+class LockHolds {
+ public:
+  void on(const std::string& robot, const clips::LockEvent& e, bool jammed) {
+    using clips::LockState;
+    auto key = std::make_pair(robot, std::string(e.resource));
+    if (e.to == LockState::kAccepted) {
+      open_.try_emplace(std::move(key), e.time);
+      return;
+    }
+    if (e.to == LockState::kRequested) return;  // taking a pending release back: still held
+    auto it = open_.find(key);
+    if (it == open_.end()) return;
+    if (!jammed) max_s_ = std::max(max_s_, (e.time - it->second).seconds());
+    open_.erase(it);
+  }
+  /// `jammed(robot)` says whether a robot is jammed at the end.
+  template <class F>
+  double finish(SimTime end, F&& jammed) {
+    for (const auto& [key, since] : open_) {
+      if (!jammed(key.first)) max_s_ = std::max(max_s_, (end - since).seconds());
+    }
+    open_.clear();
+    return max_s_;
+  }
+
+ private:
+  std::map<std::pair<std::string, std::string>, SimTime> open_;
+  double max_s_ = 0.0;
+};
+
+// Runs of failures of one skill by one robot (a FINAL of that skill ends the run).
+class FailureStreaks {
+ public:
+  void on(const SkillStatusChange& ch) {
+    const std::string skill = ch.skill_string.substr(0, ch.skill_string.find('{'));
+    int& n = runs_[{ch.robot, skill}];
+    if (ch.status == lua::SkillStatus::kFailed) {
+      // A skill aborted by a newer skill string did not fail on its own.
+      if (ch.error.find("aborted") != std::string::npos) return;
+      max_ = std::max(max_, ++n);
+    } else if (ch.status == lua::SkillStatus::kFinal) {
+      n = 0;
+    }
+  }
+  int max() const { return max_; }
+
+ private:
+  std::map<std::pair<std::string, std::string>, int> runs_;
+  int max_ = 0;
+};
+
+/// Pucks in `area` that no robot holds.
+int pucks_in(const Game& g, const kinematic::Rect& area) {
+  const kinematic::World& w = g.world();
+  int n = 0;
+  for (const core::PuckId p : w.pucks()) {
+    if (!area.contains(w.puck_position(p))) continue;
+    bool held = false;
+    for (int i = 0; i < g.robot_count(); ++i) {
+      const auto h = w.held_puck(core::RobotId(i));
+      if (h && *h == p) held = true;
+    }
+    if (!held) ++n;
+  }
+  return n;
+}
+
 }  // namespace
 
 bool RunResult::passed() const {
@@ -133,6 +210,10 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   config.seed = seed;
   Game game(config);
   LockWaits lock_waits;  // before the brains, which call it
+  LockHolds lock_holds;
+  FailureStreaks streaks;
+  int role_changes = 0;
+  double first_role_change_s = -1.0;
   std::vector<std::unique_ptr<AgentBrain>> brains;
   int skill_failures = 0;
   std::unique_ptr<Recorder> recorder;
@@ -150,25 +231,32 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
     c.skills = scenario.skills;
     c.locks = spec.locks;
     const std::string name(game.robot(i).name());
-    clips::LogSink log;
-    if (recorder) {
-      // The agent's decisions (info and above) go into the recording.
-      log = [&recorder](const clips::LogRecord& rec) {
-        if (rec.level != clips::LogLevel::kDebug) recorder->agent(rec);
-      };
-    }
-    auto locks = [&recorder, &lock_waits, name](const clips::LockEvent& e) {
+    // The agent's decisions (info and above) go into the recording; the team agent's role
+    // changes are counted.
+    clips::LogSink log = [&recorder, &role_changes,
+                          &first_role_change_s](const clips::LogRecord& rec) {
+      if (rec.level == clips::LogLevel::kDebug) return;
+      if (recorder) recorder->agent(rec);
+      if (rec.text.find("production: role change") != std::string_view::npos) {
+        if (role_changes++ == 0) first_role_change_s = rec.time.seconds();
+      }
+    };
+    auto locks = [&recorder, &lock_waits, &lock_holds, &game, i, name](const clips::LockEvent& e) {
       lock_waits.on(name, e);
+      lock_holds.on(name, e, game.robot(i).jammed());
       if (recorder) recorder->lock(name, e);
     };
     brains.push_back(std::make_unique<AgentBrain>(game, i, c, std::move(log), std::move(locks)));
     brains.back()->skills().set_listener(
-        [&skill_failures, &hooks, &recorder](const SkillStatusChange& ch) {
+        [&skill_failures, &hooks, &recorder, &streaks, &game, i](const SkillStatusChange& ch) {
           if (recorder) recorder->skill(ch);
           if (hooks.skill) hooks.skill(ch);
           if (ch.status == lua::SkillStatus::kFailed) ++skill_failures;
+          // A jammed robot's failures are the jam's (robot profiles), not a livelock's.
+          if (!game.robot(i).jammed()) streaks.on(ch);
         });
   }
+  double lock_hold_max_s = 0.0;  // set at the end, before the test cases without a deadline
   // Test cases with a deadline are judged when the game passes it.
   std::vector<TestVerdict> verdicts(scenario.tests.size());
   std::vector<bool> judged(scenario.tests.size(), false);
@@ -207,10 +295,21 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
         d << errors << " agent runtime errors";
         break;
       }
+      case TestCase::Kind::kSkillFailureStreakAtMost:
+        value = streaks.max();
+        d << value << " failures of one skill in a row";
+        break;
+      case TestCase::Kind::kLockHoldAtMost:
+        value = lock_hold_max_s;
+        d << fmt_s(value) << " s the longest lock hold";
+        break;
     }
-    v.passed = t.kind == TestCase::Kind::kCollisionsAtMost ? value <= t.value
-               : t.kind == TestCase::Kind::kNoAgentErrors  ? value == 0.0
-                                                           : value >= t.value;
+    const bool at_most = t.kind == TestCase::Kind::kCollisionsAtMost ||
+                         t.kind == TestCase::Kind::kSkillFailureStreakAtMost ||
+                         t.kind == TestCase::Kind::kLockHoldAtMost;
+    v.passed = at_most                                    ? value <= t.value
+               : t.kind == TestCase::Kind::kNoAgentErrors ? value == 0.0
+                                                          : value >= t.value;
     d << " (need " << describe(t) << ")";
     v.detail = d.str();
     v.at_s = game.time().seconds();
@@ -226,8 +325,21 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
       0.0;  // with hooks.profile: the recorder's frames (wall clock, profile only)
   // The refbox records awards with its phase-relative time; the run notes the game time too.
   std::vector<double> award_times_s;
+  // The input storage, grown by 0.1 m: pucks pushed just past its marks are still there to take.
+  kinematic::Rect storage = game.config().world.field.input_storage;
+  storage.lo -= core::Vec2(0.1, 0.1);
+  storage.hi += core::Vec2(0.1, 0.1);
+  int storage_min = pucks_in(game, storage);
+  double storage_empty_s = storage_min == 0 ? 0.0 : -1.0;
+  SimTime next_storage_sample = SimTime::from_sec(1);
   while (game.time() < end) {
     game.step();
+    if (game.time() >= next_storage_sample) {
+      next_storage_sample += SimTime::from_sec(1);
+      const int n = pucks_in(game, storage);
+      storage_min = std::min(storage_min, n);
+      if (n == 0 && storage_empty_s < 0.0) storage_empty_s = game.time().seconds();
+    }
     if (recorder) {
       if (hooks.profile) {
         const auto t = std::chrono::steady_clock::now();
@@ -259,6 +371,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   r.scenario = scenario.name;
   r.variant = scenario.variant;
   r.seed = seed;
+  r.profile = scenario.game.profile;
   r.game_time_s = game.time().seconds();
   const GameSummary s = game.summary();
   r.points = s.points;
@@ -288,11 +401,16 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
         break;
       case refbox::AwardReason::kRecycled:
         ++r.recycled;
+        r.recycle_points += a.points;
         break;
       case refbox::AwardReason::kMachineCompleted: {
         const auto type = rb.machine(a.device).type;
         if (type == refbox::MachineType::kT3) ++r.products_p1;
         if (type == refbox::MachineType::kT4) ++r.products_p2;
+        if ((type == refbox::MachineType::kT3 || type == refbox::MachineType::kT4) &&
+            r.first_complex_s < 0.0) {
+          r.first_complex_s = a.game_time.seconds();
+        }
         if (type == refbox::MachineType::kT5) ++r.products_p3;
         break;
       }
@@ -311,6 +429,22 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   r.skill_failures = skill_failures;
   for (const auto& b : brains) r.agent_runtime_errors += b->agent().runtime_errors();
   lock_waits.finish(game.time(), r);
+  lock_hold_max_s = lock_holds.finish(game.time(), [&game](const std::string& robot) {
+    for (int i = 0; i < game.robot_count(); ++i) {
+      if (game.robot(i).name() == robot) return game.robot(i).jammed();
+    }
+    return false;
+  });
+  r.lock_hold_max_s = lock_hold_max_s;
+  r.role_changes = role_changes;
+  r.first_role_change_s = first_role_change_s;
+  r.storage_min = storage_min;
+  r.storage_empty_s = storage_empty_s;
+  for (int i = 0; i < game.robot_count(); ++i) {
+    r.jams += game.robot(i).jams();
+    if (game.robot(i).jammed()) ++r.jammed_at_end;
+  }
+  r.skill_failure_streak_max = streaks.max();
   r.messages_sent = s.comm.sent;
   r.messages_dropped = s.comm.dropped_total();
   r.cpu_s = cpu;
@@ -353,8 +487,9 @@ std::string to_json(const RunResult& r) {
     return out + "\"";
   };
   o << "{\"scenario\": " << str(r.scenario) << ", \"variant\": " << str(r.variant)
-    << ", \"seed\": " << r.seed << ", \"game_time_s\": " << r.game_time_s
-    << ", \"points\": " << r.points << ", \"exploration_points\": " << r.exploration_points
+    << ", \"seed\": " << r.seed << ", \"profile\": " << str(r.profile)
+    << ", \"game_time_s\": " << r.game_time_s << ", \"points\": " << r.points
+    << ", \"exploration_points\": " << r.exploration_points
     << ", \"production_points\": " << r.production_points
     << ", \"exploration_reports\": " << r.exploration_reports
     << ", \"exploration_correct\": " << r.exploration_correct
@@ -367,11 +502,17 @@ std::string to_json(const RunResult& r) {
   }
   o << "], \"products\": {\"P1\": " << r.products_p1 << ", \"P2\": " << r.products_p2
     << ", \"P3\": " << r.products_p3 << "}, \"recycled\": " << r.recycled
-    << ", \"collisions\": " << r.collisions << ", \"skill_failures\": " << r.skill_failures
+    << ", \"recycle_points\": " << r.recycle_points << ", \"collisions\": " << r.collisions
+    << ", \"skill_failures\": " << r.skill_failures
     << ", \"agent_runtime_errors\": " << r.agent_runtime_errors
     << ", \"locks\": {\"grants\": " << r.lock_grants << ", \"refusals\": " << r.lock_refusals
     << ", \"waits\": " << r.lock_waits << ", \"wait_s\": " << r.lock_wait_s
-    << ", \"wait_max_s\": " << r.lock_wait_max_s << "}"
+    << ", \"wait_max_s\": " << r.lock_wait_max_s << ", \"hold_max_s\": " << r.lock_hold_max_s
+    << "}, \"first_complex_s\": " << r.first_complex_s << ", \"role_changes\": " << r.role_changes
+    << ", \"first_role_change_s\": " << r.first_role_change_s
+    << ", \"storage_min\": " << r.storage_min << ", \"storage_empty_s\": " << r.storage_empty_s
+    << ", \"jams\": " << r.jams << ", \"jammed_at_end\": " << r.jammed_at_end
+    << ", \"skill_failure_streak_max\": " << r.skill_failure_streak_max
     << ", \"messages_sent\": " << r.messages_sent
     << ", \"messages_dropped\": " << r.messages_dropped << ", \"cpu_s\": " << r.cpu_s
     << ", \"real_time_factor\": " << r.real_time_factor << ", \"result_hash\": \"" << std::hex

@@ -11,6 +11,7 @@
 #include "llsf/kinematic/world_config.h"
 #include "llsf/planner/config.h"
 #include "llsf/refbox/config.h"
+#include "llsf/sim/profile.h"
 
 namespace llsf::sim {
 
@@ -219,7 +220,8 @@ void read_tests(const core::ConfigNode& n, Scenario& s) {
     t.require_map();
     t.check_keys({"name", "points_at_least", "exploration_points_at_least",
                   "production_points_at_least", "deliveries_at_least", "collisions_at_most",
-                  "no_agent_errors", "by_s"});
+                  "no_agent_errors", "skill_failure_streak_at_most", "lock_hold_at_most_s",
+                  "by_s"});
     TestCase tc;
     int kinds = 0;
     auto kind = [&](const char* key, TestCase::Kind k) {
@@ -239,6 +241,8 @@ void read_tests(const core::ConfigNode& n, Scenario& s) {
     kind("deliveries_at_least", TestCase::Kind::kDeliveriesAtLeast);
     kind("collisions_at_most", TestCase::Kind::kCollisionsAtMost);
     kind("no_agent_errors", TestCase::Kind::kNoAgentErrors);
+    kind("skill_failure_streak_at_most", TestCase::Kind::kSkillFailureStreakAtMost);
+    kind("lock_hold_at_most_s", TestCase::Kind::kLockHoldAtMost);
     if (kinds != 1) t.fail("a test case needs exactly one condition (e.g. points_at_least: 30)");
     if (t["by_s"].defined()) {
       if (tc.kind != TestCase::Kind::kPointsAtLeast &&
@@ -257,7 +261,7 @@ Scenario read_scenario(const core::ConfigNode& root, const std::string& file) {
   root.require_map();
   root.check_keys({"name", "description", "seed", "seeds", "start", "duration_s", "refbox", "world",
                    "radio", "navigation", "levels", "rates", "team", "robots", "skills", "tests",
-                   "matrix", "hackathon"});
+                   "matrix", "hackathon", "profile"});
   const std::string dir = fs::path(file).parent_path().string();
   Scenario s;
   s.file = file;
@@ -266,7 +270,13 @@ Scenario read_scenario(const core::ConfigNode& root, const std::string& file) {
   root.read("description", s.description);
   s.seeds = read_seeds(root);
   if (root["refbox"].defined()) s.game.refbox = refbox::load_refbox_config(root["refbox"]);
-  if (root["world"].defined()) s.game.world = kinematic::load_world_config(root["world"]);
+  // The robot profile first: world, navigation and levels keys override its figures.
+  RobotProfile profile;
+  if (root["profile"].defined()) profile = load_profile(root["profile"]);
+  profile.apply(s.game, s.skills);
+  if (root["world"].defined()) {
+    s.game.world = kinematic::load_world_config(root["world"], s.game.world);
+  }
   if (root["radio"].defined()) s.game.hub = comm::load_hub_config(root["radio"]);
   if (root["navigation"].defined()) {
     planner::NavigationConfig nav{s.game.planner, s.game.controller};
@@ -300,6 +310,8 @@ Scenario read_scenario(const core::ConfigNode& root, const std::string& file) {
   if (root["skills"].defined()) {
     s.skills = lua::SkillEngineConfig::from_config(root["skills"]);
     for (std::string& d : s.skills.skill_dirs) d = resolve(dir, d);
+    s.skills.profile = profile.name;
+    s.skills.stuck_detection = profile.stuck_detection;
   }
   read_tests(root["tests"], s);
   s.game.seed = s.seeds.front();
@@ -333,6 +345,12 @@ std::string describe(const TestCase& t) {
       break;
     case TestCase::Kind::kNoAgentErrors:
       ss << "no agent runtime errors";
+      break;
+    case TestCase::Kind::kSkillFailureStreakAtMost:
+      ss << "<= " << t.value << " failures of one skill in a row";
+      break;
+    case TestCase::Kind::kLockHoldAtMost:
+      ss << "no lock held longer than " << t.value << " s";
       break;
   }
   if (t.by_s) ss << " by " << *t.by_s << " s";

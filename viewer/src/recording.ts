@@ -389,6 +389,9 @@ export class Recording {
         kind: "failure",
         label: `${line.robot}: ${line.string ?? ""} failed: ${line.error ?? ""}`,
       });
+    } else if (line.e === "jam" && line.jammed) {
+      // Robot profiles: a robot jammed at a device (docs/profiles.md).
+      this.markers.push({t: line.t, kind: "failure", label: `${line.robot} jammed at ${line.d}`});
     } else if (line.e === "collision") {
       this.markers.push({
         t: line.t,

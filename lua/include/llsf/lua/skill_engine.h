@@ -40,6 +40,11 @@ struct SkillEngineConfig {
   bool hot_reload = true;
   /// Seed of `math.random` inside the interpreter (e.g. from rng.stream("lua/robot1")).
   std::uint64_t random_seed = 0;
+  /// The robot profile, as skills see it in the global table `profile` (`profile.name`,
+  /// `profile.stuck_detection`): set by sim's robot profiles (docs/profiles.md), not a YAML key.
+  std::string profile = "ideal";
+  /// Whether skills give up when the robot makes no progress (their stall checks and timeouts).
+  bool stuck_detection = true;
 
   /// Throws core::ConfigError naming the bad field.
   void validate() const;

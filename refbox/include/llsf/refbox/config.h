@@ -19,6 +19,9 @@ namespace llsf::refbox {
 struct RefboxConfig {
   /// Rules variant name: "refbox-0.6.1" (default) or "rulebook-2013" (see RulesVariant).
   std::string rules = std::string(kRulesRefbox061);
+  /// Points per recycled puck instead of the rules variant's (3 in refbox-0.6.1, 5 in the
+  /// rule book); unset = the variant's. The thesis' games counted 5 (thesis §5.3.2).
+  std::optional<int> recycle_points;
   /// Team name. Empty = training game: start goes straight to EXPLORATION (spec §4).
   std::string team;
   /// Skip SETUP even with a team name.

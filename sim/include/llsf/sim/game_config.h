@@ -90,6 +90,34 @@ struct SymbolicConfig {
   double turn_rate_rps = 1.5;
 };
 
+/// The robots' low-level behaviour that sets the pace and the failures of a game (set by a robot
+/// profile, docs/profiles.md). The defaults change nothing.
+struct HandlingConfig {
+  /// After the navigator arrives at the end of a drive of at least `align_min_drive_m`, the
+  /// robot spends this long on its fine alignment (move_base's goal approach and the alignment
+  /// in front of a machine) before the navigator reports the arrival. Short moves (pushing a
+  /// puck under a reader) are not aligned again.
+  double align_s = 0.0;
+  double align_min_drive_m = 0.5;
+  /// Direct motor commands (RobotApi::set_velocity: motor_move, take_puck, ...) are capped to
+  /// these; 0 = no cap.
+  double motor_max_speed_mps = 0.0;
+  double motor_max_omega_rps = 0.0;
+  /// A jam: when the robot starts moving by direct motor commands within `jam_zone_m` of a
+  /// device's front, it jams against the device with this probability (one draw per such
+  /// approach, stream "sim/<robot>/jam"): from then on it neither moves towards the device nor
+  /// turns, until a command moves it away from the device (which frees it).
+  double jam_probability = 0.0;
+  double jam_zone_m = 0.5;
+  /// With `stuck_detection`, the skills' recovery frees a jammed robot after this long (their
+  /// stall checks notice it and the robot wiggles free); without, only moving away frees it.
+  double jam_recovery_s = 5.0;
+  /// Whether skills give up when the robot makes no progress (motor_move's stall check and
+  /// deadline, take_puck's creep timeout, drive_to's timeout). Skills read it as
+  /// `profile.stuck_detection`; false = the thesis' agent, which had no stuck detection.
+  bool stuck_detection = true;
+};
+
 /// The abstraction levels of every robot's interfaces (RobotApi).
 struct RobotLevelsConfig {
   LocalizationConfig localization;
@@ -109,6 +137,9 @@ struct GameConfig {
   planner::PlannerConfig planner;
   planner::ControllerConfig controller;
   RobotLevelsConfig levels;
+  HandlingConfig handling;
+  /// The robot profile these fields came from ("ideal" unless a scenario says otherwise).
+  std::string profile = "ideal";
   /// Scenario seed: every random draw comes from a named stream of it.
   std::uint64_t seed = 1;
   /// Skill cycles per second (RobotBrain::on_skill_cycle); the physics step comes from

@@ -163,6 +163,11 @@ class RobotStack final : public lua::RobotApi {
   void on_teleported(const core::Pose2D& from, const core::Pose2D& to);
   /// The symbolic requests since the last call (the Game carries them out in tick step 2).
   std::vector<SymbolicRequest>& symbolic_requests() { return symbolic_requests_; }
+  /// Handling (robot profiles): whether the robot is jammed against a device now, the device
+  /// (DeviceView index; -1 none), and how many jams it had.
+  bool jammed() const { return jam_device_ >= 0; }
+  int jam_device() const { return jam_device_; }
+  int jams() const { return jams_; }
 
  private:
   enum class Drive : std::uint8_t { kIdle, kNavigator, kMotor };
@@ -200,6 +205,18 @@ class RobotStack final : public lua::RobotApi {
   Drive drive_ = Drive::kIdle;
   kinematic::MotorCommand velocity_;
   std::uint64_t goal_id_ = 0;
+  // Handling (robot profiles): alignment after arrival, motor caps, jams.
+  HandlingConfig handling_;
+  core::RandomStream jam_rng_;
+  core::Pose2D true_pose_;
+  std::optional<SimTime> arrived_at_;  ///< when the navigator arrived at the current goal
+  core::Vec2 goal_from_{0.0, 0.0};     ///< where the robot stood when the goal was given
+  SimTime jammed_since_;
+  bool motor_started_ = false;  ///< a new run of direct motor commands began
+  int jam_device_ = -1;
+  int jams_ = 0;
+  /// Applies the motor caps and the jam to a command; may start or end a jam.
+  kinematic::MotorCommand handle(kinematic::MotorCommand c, bool motor);
 
   // Localization.
   core::RandomStream loc_rng_;

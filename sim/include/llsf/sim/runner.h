@@ -53,6 +53,7 @@ struct RunResult {
   std::string scenario;
   std::string variant;
   std::uint64_t seed = 0;
+  std::string profile;  ///< the robot profile's name (docs/profiles.md)
   double game_time_s = 0.0;
   int points = 0;  ///< the refbox's total
   int exploration_points = 0;
@@ -63,6 +64,7 @@ struct RunResult {
   std::vector<OrderResult> orders;
   int products_p1 = 0, products_p2 = 0, products_p3 = 0;  ///< made (machine completions)
   int recycled = 0;
+  int recycle_points = 0;  ///< points the recycling awards gave
   int collisions = 0;
   int skill_failures = 0;
   int agent_runtime_errors = 0;
@@ -75,6 +77,25 @@ struct RunResult {
   int lock_waits = 0;
   double lock_wait_s = 0.0;      ///< summed over robots and resources
   double lock_wait_max_s = 0.0;  ///< the longest single wait
+  /// The longest time one robot held one lock (grant to release or the end), not counting
+  /// holds of a robot that was jammed (robot profiles) when the hold ended.
+  double lock_hold_max_s = 0.0;
+  /// The thesis' measures (docs/statistics.md): the production game time at which the first
+  /// complex product (P1/P2: a T3 or T4 completed) was made, -1 if none; the team agent's role
+  /// changes ("production: role change" decisions) and the game time of the first, -1 if none;
+  /// the fewest pucks left in the input storage (its area grown by 0.1 m, so that pucks pushed
+  /// just past its marks count; sampled every second; pucks held by a robot not counted) and the
+  /// game time it first was empty, -1 if never.
+  double first_complex_s = -1.0;
+  int role_changes = 0;
+  double first_role_change_s = -1.0;
+  int storage_min = 0;
+  double storage_empty_s = -1.0;
+  /// Robot profiles: jams at devices, robots jammed at the end, and the longest run of failures
+  /// of one skill by one robot without a success of that skill in between.
+  int jams = 0;
+  int jammed_at_end = 0;
+  int skill_failure_streak_max = 0;
   std::int64_t messages_sent = 0;
   std::int64_t messages_dropped = 0;
   double cpu_s = 0.0;

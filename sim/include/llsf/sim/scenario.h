@@ -33,6 +33,8 @@ struct TestCase {
     kDeliveriesAtLeast,         ///< products delivered >= value (at `by_s` if set)
     kCollisionsAtMost,          ///< robot-robot + robot-wall + robot-device contacts <= value
     kNoAgentErrors,             ///< no CLIPS runtime error in any agent
+    kSkillFailureStreakAtMost,  ///< RunResult::skill_failure_streak_max <= value
+    kLockHoldAtMost,            ///< RunResult::lock_hold_max_s <= value
   };
   std::string name;
   Kind kind = Kind::kPointsAtLeast;
