@@ -14,7 +14,8 @@ documentation      = [==[Drives to a named place or to a pose with the navigator
 @param ori           heading at the pose (rad, default 0)
 @param forward_only  keep the holder in front, never drive backwards (default: true while a
                      puck is in the holder, so that it is not lost)
-@param timeout       seconds before giving up (default 120)
+@param timeout       seconds before giving up (default 120; none without stuck detection,
+                     profile.stuck_detection false)
 Fails: "drive_to needs place=<name> or x=, y=", the navigator's outcome with its reason
 ("navigator NO_PATH: ...", "INVALID_GOAL: unknown place 'M11'", "BLOCKED by robot2",
 "STUCK: ..."), or "no arrival within N s".
@@ -34,7 +35,8 @@ local function navigator_failed(self)
 end
 
 local function timed_out(self, vars)
-   if clock.now() < vars.deadline then return false end
+   -- Without stuck detection (profile.stuck_detection false) there is no timeout.
+   if not profile.stuck_detection or clock.now() < vars.deadline then return false end
    self.fsm.error = string.format("no arrival within %g s", vars.timeout or 120)
    return true
 end

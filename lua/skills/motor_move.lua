@@ -16,7 +16,9 @@ documentation      = [==[Moves the robot relative to where it stands, without pa
 @param vel_rot    top turn rate (rad/s, default 1.0)
 @param tolerance  position tolerance (m, default 0.01; heading: 0.03 rad)
 Fails: "motor_move: no progress for 2 s (blocked?)" when something holds the robot back,
-"motor_move: not there after N s", "motor_move needs numbers x, y, ori".
+"motor_move: not there after N s", "motor_move needs numbers x, y, ori". Without stuck
+detection (profile.stuck_detection false, the robotino-2013 profile: the thesis' skills had
+none) it neither checks progress nor gives up: a robot held back keeps trying.
 ]==]
 
 local function field_goal(vars)
@@ -54,6 +56,7 @@ local function there(self, vars)
 end
 
 local function stalled(self, vars)
+   if not profile.stuck_detection then return false end
    local now = clock.now()
    local _, _, et, d = errors(vars)
    local progress = d + 0.2 * math.abs(et)
@@ -69,7 +72,7 @@ local function stalled(self, vars)
 end
 
 local function timed_out(self, vars)
-   if clock.now() < vars.deadline then return false end
+   if not profile.stuck_detection or clock.now() < vars.deadline then return false end
    self.fsm.error = string.format("motor_move: not there after %.0f s", vars.limit)
    return true
 end
