@@ -57,6 +57,9 @@ RobotProfile robotino_2013() {
   p.light_frame_rate_hz = 2.0;
   p.light_delay_s = 1.0;
   p.light_error_rate = 0.0;
+  // Thesis §5.1.3: Gazsim-Light-Front takes the lights' states from the simulation (a blinking
+  // lamp is a state, not pixels a 2 Hz camera would alias).
+  p.light_reads_states = true;
   p.laser_rate_hz = 5.0;  // thesis §6.1.1: half the real sensor's 10 Hz
   // Thesis §6.1.1: amcl, no difference to reality seen; Fig. 6.4c: wrongly localized robots.
   p.localization = LocalizationLevel::kNoisy;
@@ -136,6 +139,7 @@ void RobotProfile::apply(GameConfig& game, lua::SkillEngineConfig& skills) const
   l.frame_rate_hz = light_frame_rate_hz;
   l.delay = SimTime::from_seconds(light_delay_s);
   l.error_rate = light_error_rate;
+  l.reads_states = light_reads_states;
   LocalizationConfig& loc = game.levels.localization;
   loc.level = localization;
   loc.position_noise_m = position_noise_m;
@@ -172,6 +176,7 @@ RobotProfile load_profile(const core::ConfigNode& node) {
                    "light_frame_rate_hz",
                    "light_delay_s",
                    "light_error_rate",
+                   "light_reads_states",
                    "laser_rate_hz",
                    "localization",
                    "position_noise_m",
@@ -211,6 +216,7 @@ RobotProfile load_profile(const core::ConfigNode& node) {
   node.read("light_frame_rate_hz", p.light_frame_rate_hz);
   node.read("light_delay_s", p.light_delay_s);
   node.read("light_error_rate", p.light_error_rate);
+  node.read("light_reads_states", p.light_reads_states);
   node.read("laser_rate_hz", p.laser_rate_hz);
   if (node["localization"].defined()) {
     const std::string v = node["localization"].as_string();

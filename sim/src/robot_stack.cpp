@@ -463,10 +463,17 @@ void RobotStack::sense_light_vision(const RobotPercept& p) {
       }
       lit_history_[static_cast<std::size_t>((lit_head_ + lit_count_) % hcap)] = {p.now, bits};
       ++lit_count_;
-      // A reading needs a full blink period of frames of this device. A lamp that changed
-      // between lit and unlit twice within the period blinks; otherwise its latest state holds
-      // (a steady lamp switching on or off changes once).
-      if (p.now - light_observed_since_ >= refbox::kBlinkPeriod) {
+      if (c.reads_states) {
+        // The lamps' states as the simulation knows them (Gazsim-Light-Front).
+        f.reading.visible = true;
+        f.reading.device = devices_[static_cast<std::size_t>(d)].name;
+        f.reading.red = to_lamp(l.red);
+        f.reading.yellow = to_lamp(l.yellow);
+        f.reading.green = to_lamp(l.green);
+      } else if (p.now - light_observed_since_ >= refbox::kBlinkPeriod) {
+        // A reading needs a full blink period of frames of this device. A lamp that changed
+        // between lit and unlit twice within the period blinks; otherwise its latest state
+        // holds (a steady lamp switching on or off changes once).
         f.reading.visible = true;
         f.reading.device = devices_[static_cast<std::size_t>(d)].name;
         for (int i = 0; i < 3; ++i) {
@@ -481,6 +488,8 @@ void RobotStack::sense_light_vision(const RobotPercept& p) {
                                   : (bits >> i) & 1 ? lua::Lamp::kOn
                                                     : lua::Lamp::kOff;
         }
+      }
+      if (f.reading.visible) {
         // A misread: one lamp reported in one of the two wrong states. Three draws per
         // reading, whatever the outcome, so the stream does not depend on the error rate.
         const double u = light_rng_.uniform01();

@@ -166,8 +166,11 @@ class FailureStreaks {
     const std::string skill = ch.skill_string.substr(0, ch.skill_string.find('{'));
     int& n = runs_[{ch.robot, skill}];
     if (ch.status == lua::SkillStatus::kFailed) {
-      // A skill aborted by a newer skill string did not fail on its own.
-      if (ch.error.find("aborted") != std::string::npos) return;
+      // A skill aborted by a newer skill string did not fail on its own; an empty storage is
+      // no livelock (the agents wait before they look again).
+      if (ch.error.find("aborted") != std::string::npos ||
+          ch.error.find("no puck seen") != std::string::npos)
+        return;
       max_ = std::max(max_, ++n);
     } else if (ch.status == lua::SkillStatus::kFinal) {
       n = 0;

@@ -233,3 +233,61 @@ TEST_CASE("recycle never: no consumed puck is taken, also when the storage looks
     CHECK(e.get_consumed_tasks > 0);
   }
 }
+
+TEST_CASE("production: a T3 that rejects the S0 has one: noted, and the next S0 goes elsewhere") {
+  // An insert that failed half-way (the robot stuck after the puck reached the reader) still
+  // counted at the machine; without noting it the agent brought S0 after S0 to the same T3,
+  // each rejected (yellow blinking), for the rest of the game (robotino-2013, seed 50).
+  Rules r;
+  r.production("P1", "M3");
+  r.f.agent().set_pose({2.0, 1.0, 0.0});
+  r.eval("(t-hold S0)");
+  r.f.steps(2);
+  REQUIRE(r.last_call() == "finish_puck_at{place=\"M3\"}");
+  r.f.skills().set_status(SkillStatus::kFailed,
+                          "finish_puck_at: M3 rejected the puck (yellow blinking: invalid input)");
+  r.f.steps(2);
+  const auto m3 = r.f.find("machine", {{"name", Value::symbol("M3")}});
+  REQUIRE(m3.size() == 1);
+  REQUIRE(m3[0].slot("loaded-with").items.size() == 1);
+  CHECK(m3[0].slot("loaded-with").items[0] == Value::symbol("S0"));
+  CHECK(r.f.find("holding", {{"puck", Value::symbol("UNKNOWN")}}).size() == 1);
+  // The rejected puck is left aside; with the S0 noted at the T3, the next S0 goes to a T1.
+  CHECK(r.last_call().rfind("leave_puck", 0) == 0);
+  r.f.skills().set_status(SkillStatus::kFinal);
+  r.f.steps(2);
+  CHECK(r.last_call() == "get_s0{}");
+  r.f.skills().set_status(SkillStatus::kFinal);
+  r.f.steps(2);
+  CHECK(r.last_call() == "finish_puck_at{place=\"M8\"}");
+  CHECK(r.f.agent().runtime_errors() == 0);
+}
+
+TEST_CASE("recycling: consumed pucks the robot cannot drive up to are given up") {
+  // A consumed puck beside M10 lay too close to the wall for the navigator (INVALID_GOAL);
+  // robots tried to fetch it again and again for the rest of the game (ideal, P1-P2-P3-RD, 68).
+  Rules r({clips::ConfigEntry::of("/clips-agent/recycle", "ifpossible")});
+  r.production("P1", "M3");
+  r.f.agent().set_pose({2.0, 1.0, 0.0});
+  r.eval("(do-for-fact ((?m machine)) (eq ?m:name M1) (modify ?m (consumed 1)))");
+  r.f.steps(2);
+  REQUIRE(r.last_call() == "get_consumed{place=\"M1\"}");
+  r.f.skills().set_status(SkillStatus::kFailed,
+                          "get_consumed: TAKE()/take_puck failed: APPROACH()/drive_to failed: "
+                          "navigator INVALID_GOAL: goal (4.2, 1.2) is 0.232 m from wall y=0; the "
+                          "robot needs 0.260 m");
+  r.f.steps(2);
+  const auto m1 = r.f.find("machine", {{"name", Value::symbol("M1")}});
+  REQUIRE(m1.size() == 1);
+  CHECK(m1[0].slot("consumed") == Value::integer_value(0));
+  // Whatever the robot does next, it does not go back for that puck.
+  bool s0 = false;
+  for (int i = 0; i < 5 && !s0; ++i) {
+    CHECK(r.last_call() != "get_consumed{place=\"M1\"}");
+    s0 = r.last_call() == "get_s0{}";
+    r.f.skills().set_status(SkillStatus::kFinal);
+    r.f.steps(2);
+  }
+  CHECK(s0);
+  CHECK(r.f.agent().runtime_errors() == 0);
+}

@@ -155,6 +155,40 @@ TEST_CASE("light vision: a change shows about one delay later, a blink after a f
   CHECK(blink_readings > 300);
 }
 
+TEST_CASE(
+    "light vision at 2 Hz: pixels alias a 2 Hz blink, reads_states tells it (robotino-2013)") {
+  RobotLevelsConfig levels;
+  levels.light.level = DetectionLevel::kVision;
+  levels.light.error_rate = 0.0;
+  levels.light.frame_rate_hz = 2.0;  // thesis §6.1.1: the webcam at 2 Hz
+  for (const bool states : {false, true}) {
+    CAPTURE(states);
+    levels.light.reads_states = states;
+    Rig rig(levels);
+    rig.pose = facing(rig.config.world, 4, 0.6);
+    rig.lights[4] = {kOff, kBlink, kOn};
+    int readings = 0, blink = 0;
+    double first = -1.0;
+    for (int k = 0; k < 1000; ++k) {  // 10 s
+      rig.tick();
+      const lua::LightReading r = rig.stack.light();
+      if (!r.visible) continue;
+      if (first < 0) first = rig.now.seconds();
+      ++readings;
+      CHECK(r.red == lua::Lamp::kOff);
+      CHECK(r.green == lua::Lamp::kOn);
+      if (r.yellow == lua::Lamp::kBlink) ++blink;
+    }
+    CHECK(readings > 800);
+    if (states) {
+      CHECK(blink == readings);  // every reading: blinking
+      CHECK(first <= 1.1);       // the first frame, one delay late
+    } else {
+      CHECK(blink == 0);  // one frame per blink period: always the same phase
+    }
+  }
+}
+
 TEST_CASE("light vision: must face the device, and the front of it") {
   RobotLevelsConfig levels;
   levels.light.level = DetectionLevel::kVision;

@@ -303,13 +303,25 @@
   (if (or (str-index "no puck in the holder" ?e) (str-index "lost the puck" ?e)) then
     (set-holding NONE))
   (if (str-index "already holding a puck" ?e) then (set-holding UNKNOWN))
-  (if (str-index "rejected the puck" ?e) then (set-holding UNKNOWN))
+  (if (str-index "rejected the puck" ?e) then
+    ; A multi-input machine that rejects an S0/S1/S2 has one of that kind already: an earlier
+    ; insert that failed half-way (the robot stuck after the puck reached the reader) still
+    ; counted. Note it, or the next puck of this kind is brought to the same machine again.
+    (bind ?held (fact-slot-value (nth$ 1 (find-fact ((?x holding)) TRUE)) puck))
+    (if (and (member$ (machine-slot ?m mtype) (create$ T2 T3 T4))
+             (member$ ?held (type-inputs (machine-slot ?m mtype)))
+             (not (member$ ?held (machine-slot ?m loaded-with)))) then
+      (machine-update ?m loaded-add ?held))
+    (set-holding UNKNOWN))
   (if (str-index "is down (red)" ?e) then (machine-update ?m down-until (+ (now) 30.0)))
   (if (and (eq ?k GET_S0) (str-index "no puck seen" ?e)) then
     ; Look again in 30 s (pucks may be pushed back, late-order pucks arrive); meanwhile wait, or
     ; recycle with recycle-when-empty.
     (assert (storage-empty (until (+ (now) 30.0)))))
-  (if (and (eq ?k GET_CONSUMED) (str-index "no puck beside" ?e)) then
+  (if (and (eq ?k GET_CONSUMED)
+           (or (str-index "no puck beside" ?e) (str-index "INVALID_GOAL" ?e))) then
+    ; None there, or none the robot can reach (lying too close to a wall to drive up to):
+    ; forget them, or every robot tries again and again.
     (machine-update ?m consumed-set 0))
   (if (and (eq ?k DELIVER) (or (str-index "refused" ?e) (str-index "no active gate" ?e))) then
     (assert (task-cooldown (until (+ (now) 10.0)))))

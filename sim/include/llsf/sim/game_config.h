@@ -68,6 +68,11 @@ struct LightDetectionConfig {
   double frame_rate_hz = 10.0;           ///< vision only
   SimTime delay = SimTime::from_sec(1);  ///< vision only
   double error_rate = 0.05;              ///< vision only; [0, 1]
+  /// vision only: each frame reads the lamps' states (on, off, blinking) of the device in front,
+  /// as the thesis' Gazsim-Light-Front plugin took them from the simulation (thesis §5.1.3),
+  /// instead of classifying lit and unlit frames (which needs several frames per blink period:
+  /// a 2 Hz camera cannot tell a 2 Hz blink from a steady lamp).
+  bool reads_states = false;
 };
 
 /// Puck detection (relative positions in the robot frame). `ground_truth`: every puck within

@@ -39,6 +39,7 @@ struct RobotProfile {
   double light_frame_rate_hz = 10.0;
   double light_delay_s = 1.0;
   double light_error_rate = 0.05;
+  bool light_reads_states = false;  ///< LightDetectionConfig::reads_states
   double laser_rate_hz = 5.0;
   LocalizationLevel localization = LocalizationLevel::kGroundTruth;
   double position_noise_m = 0.01;

@@ -92,7 +92,8 @@ struct RunResult {
   int storage_min = 0;
   double storage_empty_s = -1.0;
   /// Robot profiles: jams at devices, robots jammed at the end, and the longest run of failures
-  /// of one skill by one robot without a success of that skill in between.
+  /// of one skill by one robot without a success of that skill in between (not counting
+  /// failures of a jammed robot, skills aborted by a newer one, and get_s0's "no puck seen").
   int jams = 0;
   int jammed_at_end = 0;
   int skill_failure_streak_max = 0;
