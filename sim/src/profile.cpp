@@ -154,87 +154,80 @@ void RobotProfile::apply(GameConfig& game, lua::SkillEngineConfig& skills) const
   skills.profile = name;
 }
 
+namespace {
+
+// The profile's figures by key: what load_profile reads (and accepts besides name, light,
+// localization).
+struct NumberKey {
+  const char* key;
+  double RobotProfile::*field;
+};
+constexpr NumberKey kNumbers[] = {
+    {"max_speed_mps", &RobotProfile::max_speed_mps},
+    {"max_omega_rps", &RobotProfile::max_omega_rps},
+    {"max_accel_mps2", &RobotProfile::max_accel_mps2},
+    {"max_alpha_rps2", &RobotProfile::max_alpha_rps2},
+    {"motor_max_speed_mps", &RobotProfile::motor_max_speed_mps},
+    {"motor_max_omega_rps", &RobotProfile::motor_max_omega_rps},
+    {"align_s", &RobotProfile::align_s},
+    {"light_frame_rate_hz", &RobotProfile::light_frame_rate_hz},
+    {"light_delay_s", &RobotProfile::light_delay_s},
+    {"light_error_rate", &RobotProfile::light_error_rate},
+    {"laser_rate_hz", &RobotProfile::laser_rate_hz},
+    {"position_noise_m", &RobotProfile::position_noise_m},
+    {"heading_noise_rad", &RobotProfile::heading_noise_rad},
+    {"wait_before_replan_s", &RobotProfile::wait_before_replan_s},
+    {"backoff_min_s", &RobotProfile::backoff_min_s},
+    {"backoff_max_s", &RobotProfile::backoff_max_s},
+    {"blocked_timeout_s", &RobotProfile::blocked_timeout_s},
+    {"jam_probability", &RobotProfile::jam_probability},
+};
+
+RobotProfile named_or_fail(const core::ConfigNode& n) {
+  try {
+    return RobotProfile::named(n.as_string());
+  } catch (const std::invalid_argument&) {
+    n.fail("unknown profile '" + n.as_string() + "' (known: ideal, robotino-2013)");
+  }
+}
+
+template <class E>
+void read_level(const core::ConfigNode& node, const char* key, E& out, const char* a, E va,
+                const char* b, E vb) {
+  if (!node[key].defined()) return;
+  const std::string v = node[key].as_string();
+  if (v == a) {
+    out = va;
+  } else if (v == b) {
+    out = vb;
+  } else {
+    node[key].fail("'" + v + "' is not one of " + a + ", " + b);
+  }
+}
+
+}  // namespace
+
 RobotProfile load_profile(const core::ConfigNode& node) {
-  if (node.is_scalar()) {
-    const std::string name = node.as_string();
-    try {
-      return RobotProfile::named(name);
-    } catch (const std::invalid_argument&) {
-      node.fail("unknown profile '" + name + "' (known: ideal, robotino-2013)");
-    }
-  }
+  if (node.is_scalar()) return named_or_fail(node);
   node.require_map();
-  node.check_keys({"name",
-                   "max_speed_mps",
-                   "max_omega_rps",
-                   "max_accel_mps2",
-                   "max_alpha_rps2",
-                   "motor_max_speed_mps",
-                   "motor_max_omega_rps",
-                   "align_s",
-                   "light",
-                   "light_frame_rate_hz",
-                   "light_delay_s",
-                   "light_error_rate",
-                   "light_reads_states",
-                   "laser_rate_hz",
-                   "localization",
-                   "position_noise_m",
-                   "heading_noise_rad",
-                   "wait_before_replan_s",
-                   "backoff_min_s",
-                   "backoff_max_s",
-                   "blocked_timeout_s",
-                   "jam_probability",
-                   "stuck_detection"});
-  const core::ConfigNode n = node["name"];
+  for (const std::string& key : node.keys()) {
+    bool known = key == "name" || key == "light" || key == "localization" ||
+                 key == "light_reads_states" || key == "stuck_detection";
+    for (const NumberKey& k : kNumbers) known = known || key == k.key;
+    if (!known) {
+      std::string allowed = "name, light, localization, light_reads_states, stuck_detection";
+      for (const NumberKey& k : kNumbers) allowed += std::string(", ") + k.key;
+      node[key].fail("unknown key '" + key + "' (allowed: " + allowed + ")");
+    }
+  }
   RobotProfile p;
-  if (n.defined()) {
-    try {
-      p = RobotProfile::named(n.as_string());
-    } catch (const std::invalid_argument&) {
-      n.fail("unknown profile '" + n.as_string() + "' (known: ideal, robotino-2013)");
-    }
-  }
-  node.read("max_speed_mps", p.max_speed_mps);
-  node.read("max_omega_rps", p.max_omega_rps);
-  node.read("max_accel_mps2", p.max_accel_mps2);
-  node.read("max_alpha_rps2", p.max_alpha_rps2);
-  node.read("motor_max_speed_mps", p.motor_max_speed_mps);
-  node.read("motor_max_omega_rps", p.motor_max_omega_rps);
-  node.read("align_s", p.align_s);
-  if (node["light"].defined()) {
-    const std::string v = node["light"].as_string();
-    if (v == "ground_truth") {
-      p.light = DetectionLevel::kGroundTruth;
-    } else if (v == "vision") {
-      p.light = DetectionLevel::kVision;
-    } else {
-      node["light"].fail("'" + v + "' is not one of ground_truth, vision");
-    }
-  }
-  node.read("light_frame_rate_hz", p.light_frame_rate_hz);
-  node.read("light_delay_s", p.light_delay_s);
-  node.read("light_error_rate", p.light_error_rate);
+  if (node["name"].defined()) p = named_or_fail(node["name"]);
+  for (const NumberKey& k : kNumbers) node.read(k.key, p.*k.field);
+  read_level(node, "light", p.light, "ground_truth", DetectionLevel::kGroundTruth, "vision",
+             DetectionLevel::kVision);
+  read_level(node, "localization", p.localization, "ground_truth", LocalizationLevel::kGroundTruth,
+             "noisy", LocalizationLevel::kNoisy);
   node.read("light_reads_states", p.light_reads_states);
-  node.read("laser_rate_hz", p.laser_rate_hz);
-  if (node["localization"].defined()) {
-    const std::string v = node["localization"].as_string();
-    if (v == "ground_truth") {
-      p.localization = LocalizationLevel::kGroundTruth;
-    } else if (v == "noisy") {
-      p.localization = LocalizationLevel::kNoisy;
-    } else {
-      node["localization"].fail("'" + v + "' is not one of ground_truth, noisy");
-    }
-  }
-  node.read("position_noise_m", p.position_noise_m);
-  node.read("heading_noise_rad", p.heading_noise_rad);
-  node.read("wait_before_replan_s", p.wait_before_replan_s);
-  node.read("backoff_min_s", p.backoff_min_s);
-  node.read("backoff_max_s", p.backoff_max_s);
-  node.read("blocked_timeout_s", p.blocked_timeout_s);
-  node.read("jam_probability", p.jam_probability);
   node.read("stuck_detection", p.stuck_detection);
   try {
     p.validate();
