@@ -39,8 +39,8 @@ void at_most(const char* field, double v, double max) {
 RobotProfile robotino_2013() {
   RobotProfile p;
   p.name = "robotino-2013";
-  // Calibrated: a single P1P2 robot's first complex product at 10:30 min (thesis §5.3.3),
-  // within what a 2013 Robotino on move_base drives (docs/profiles.md).
+  // Assumption: a 2013 Robotino on move_base (no source gives its speed; the sensitivity sweep
+  // varies it); the turn rate halved with it.
   p.max_speed_mps = 0.5;
   p.max_omega_rps = 1.0;
   p.max_accel_mps2 = 0.5;  // assumption: half the ideal, with the halved top speed
@@ -48,8 +48,9 @@ RobotProfile robotino_2013() {
   // Assumption: Fawkes' relative motion at a machine creeps (no source gives a figure).
   p.motor_max_speed_mps = 0.15;
   p.motor_max_omega_rps = 0.5;
-  // Calibrated with max_speed_mps (same target): move_base's goal approach and the laser
-  // alignment in front of a machine.
+  // Calibrated (the only calibrated figure): a single P1P2 robot's first complex product at
+  // 10:30 min (thesis §5.3.3); move_base's goal approach and the laser alignment in front of a
+  // machine after every drive.
   p.align_s = 12.0;
   // Thesis §6.1.1: webcam at 2 Hz, light detection about 1 s late; §6.1.3: the light
   // detection is very reliable in the simulation.
