@@ -291,3 +291,32 @@ TEST_CASE("recycling: consumed pucks the robot cannot drive up to are given up")
   CHECK(s0);
   CHECK(r.f.agent().runtime_errors() == 0);
 }
+
+TEST_CASE("role change time-left: only between two productions, never one under way") {
+  // The 2013 agent changed P1P2 -> P3 when too little time was left "and nothing is loaded"; a
+  // rule that changed whenever the robot held nothing turned every game's P1P2 robot into a P3
+  // at exactly 420 s left, abandoning the pucks already in its T3 (thesis experiment, F3).
+  Rules r({clips::ConfigEntry::of("/clips-agent/role-change/time-left", 420)});
+  r.production("P1P2", "M3");
+  r.f.agent().set_pose({2.0, 1.0, 0.0});
+  r.eval("(t-loaded M3 S0 S1)");
+  r.eval("(do-for-fact ((?g game)) TRUE (modify ?g (time 600.0)))");  // 300 s left
+  r.f.steps(2);
+  CHECK(r.f.find("role", {{"name", Value::symbol("P1P2")}}).size() == 1);
+  // The product is taken out: nothing loaded any more, and too little time for another one.
+  r.eval("(t-loaded M3)");
+  r.f.steps(2);
+  CHECK(r.f.find("role", {{"name", Value::symbol("P3")}}).size() == 1);
+  CHECK(r.f.agent().runtime_errors() == 0);
+}
+
+TEST_CASE("role change time-left: not while enough time is left") {
+  Rules r({clips::ConfigEntry::of("/clips-agent/role-change/time-left", 420)});
+  r.production("P1P2", "M3");
+  r.eval("(do-for-fact ((?g game)) TRUE (modify ?g (time 400.0)))");  // 500 s left
+  r.f.steps(2);
+  CHECK(r.f.find("role", {{"name", Value::symbol("P1P2")}}).size() == 1);
+  r.eval("(do-for-fact ((?g game)) TRUE (modify ?g (time 481.0)))");  // 419 s left
+  r.f.steps(2);
+  CHECK(r.f.find("role", {{"name", Value::symbol("P3")}}).size() == 1);
+}

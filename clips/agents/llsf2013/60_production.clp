@@ -179,11 +179,16 @@
   (change-role ?r "a complex product was delivered")
 )
 
+; Too little time left to start another complex product (thesis §5.3.3: "not reasonable to start
+; a second production"; the 2013 agent changed "when nothing is loaded"): only between two
+; productions -- the target machine has nothing loaded and the robot holds no intermediate. A
+; production under way is finished.
 (defrule prod-role-change-time-left
   (declare (salience ?*PRIORITY-DECIDE*))
   (game (phase PRODUCTION) (time ?gt))
-  ?r <- (role (name ~P3))
+  ?r <- (role (name ~P3) (target ?t))
   (holding (puck NONE|S0))
+  (machine (name ?t) (loaded-with))
   (test (> (cfg "/clips-agent/role-change/time-left" 0) 0))
   (test (> ?gt (- ?*PRODUCTION-TIME* (cfg "/clips-agent/role-change/time-left" 0))))
   =>
