@@ -233,7 +233,8 @@ Action add_experiment_command(CLI::App& app) {
   app.footer(
       "Plays every batch of the experiment (each scenario file: every matrix variant x N seeds, "
       "as llsfsim batch; resumable, Ctrl-C stores the running games and stops), then evaluates "
-      "its calibration targets, findings and sweeps per group against the stored runs, with "
+      "its calibration targets, findings, sweeps and tables per group against the stored runs, "
+      "with "
       "bootstrap 95 % intervals from a fixed seed (the same store gives the same report), and "
       "prints the verdicts. Verdicts are results: a finding that is not reproduced still exits "
       "0.\n"

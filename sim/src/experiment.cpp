@@ -370,6 +370,64 @@ Sweep read_sweep(const Experiment& e, const core::ConfigNode& n) {
   return s;
 }
 
+Table read_table(const Experiment& e, const core::ConfigNode& n) {
+  n.require_map();
+  n.check_keys({"name", "source", "batch", "rows", "values", "statistics", "where", "groups",
+                "ignore_below"});
+  Table t;
+  t.name = required_string(n, "name");
+  t.source = optional_string(n, "source");
+  t.where = where_of(n);
+  const ExperimentBatch& b = batch_of(e, n, &t.sel.batch);
+  read_selection_options(n, false, t.sel);
+  t.rows = required_string(n, "rows");
+  require_axis(b, t.rows, n["rows"]);
+  if (t.rows == e.group_by) {
+    n["rows"].fail("'" + e.group_by + "' is the group_by axis (tables are made per group)");
+  }
+  const auto& all = b.axis_values[static_cast<std::size_t>(b.axis_index(t.rows))];
+  if (n["values"].defined()) {
+    const core::ConfigNode v = n["values"];
+    if (!v.is_sequence() || v.size() == 0) v.fail("expected a list of values of '" + t.rows + "'");
+    for (const core::ConfigNode& x : v.elements()) {
+      require_value(b, t.rows, x.as_string(), x);
+      if (contains(t.values, x.as_string())) x.fail("a second row of this value");
+      t.values.push_back(x.as_string());
+    }
+  } else {
+    t.values = all;
+  }
+  const core::ConfigNode stats = n["statistics"];
+  if (!stats.defined()) n.fail("missing key 'statistics' (the columns: a list of statistics)");
+  if (!stats.is_sequence() || stats.size() == 0) stats.fail("expected a list of statistics");
+  for (const core::ConfigNode& x : stats.elements()) {
+    const std::string st = x.as_string();
+    if (!contains(known_statistics(), st)) {
+      x.fail("unknown statistic '" + st + "' (docs/statistics.md)");
+    }
+    t.statistics.push_back(st);
+  }
+  t.fixed = read_filter(e, b, n["where"]);
+  for (const auto& [axis, value] : t.fixed) {
+    if (axis == t.rows) n["where"][axis].fail("'" + axis + "' makes the rows; it cannot be fixed");
+  }
+  // Every other axis must be fixed: a mean over pooled variants would mean nothing.
+  for (const std::string& axis : b.scenario.axes) {
+    if (axis == t.rows || axis == e.group_by) continue;
+    const bool fixed =
+        std::any_of(t.fixed.begin(), t.fixed.end(), [&](const auto& f) { return f.first == axis; });
+    if (!fixed) {
+      n.fail("axis '" + axis + "' of batch '" + b.name +
+             "' is neither the rows nor fixed: give it in `where: {" + axis + ": ...}`");
+    }
+  }
+  t.groups = read_groups(e, n);
+  if (!t.groups.empty() && b.axis_index(e.group_by) < 0) {
+    n["groups"].fail("batch '" + b.name + "' has no axis '" + e.group_by + "'");
+  }
+  return t;
+}
+
 ExperimentBatch read_batch(const std::string& name, const core::ConfigNode& n,
                            const std::filesystem::path& dir) {
   ExperimentBatch b;
@@ -436,8 +494,8 @@ std::string to_string(Check::Kind k) {
 Experiment load_experiment(const std::string& path) {
   const core::ConfigNode root = core::ConfigNode::load_file(path);
   if (!root.is_map()) root.fail("an experiment file is a map (name, batches, findings, ...)");
-  root.check_keys(
-      {"name", "description", "batches", "group_by", "calibration", "findings", "sweeps"});
+  root.check_keys({"name", "description", "batches", "group_by", "calibration", "findings",
+                   "sweeps", "tables"});
   Experiment e;
   e.file = path;
   e.name = required_string(root, "name");
@@ -494,8 +552,13 @@ Experiment load_experiment(const std::string& path) {
     e.sweeps.push_back(read_sweep(e, n));
     if (!names.insert(e.sweeps.back().name).second) n["name"].fail("a second sweep of this name");
   }
-  if (e.calibration.empty() && e.findings.empty() && e.sweeps.empty()) {
-    root.fail("nothing to evaluate: give calibration targets, findings or sweeps");
+  names.clear();
+  for (const core::ConfigNode& n : list("tables")) {
+    e.tables.push_back(read_table(e, n));
+    if (!names.insert(e.tables.back().name).second) n["name"].fail("a second table of this name");
+  }
+  if (e.calibration.empty() && e.findings.empty() && e.sweeps.empty() && e.tables.empty()) {
+    root.fail("nothing to evaluate: give calibration targets, findings, sweeps or tables");
   }
   return e;
 }
@@ -821,6 +884,39 @@ SweepResult evaluate_sweep(const Experiment& e, const std::vector<BatchData>& da
   return r;
 }
 
+TableResult evaluate_table(const Experiment& e, const std::vector<BatchData>& data, const Table& t,
+                           const std::string& group) {
+  const BatchData& d = data[static_cast<std::size_t>(t.sel.batch)];
+  const ExperimentBatch& b = *d.batch;
+  for (const std::string& st : t.statistics) {
+    if (d.statistics.size() > 0 && d.statistics.count(st) == 0) {
+      throw core::ConfigError(t.where + ": no stored run of batch '" + b.name +
+                              "' has the statistic '" + st + "'");
+    }
+  }
+  TableResult r;
+  r.table = &t;
+  r.group = group;
+  for (const std::string& value : t.values) {
+    TableRow row;
+    row.value = value;
+    AxisFilter f = t.fixed;
+    f.emplace_back(t.rows, value);
+    f = with_group(e, b, f, group);
+    for (const std::string& st : t.statistics) {
+      Selection sel = t.sel;
+      sel.statistic = st;
+      SampleCounts n;
+      const std::vector<double> v = collect(d, sel, f, n);
+      row.runs = n.stored;
+      row.means.push_back(v.empty() ? 0.0 : mean_of(v));
+      row.n.push_back(n.used);
+    }
+    r.rows.push_back(std::move(row));
+  }
+  return r;
+}
+
 }  // namespace
 
 ExperimentResult evaluate(const Experiment& e, const StatsStore& store, const EvaluateOptions& o) {
@@ -874,6 +970,12 @@ ExperimentResult evaluate(const Experiment& e, const StatsStore& store, const Ev
   for (const Sweep& s : e.sweeps) {
     for (const std::string& g : groups_of(e, {s.sel.batch}, s.groups)) {
       r.sweeps.push_back(evaluate_sweep(e, data, s, g, o));
+    }
+  }
+
+  for (const Table& t : e.tables) {
+    for (const std::string& g : groups_of(e, {t.sel.batch}, t.groups)) {
+      r.tables.push_back(evaluate_table(e, data, t, g));
     }
   }
   return r;
@@ -930,6 +1032,22 @@ std::string top_two(const SweepRow& row) {
   return std::string(row.separated ? "separated" : "not separated") + ": " +
          signed_num(row.top_diff) + " [" + signed_num(row.top_low) + ", " +
          signed_num(row.top_high) + "]";
+}
+
+/// A table's cell: the mean, with the runs it counts if some were left out.
+std::string table_cell(const TableRow& row, std::size_t i) {
+  if (row.n[i] == 0) return "-";
+  return num(row.means[i]) + (row.n[i] != row.runs ? " (n " + std::to_string(row.n[i]) + ")" : "");
+}
+
+std::string table_heading(const TableResult& t, const Experiment& e) {
+  const Table& tb = *t.table;
+  return "Mean per run by `" + tb.rows + "` of batch `" +
+         e.batches[static_cast<std::size_t>(tb.sel.batch)].name + "`" +
+         (tb.fixed.empty() ? "" : " (" + filter_text(tb.fixed) + ")") +
+         (tb.sel.ignore_below ? ", values below " + bound(*tb.sel.ignore_below) + " left out"
+                              : "") +
+         ".";
 }
 
 std::string vs_baseline(const SweepRow& row, const Sweep& s) {
@@ -1023,6 +1141,33 @@ std::string to_text(const ExperimentResult& r) {
              "; top two " + top_two(row) + ")\n";
     }
   }
+
+  if (!r.tables.empty()) out += "\ntables\n";
+  for (const TableResult& t : r.tables) {
+    const Table& tb = *t.table;
+    out += "  " + tb.name + (t.group.empty() ? "" : " [" + t.group + "]") + ": " +
+           table_heading(t, e) + "\n";
+    std::size_t w = tb.rows.size();
+    for (const TableRow& row : t.rows) w = std::max(w, row.value.size());
+    std::vector<std::size_t> cw;
+    for (std::size_t i = 0; i < tb.statistics.size(); ++i) {
+      std::size_t c = tb.statistics[i].size();
+      for (const TableRow& row : t.rows) c = std::max(c, table_cell(row, i).size());
+      cw.push_back(c + 2);
+    }
+    auto add_line = [&out](std::string line) {
+      while (!line.empty() && line.back() == ' ') line.pop_back();
+      out += line + "\n";
+    };
+    std::string head = "    " + pad(tb.rows, w + 2) + pad("runs", 6);
+    for (std::size_t i = 0; i < tb.statistics.size(); ++i) head += pad(tb.statistics[i], cw[i]);
+    add_line(head);
+    for (const TableRow& row : t.rows) {
+      std::string line = "    " + pad(row.value, w + 2) + pad(std::to_string(row.runs), 6);
+      for (std::size_t i = 0; i < tb.statistics.size(); ++i) line += pad(table_cell(row, i), cw[i]);
+      add_line(line);
+    }
+  }
   return out;
 }
 
@@ -1102,6 +1247,26 @@ std::string to_markdown(const ExperimentResult& r) {
       cells.push_back(rw.ranking.empty() ? "-" : rw.ranking);
       cells.push_back(rw.differs ? "**differs**" : vs_baseline(rw, sw));
       cells.push_back(top_two(rw));
+      out += row(cells);
+    }
+  }
+
+  if (!r.tables.empty()) out += "\n### Tables\n";
+  for (const TableResult& t : r.tables) {
+    const Table& tb = *t.table;
+    out += "\n#### " + tb.name + (t.group.empty() ? "" : " (" + t.group + ")") + "\n\n";
+    if (!tb.source.empty()) out += "Source: " + tb.source + "\n\n";
+    out += table_heading(t, e) + "\n\n";
+    std::vector<std::string> head{tb.rows, "runs"};
+    std::string align = "|---|---:|";
+    for (const std::string& st : tb.statistics) {
+      head.push_back(st);
+      align += "---:|";
+    }
+    out += row(head) + align + "\n";
+    for (const TableRow& rw : t.rows) {
+      std::vector<std::string> cells{rw.value, std::to_string(rw.runs)};
+      for (std::size_t i = 0; i < tb.statistics.size(); ++i) cells.push_back(table_cell(rw, i));
       out += row(cells);
     }
   }

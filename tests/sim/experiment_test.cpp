@@ -274,6 +274,18 @@ TEST_CASE("experiment files: errors name file:line and the key") {
       {"sweeps:\n  - name: s\n    batch: conf\n    axis: config\n    compare: profile\n"
        "    statistic: points\n",
        ":11:", "is the group_by axis"},
+      {"tables:\n  - name: t\n    batch: conf\n    rows: config\n    statistics: [points, "
+       "pionts]\n",
+       ":11:", "unknown statistic 'pionts'"},
+      {"tables:\n  - name: t\n    batch: conf\n    rows: config\n",
+       ":8:", "missing key 'statistics'"},
+      {"tables:\n  - name: t\n    batch: conf\n    rows: profile\n    statistics: [points]\n",
+       ":10:", "is the group_by axis"},
+      {"tables:\n  - name: t\n    batch: conf\n    rows: config\n    values: [A, Z]\n"
+       "    statistics: [points]\n",
+       ":11:", "axis 'config' of batch 'conf' has no value 'Z'"},
+      {"tables:\n  - name: t\n    batch: sweep\n    rows: config\n    statistics: [points]\n",
+       ":8:", "axis 'speed' of batch 'sweep' is neither the rows nor fixed"},
   };
   for (const Case& c : cases) {
     const std::string e = load_error(f, c.body);
@@ -541,6 +553,43 @@ TEST_CASE("experiment sweeps: rankings per row, flips against the baseline, top 
             "| mid | 101.0 (n 3) | 100.0 (n 3) | 20.0 (n 3) | A > B > C | baseline | not "
             "separated: "));
   CHECK(has(md, "| fast | 100.0 (n 3) | 180.0 (n 3) | 20.0 (n 3) | B > A > C | **differs** |"));
+}
+
+TEST_CASE("experiment tables: means per row and group, left-out values counted") {
+  const StudyFixture f;
+  Experiment e;
+  const ExperimentResult r = f.evaluate_body(
+      "tables:\n"
+      "  - name: Why\n"
+      "    source: the mechanisms\n"
+      "    batch: conf\n"
+      "    rows: config\n"
+      "    values: [B, A]\n"
+      "    statistics: [points, lock_wait_max_s]\n"
+      "    ignore_below: 0\n",
+      e);
+  REQUIRE(r.tables.size() == 2);  // per profile
+  const TableResult& ideal = r.tables[0];
+  CHECK(ideal.group == "ideal");
+  REQUIRE(ideal.rows.size() == 2);
+  CHECK(ideal.rows[0].value == "B");
+  CHECK(ideal.rows[0].runs == 4);
+  CHECK(ideal.rows[0].means[0] == doctest::Approx(52.5));   // 51..54
+  CHECK(ideal.rows[0].n[1] == 0);                           // lock_wait_max_s -1: left out
+  CHECK(ideal.rows[1].means[0] == doctest::Approx(102.5));  // 101..104
+  CHECK(ideal.rows[1].n[1] == 3);                           // seed 3 never waited
+  CHECK(ideal.rows[1].means[1] == doctest::Approx(620.0));
+  CHECK(r.tables[1].group == "real");
+  CHECK(r.tables[1].rows[1].means[0] == doctest::Approx(62.5));
+  const std::string md = to_markdown(r);
+  CHECK(has(md, "#### Why (ideal)\n\nSource: the mechanisms\n\n"));
+  CHECK(has(md,
+            "| config | runs | points | lock_wait_max_s |\n|---|---:|---:|---:|\n"
+            "| B | 4 | 52.5 | - |\n| A | 4 | 102.5 | 620.0 (n 3) |\n"));
+  const std::string text = to_text(r);
+  CHECK(has(text,
+            "  Why [real]: Mean per run by `config` of batch `conf`, values below 0 left out.\n"));
+  CHECK(has(text, "    A       4     62.5"));
 }
 
 TEST_CASE("experiment reports are deterministic and seeded per check") {

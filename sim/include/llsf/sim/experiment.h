@@ -98,6 +98,20 @@ struct Sweep {
   std::string where;
 };
 
+/// A table of means: one row per value of `rows` (an axis), one column per statistic -- the
+/// mechanisms behind a verdict (lock waits, collisions, failures) beside the outcome.
+struct Table {
+  std::string name;
+  std::string source;
+  Selection sel;                        ///< batch and ignore_below (statistic: per column)
+  std::string rows;                     ///< an axis of the batch
+  std::vector<std::string> values;      ///< its values shown, in this order
+  std::vector<std::string> statistics;  ///< the columns
+  AxisFilter fixed;                     ///< `where`: the batch's other axes
+  std::vector<std::string> groups;
+  std::string where;
+};
+
 /// A loaded and validated experiment file.
 struct Experiment {
   std::string file;  ///< the experiment file, as given
@@ -110,6 +124,7 @@ struct Experiment {
   std::vector<CalibrationTarget> calibration;
   std::vector<Finding> findings;
   std::vector<Sweep> sweeps;
+  std::vector<Table> tables;
 
   /// The batch named `name`, or null.
   const ExperimentBatch* batch(const std::string& name) const;
@@ -212,6 +227,20 @@ struct SweepResult {
   std::vector<SweepRow> rows;
 };
 
+/// One row of a table: one value of its axis.
+struct TableRow {
+  std::string value;
+  int runs = 0;               ///< stored runs of the row
+  std::vector<double> means;  ///< per statistic (Table::statistics' order)
+  std::vector<int> n;         ///< runs whose value entered each mean
+};
+
+struct TableResult {
+  const Table* table = nullptr;
+  std::string group;
+  std::vector<TableRow> rows;
+};
+
 /// Everything an evaluation found; rendered by to_text() and to_markdown().
 struct ExperimentResult {
   const Experiment* experiment = nullptr;
@@ -220,6 +249,7 @@ struct ExperimentResult {
   std::vector<TargetResult> calibration;
   std::vector<FindingResult> findings;
   std::vector<SweepResult> sweeps;
+  std::vector<TableResult> tables;
 };
 
 /// Evaluates `e` against the runs `store` holds (it keeps a pointer to `e`: `e` must outlive
