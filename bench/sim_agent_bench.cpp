@@ -82,12 +82,7 @@ GameResult play(std::uint64_t seed, double loss, bool locks, const AgentVariant&
     timed.push_back(std::make_unique<TimedBrain>(*brains.back()));
     game.set_brain(i, timed.back().get());
   }
-  llsf_msgs::SetGamePhase phase;
-  phase.set_phase(llsf_msgs::GameState::EXPLORATION);
-  game.controller_command(phase);
-  llsf_msgs::SetGameState run;
-  run.set_state(llsf_msgs::GameState::RUNNING);
-  game.controller_command(run);
+  game.start(refbox::GamePhase::kExploration);
   const double t0 = bench::cpu_seconds();
   game.run_until(core::SimTime::from_sec(180 + 900));
   GameResult r;

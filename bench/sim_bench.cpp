@@ -44,12 +44,7 @@ Run game_loop() {
   sim::GameConfig config;  // the 2013 world (3 robots, laser on), ground-truth levels
   config.seed = 2013;
   sim::Game game(config);
-  llsf_msgs::SetGamePhase phase;
-  phase.set_phase(llsf_msgs::GameState::PRODUCTION);
-  game.controller_command(phase);
-  llsf_msgs::SetGameState run;
-  run.set_state(llsf_msgs::GameState::RUNNING);
-  game.controller_command(run);
+  game.start(refbox::GamePhase::kProduction);
   std::vector<LoopBrain> brains{LoopBrain({"M1_look", "D2_look", "M8_look", "INS_2"}),
                                 LoopBrain({"M4_look", "R1_look", "M9_look", "WAIT_INS"}),
                                 LoopBrain({"M10_look", "TST_look", "M5_look", "LATE_ORDER"})};

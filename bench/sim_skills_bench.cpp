@@ -35,12 +35,7 @@ Run skill_loop(sim::SkillLevel level) {
   config.world.robots.resize(1);
   config.levels.skill = level;
   sim::Game game(config);
-  llsf_msgs::SetGamePhase phase;
-  phase.set_phase(llsf_msgs::GameState::PRODUCTION);
-  game.controller_command(phase);
-  llsf_msgs::SetGameState run;
-  run.set_state(llsf_msgs::GameState::RUNNING);
-  game.controller_command(run);
+  game.start(refbox::GamePhase::kProduction);
   game.step();
   // A T1 (the game plan is fixed by the seed).
   std::string t1 = "M1";

@@ -46,14 +46,14 @@ std::string stamp(SimTime t) { return fmt::format("[{:8.2f} s]", t.seconds()); }
 
 const char* status_name(lua::SkillStatus s) { return lua::to_string(s); }
 
-llsf_msgs::GameState::Phase phase_of(const std::string& name) {
+refbox::GamePhase phase_of(const std::string& name) {
   static const std::map<std::string, refbox::GamePhase> phases{
       {"pre_game", refbox::GamePhase::kPreGame},
       {"setup", refbox::GamePhase::kSetup},
       {"exploration", refbox::GamePhase::kExploration},
       {"production", refbox::GamePhase::kProduction},
   };
-  return refbox::to_msg_phase(phases.at(name));
+  return phases.at(name);
 }
 
 void print_skills(const sim::SkillBrain& brain, std::ostream& out) {
@@ -124,14 +124,7 @@ int run_skill(const SkillOptions& o, std::ostream& out, std::ostream& err) {
   });
 
   // The refbox: the chosen phase, running.
-  if (o.phase != "pre_game") {
-    llsf_msgs::SetGamePhase p;
-    p.set_phase(phase_of(o.phase));
-    game.controller_command(p);
-    llsf_msgs::SetGameState s;
-    s.set_state(llsf_msgs::GameState::RUNNING);
-    game.controller_command(s);
-  }
+  if (o.phase != "pre_game") game.start(phase_of(o.phase));
   game.run_until(game.time() + SimTime::from_seconds(o.after_s));
   if (!o.quiet) {
     out << stamp(game.time()) << " game: seed " << o.seed << ", " << o.robots << " robot(s), "

@@ -20,6 +20,7 @@
 #include <llsf_msgs/VersionInfo.pb.h>
 
 #include <algorithm>
+#include <stdexcept>
 #include <string>
 #include <utility>
 
@@ -201,6 +202,24 @@ refbox::ReceiveResult Game::controller_command(const google::protobuf::Message& 
   refbox::ReceiveResult r = protocol_->receive(message, refbox::Origin::stream(0));
   if (r.status == refbox::ReceiveStatus::kRejected) ++controller_rejected_;
   return r;
+}
+
+void Game::start(refbox::GamePhase phase) {
+  auto send = [this](const google::protobuf::Message& m) {
+    const refbox::ReceiveResult r = controller_command(m);
+    if (r.status != refbox::ReceiveStatus::kAccepted) {
+      throw std::logic_error("Game::start: the refbox refused " + m.GetTypeName() + ": " +
+                             r.reason);
+    }
+  };
+  if (phase != refbox().phase()) {
+    llsf_msgs::SetGamePhase p;
+    p.set_phase(refbox::to_msg_phase(phase));
+    send(p);
+  }
+  llsf_msgs::SetGameState s;
+  s.set_state(llsf_msgs::GameState::RUNNING);
+  send(s);
 }
 
 void Game::run_until(SimTime until) {

@@ -39,15 +39,9 @@ double cpu_seconds() {
 
 void start_game(Game& g, StartMode start) {
   if (start == StartMode::kNone) return;  // the refbox stays in PRE_GAME
-  if (start != StartMode::kGame) {
-    llsf_msgs::SetGamePhase p;
-    p.set_phase(start == StartMode::kExploration ? llsf_msgs::GameState::EXPLORATION
-                                                 : llsf_msgs::GameState::PRODUCTION);
-    g.controller_command(p);
-  }
-  llsf_msgs::SetGameState s;
-  s.set_state(llsf_msgs::GameState::RUNNING);
-  g.controller_command(s);
+  g.start(start == StartMode::kExploration  ? refbox::GamePhase::kExploration
+          : start == StartMode::kProduction ? refbox::GamePhase::kProduction
+                                            : refbox::GamePhase::kPreGame);
 }
 
 int deliveries_of(const refbox::Refbox& rb) {

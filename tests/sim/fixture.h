@@ -41,14 +41,7 @@ inline std::optional<int> machine_of_type(const refbox::Refbox& rb, refbox::Mach
 }
 
 /// Controller: switch the refbox to `phase` and start it.
-inline void start_phase(sim::Game& g, refbox::GamePhase phase) {
-  llsf_msgs::SetGamePhase p;
-  p.set_phase(refbox::to_msg_phase(phase));
-  REQUIRE(g.controller_command(p).status == refbox::ReceiveStatus::kAccepted);
-  llsf_msgs::SetGameState s;
-  s.set_state(llsf_msgs::GameState::RUNNING);
-  REQUIRE(g.controller_command(s).status == refbox::ReceiveStatus::kAccepted);
-}
+inline void start_phase(sim::Game& g, refbox::GamePhase phase) { g.start(phase); }
 
 /// A brain running a list of skill steps in order: each step is called every skill cycle until
 /// it returns true.

@@ -122,6 +122,11 @@ class Game {
   /// A controller command (as if sent over the refbox's TCP port): applied at the next tick's
   /// refbox step. Returns the adapter's verdict.
   refbox::ReceiveResult controller_command(const google::protobuf::Message& message);
+  /// Starts the game as a controller would: SetGamePhase(`phase`) unless the refbox is in that
+  /// phase already, then SetGameState(RUNNING); they take effect at the next tick's refbox step
+  /// (kPreGame: the refbox runs from PRE_GAME through the setup as in a real game). Throws
+  /// std::logic_error if the refbox refuses (a bug: both commands are valid before a game).
+  void start(refbox::GamePhase phase);
   /// Called at the end of every tick (step 9), e.g. by a recorder.
   void set_tick_hook(std::function<void(const Game&)> hook) { tick_hook_ = std::move(hook); }
 
