@@ -1,8 +1,9 @@
 # SPDX-License-Identifier: MIT
 # The project's front door. `make run` and `make test` work on a fresh Debian bookworm machine.
 JOBS ?= $(shell nproc)
+PREFIX ?= /usr/local
 
-.PHONY: all deps viewer run demo test build-release build-ci bench format check-format clean help
+.PHONY: all deps viewer run demo test install build-release build-ci bench format check-format clean help
 
 all: build-release
 
@@ -10,6 +11,7 @@ help:
 	@echo "make run          install deps, build Release, play the default scenario (llsfsim run)"
 	@echo "make demo         the kinematic world demo (three robots, no refbox)"
 	@echo "make test         install deps, build with -Werror, run the whole test suite"
+	@echo "make install      build Release, install into PREFIX (default /usr/local; docs/install.md)"
 	@echo "make bench        build Release and run every benchmark (bench/run)"
 	@echo "make viewer       build the browser front end (viewer/dist/report.js; scripts/build-viewer)"
 	@echo "make format       clang-format every source file"
@@ -39,6 +41,9 @@ demo: build-release
 
 test: build-ci
 	ctest --preset ci -j $(JOBS)
+
+install: build-release
+	cmake --install build/release --prefix $(PREFIX)
 
 bench: deps
 	bench/run

@@ -78,7 +78,7 @@ int batch(const BatchCommandOptions& o, std::ostream& out, std::ostream& err) {
       for (const sim::Scenario& s : l.file.variants) (void)sim::batch_seeds(s, o.runs);
       loaded.push_back(std::move(l));
     }
-  } catch (const std::exception& e) {
+  } catch (const core::UserError& e) {
     err << "llsfsim batch: " << e.what() << "\n";
     return kExitBadInput;
   }
@@ -146,8 +146,8 @@ Action add_batch_command(CLI::App& app) {
       "Resumable: runs the store already holds for the same "
       "scenario file content and --runs are not played again; Ctrl-C stores the running games "
       "and stops.\n"
-      "Exit code: 0 every run passed its test cases, 1 one failed, 2 bad input, 130 "
-      "interrupted.");
+      "Exit code: 0 every run passed its test cases, 1 one failed, 2 bad input, 3 internal "
+      "error (a bug: please report it), 130 interrupted.");
   return [o](std::ostream& out, std::ostream& err) { return batch(*o, out, err); };
 }
 

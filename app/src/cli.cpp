@@ -6,19 +6,35 @@
 #include <algorithm>
 #include <exception>
 #include <ostream>
+#include <string>
 #include <vector>
 
 #include "commands.h"
+#include "llsf/core/error.h"
+#include "llsf/core/version.h"
 
 namespace llsf::app {
+
+namespace {
+
+/// An exception that is not the user's error: a bug. Says so and how to report it; exit code 3.
+int internal_error(const std::string& who, const char* what, std::ostream& err) {
+  err << who << ": internal error: " << what << "\n"
+      << "This is a bug in llsfsim " << core::kVersion
+      << "; please report it with the command line and the scenario file.\n";
+  return kExitInternalError;
+}
+
+}  // namespace
 
 int run(std::span<const std::string> args, std::ostream& out, std::ostream& err) {
   CLI::App app{
       "llsfsim: a fast, deterministic simulator of the RoboCup Logistics League 2013 (LLSF).\n"
-      "Exit codes: 0 ok, 1 a skill or test case failed, 2 bad input.",
+      "Exit codes: 0 ok, 1 a skill or test case failed, 2 bad input, 3 internal error (a bug: "
+      "please report it).",
       "llsfsim"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "llsfsim 0.1.0");
+  app.set_version_flag("--version", "llsfsim " + std::string(core::kVersion));
   std::vector<std::pair<CLI::App*, Action>> commands;
   {
     CLI::App* sub = app.add_subcommand("run", "Play one game of a scenario; print a summary");
@@ -82,14 +98,23 @@ int run(std::span<const std::string> args, std::ostream& out, std::ostream& err)
           << " --help' for its options.\n";
     }
     return kExitBadInput;
+  } catch (const std::exception& e) {
+    return internal_error("llsfsim", e.what(), err);
   }
+  // The commands catch what they can say more about; the user's errors left over exit with 2,
+  // anything else is a bug (exit code 3).
   for (auto& [sub, action] : commands) {
     if (!sub->parsed()) continue;
+    const std::string who = "llsfsim " + sub->get_name();
     try {
       return action(out, err);
-    } catch (const std::exception& e) {
-      err << "llsfsim " << sub->get_name() << ": " << e.what() << "\n";
+    } catch (const core::UserError& e) {
+      err << who << ": " << e.what() << "\n";
       return kExitBadInput;
+    } catch (const std::exception& e) {
+      return internal_error(who, e.what(), err);
+    } catch (...) {
+      return internal_error(who, "an exception of unknown type", err);
     }
   }
   return kExitBadInput;

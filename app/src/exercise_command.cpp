@@ -25,7 +25,9 @@
 #include "live.h"
 #include "llsf/app/cli.h"
 #include "llsf/core/config.h"
+#include "llsf/core/data_dir.h"
 #include "llsf/core/error.h"
+#include "llsf/core/version.h"
 #include "llsf/sim/game.h"
 #include "llsf/sim/recording.h"
 #include "llsf/sim/scenario.h"
@@ -172,7 +174,7 @@ std::string exercises_root(const std::string& option) {
   if (!option.empty()) return option;
   const char* env = std::getenv("LLSF_EXERCISES_DIR");
   if (env != nullptr && *env != '\0') return env;
-  return LLSF_DEFAULT_EXERCISES_DIR;
+  return core::data_dir() + "/exercises";
 }
 
 std::vector<std::string> exercise_names(const std::string& root) {
@@ -450,7 +452,7 @@ int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err)
     so.db = "";
     so.recordings = default_recordings_dir(std::string(sim::StatsStore::kDefaultPath));
     server = start_live_server(o.live, so, feed, out);
-  } catch (const std::runtime_error& e) {
+  } catch (const core::UserError& e) {  // cannot listen
     err << "llsfsim exercise: " << e.what() << "\n";
     return kExitBadInput;
   }
@@ -460,8 +462,9 @@ int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err)
     if (o.live.serve) sink = [&feed](std::string_view line) { feed.publish(line); };
     try {
       recorder = std::make_unique<sim::Recorder>(
-          o.record, game, sim::RecordingInfo{ex.name, "", seed, "0.1.0"}, 10.0, sink);
-    } catch (const std::runtime_error& e) {
+          o.record, game, sim::RecordingInfo{ex.name, "", seed, std::string(core::kVersion)}, 10.0,
+          sink);
+    } catch (const core::UserError& e) {  // the recording cannot be written
       err << "llsfsim exercise: " << e.what() << "\n";
       return kExitBadInput;
     }
@@ -665,7 +668,7 @@ Action add_exercise_command(CLI::App& app) {
   app.add_option("--seed", o->seed, "Seed to play (default: the exercise's first)");
   app.add_option("--exercises", o->root,
                  "Where the exercises are (default: $LLSF_EXERCISES_DIR, else exercises/ of the "
-                 "source tree)");
+                 "data directory)");
   add_live_options(app, o->live,
                    "Serve the browser viewer with the game live at http://127.0.0.1:PORT/#/live "
                    "(best with --realtime or --speed)");
@@ -680,8 +683,8 @@ Action add_exercise_command(CLI::App& app) {
       "  llsfsim exercise 01 --skill my_drive.lua\n"
       "  llsfsim exercise 04 --skill my_rescue.lua --seed 7 --realtime --serve\n"
       "Exit code: 0 PASS, 1 not passed (also a skill that fails, crashes or loops forever), 2 bad "
-      "input (unknown exercise, missing file, a skill file that does not load). "
-      "docs/exercises.md");
+      "input (unknown exercise, missing file, a skill file that does not load), 3 internal error "
+      "(a bug: please report it). docs/exercises.md");
   return [o](std::ostream& out, std::ostream& err) { return run_exercise(*o, out, err); };
 }
 

@@ -117,7 +117,7 @@ int experiment(const ExperimentOptions& o, std::ostream& out, std::ostream& err)
     for (const sim::ExperimentBatch& b : e.batches) {
       for (const sim::Scenario& s : b.scenario.variants) (void)sim::batch_seeds(s, o.runs);
     }
-  } catch (const std::exception& ex) {
+  } catch (const core::UserError& ex) {
     err << "llsfsim experiment: " << ex.what() << "\n";
     return kExitBadInput;
   }
@@ -239,7 +239,7 @@ Action add_experiment_command(CLI::App& app) {
       "prints the verdicts. Verdicts are results: a finding that is not reproduced still exits "
       "0.\n"
       "Exit code: 0 done, 2 bad input (the experiment, a scenario, the store, a markdown file "
-      "without the markers), 130 interrupted.");
+      "without the markers), 3 internal error (a bug: please report it), 130 interrupted.");
   return [o](std::ostream& out, std::ostream& err) { return experiment(*o, out, err); };
 }
 

@@ -100,8 +100,9 @@ Action add_report_command(CLI::App& app) {
       "Per variant: runs, pass rate and the distribution of the points; then every variant's "
       "mean points against the first variant's, with a bootstrap 95 % interval (* = the "
       "interval excludes 0). The HTML page inlines the viewer's bundle from $LLSF_VIEWER_DIR or "
-      "viewer/dist of the source tree (`make viewer` builds it). Exit code 0, or 2 for a bad "
-      "store or batch, a file that cannot be written or a missing viewer bundle.");
+      "viewer/dist of the data directory (`make viewer` builds it).\n"
+      "Exit code: 0 done, 2 bad input (a bad store or batch, a file that cannot be written, a "
+      "missing viewer bundle), 3 internal error (a bug: please report it).");
   return [o](std::ostream& out, std::ostream& err) { return report(*o, out, err); };
 }
 

@@ -172,7 +172,7 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
     so.db = o.no_db ? "" : o.db;
     so.recordings = default_recordings_dir(o.db);
     server = start_live_server(o.live, so, feed, note);
-  } catch (const std::runtime_error& e) {
+  } catch (const core::UserError& e) {  // cannot listen
     err << "llsfsim run: " << e.what() << "\n";
     return kExitBadInput;
   }
@@ -196,7 +196,7 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
   } catch (const core::ConfigError& e) {
     err << "llsfsim run: " << e.what() << "\n";
     return kExitBadInput;
-  } catch (const std::runtime_error& e) {  // e.g. the recording cannot be written
+  } catch (const core::UserError& e) {  // e.g. the recording cannot be written
     err << "llsfsim run: " << e.what() << "\n";
     return kExitBadInput;
   }
@@ -250,7 +250,7 @@ int check(const std::vector<std::string>& files, std::ostream& out, std::ostream
         }
       }
       out << fmt::format("ok   {}: {} variant(s), {} game(s)\n", path, f.variants.size(), seeds);
-    } catch (const std::exception& e) {
+    } catch (const core::UserError& e) {  // anything else is a bug: exit code 3 (cli.cpp)
       err << "FAIL " << path << ": " << e.what() << "\n";
       ++bad;
     }
@@ -287,7 +287,8 @@ Action add_run_command(CLI::App& app) {
       "Plays one game headless and prints a summary and the test-case verdicts; stores the run "
       "in the statistics store (--db, default llsfsim.db; the latest game of each variant and "
       "seed of a scenario file's content) and writes a recording of it.\n"
-      "Exit code: 0 all test cases passed, 1 one failed, 2 bad scenario or agent.");
+      "Exit code: 0 all test cases passed, 1 one failed, 2 bad input (scenario, agent, skill "
+      "file, a path that cannot be written), 3 internal error (a bug: please report it).");
   return [o](std::ostream& out, std::ostream& err) { return run(*o, out, err); };
 }
 
@@ -296,7 +297,8 @@ Action add_check_command(CLI::App& app) {
   app.add_option("scenarios", *files, "Scenario files")->required();
   app.footer(
       "Validates scenarios: every key and value, every matrix variant, the agent files (CLIPS "
-      "syntax) and the skill files, without playing. Exit code 0 or 2.");
+      "syntax) and the skill files, without playing.\n"
+      "Exit code: 0 all valid, 2 one is not, 3 internal error (a bug: please report it).");
   return [files](std::ostream& out, std::ostream& err) { return check(*files, out, err); };
 }
 

@@ -8,6 +8,7 @@
 
 #include "commands.h"
 #include "llsf/app/cli.h"
+#include "llsf/core/error.h"
 #include "llsf/sim/stats_store.h"
 #include "server.h"
 
@@ -26,17 +27,19 @@ Action add_serve_command(CLI::App& app) {
                  "Recordings served below /api/recordings/ (default: <db>-recordings beside "
                  "the --db file)");
   app.add_option("--viewer", o->viewer,
-                 "The built viewer (default: $LLSF_VIEWER_DIR, else viewer/dist of the source "
-                 "tree; `make viewer`)");
+                 "The built viewer (default: $LLSF_VIEWER_DIR, else viewer/dist of the data "
+                 "directory; `make viewer`)");
   app.footer(
       "Serves the browser viewer, the stored batches, runs and reports as JSON and the "
       "recordings as JSON lines (docs/llsfsim.md). Prints 'llsfsim serve: URL' and runs until "
-      "Ctrl-C or SIGTERM. Exit code 0, or 2 if it cannot listen.");
+      "Ctrl-C or SIGTERM.\n"
+      "Exit code: 0 stopped, 2 cannot listen (bad address or port, port in use), 3 internal "
+      "error (a bug: please report it).");
   return [o](std::ostream& out, std::ostream& err) {
     std::unique_ptr<Server> server;
     try {
       server = std::make_unique<Server>(*o);
-    } catch (const std::runtime_error& e) {
+    } catch (const core::UserError& e) {  // cannot listen
       err << "llsfsim serve: " << e.what() << "\n";
       return kExitBadInput;
     }

@@ -28,6 +28,7 @@
 #include <utility>
 
 #include "commands.h"
+#include "llsf/core/error.h"
 #include "llsf/sim/recording.h"
 #include "llsf/sim/report.h"
 #include "llsf/sim/stats_store.h"
@@ -566,14 +567,14 @@ Server::Server(ServerOptions options, LiveFeed* feed) : impl_(std::make_unique<S
   m.feed = feed;
   const std::string& bind = m.options.bind;
   if (m.options.port < 0 || m.options.port > 65535) {
-    throw std::runtime_error(fmt::format("bad port {}", m.options.port));
+    throw core::UserError(fmt::format("bad port {}", m.options.port));
   }
   beast::error_code ec;
   const asio::ip::address address = asio::ip::make_address(bind, ec);
-  if (ec) throw std::runtime_error("bad address to bind: '" + bind + "'");
+  if (ec) throw core::UserError("bad address to bind: '" + bind + "'");
   const tcp::endpoint endpoint(address, static_cast<unsigned short>(m.options.port));
   const auto fail = [&](const char* what) {
-    throw std::runtime_error(
+    throw core::UserError(
         fmt::format("cannot {} {}:{}: {}", what, bind, m.options.port, ec.message()));
   };
   if (m.acceptor.open(endpoint.protocol(), ec)) fail("open a socket for");

@@ -206,7 +206,9 @@ Action add_skill_command(CLI::App& app) {
       "  llsfsim skill --skills my_skills 'my_first_skill{}'\n"
       "  llsfsim skill --list\n"
       "Status lines: [game time] robot STATUS skill-string  -> result; the skill library is "
-      "documented in docs/skills.md.");
+      "documented in docs/skills.md.\n"
+      "Exit code: 0 every skill succeeded, 1 one failed, 2 bad input (options, skill string or "
+      "file), 3 internal error (a bug: please report it).");
   app.add_option("skill_strings", o->skill_strings,
                  "Skill strings to run in turn, e.g. 'drive_to{place=\"M3\"}'; stops at the "
                  "first failure");
@@ -238,7 +240,7 @@ Action add_skill_command(CLI::App& app) {
       ->check(CLI::ExistingDirectory)
       ->allow_extra_args(false);  // one directory per --skills: skill strings follow
   app.add_option("--library", o->library_dir,
-                 "The skill library directory (default: lua/skills of the source tree)")
+                 "The skill library directory (default: lua/skills of the data directory)")
       ->check(CLI::ExistingDirectory);
   app.add_option("--timeout", o->timeout_s, "Seconds of game time each skill string may run")
       ->capture_default_str()

@@ -441,7 +441,7 @@ ExperimentBatch read_batch(const std::string& name, const core::ConfigNode& n,
   try {
     b.scenario = load_scenario(b.file);
     b.hash = file_content_hash(b.file);
-  } catch (const std::exception& err) {
+  } catch (const core::UserError& err) {
     n.fail(err.what());
   }
   b.axis_values.resize(b.scenario.axes.size());

@@ -12,6 +12,7 @@
 #include <string_view>
 #include <unordered_map>
 
+#include "llsf/core/error.h"
 #include "llsf/refbox/refbox.h"
 
 namespace llsf::sim {
@@ -84,7 +85,7 @@ struct Recorder::Impl {
     if (file != nullptr && (gzwrite(file, line.data(), static_cast<unsigned>(line.size())) !=
                                 static_cast<int>(line.size()) ||
                             gzputc(file, '\n') < 0)) {
-      throw std::runtime_error(path + ": cannot write the recording");
+      throw core::UserError(path + ": cannot write the recording");
     }
     if (sink) sink(line);
     ++lines;
@@ -103,7 +104,7 @@ Recorder::Recorder(const std::string& path, const Game& game, const RecordingInf
   m.sink = std::move(sink);
   if (!path.empty()) {
     m.file = gzopen(path.c_str(), "wb6");
-    if (m.file == nullptr) throw std::runtime_error(path + ": cannot create the recording");
+    if (m.file == nullptr) throw core::UserError(path + ": cannot create the recording");
   }
   m.paths.resize(static_cast<std::size_t>(game.robot_count()));
   m.jam_device.assign(static_cast<std::size_t>(game.robot_count()), -1);
@@ -187,7 +188,7 @@ void Recorder::close() {
   if (impl_->file == nullptr) return;
   const int rc = gzclose(impl_->file);
   impl_->file = nullptr;
-  if (rc != Z_OK) throw std::runtime_error(impl_->path + ": cannot finish the recording");
+  if (rc != Z_OK) throw core::UserError(impl_->path + ": cannot finish the recording");
 }
 
 std::int64_t Recorder::lines() const { return impl_->lines; }
@@ -450,14 +451,14 @@ void Recorder::frame(const Game& game) {
 
 std::vector<RecordingLine> read_recording(const std::string& path) {
   gzFile f = gzopen(path.c_str(), "rb");
-  if (f == nullptr) throw std::runtime_error(path + ": cannot open the recording");
+  if (f == nullptr) throw core::UserError(path + ": cannot open the recording");
   std::vector<RecordingLine> out;
   std::string line;
   char buf[65536];
   int number = 0;
   auto fail = [&](const std::string& what) {
     gzclose(f);
-    throw std::runtime_error(path + ":" + std::to_string(number) + ": " + what);
+    throw core::UserError(path + ":" + std::to_string(number) + ": " + what);
   };
   while (true) {
     line.clear();
@@ -509,7 +510,7 @@ std::vector<RecordingLine> read_recording(const std::string& path) {
     out.push_back(std::move(r));
   }
   gzclose(f);
-  if (out.empty()) throw std::runtime_error(path + ": empty recording");
+  if (out.empty()) throw core::UserError(path + ": empty recording");
   return out;
 }
 

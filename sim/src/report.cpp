@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "llsf/core/assert.h"
+#include "llsf/core/data_dir.h"
 #include "llsf/core/rng.h"
 
 namespace llsf::sim {
@@ -350,7 +351,7 @@ std::string to_json(const BatchReport& r, const std::vector<RunValues>& runs) {
 std::string viewer_dir() {
   const char* env = std::getenv("LLSF_VIEWER_DIR");
   if (env != nullptr && *env != '\0') return env;
-  return LLSF_DEFAULT_VIEWER_DIR;
+  return core::data_dir() + "/viewer/dist";
 }
 
 std::string to_html(const BatchReport& r, const std::string& json, const std::string& dir) {

@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "llsf/core/rng.h"
+#include "llsf/core/version.h"
 #include "llsf/refbox/protocol.h"
 #include "llsf/sim/agent_brain.h"
 #include "llsf/sim/recording.h"
@@ -225,8 +226,9 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   std::unique_ptr<Recorder> recorder;
   if (!hooks.record_path.empty() || hooks.record_sink) {
     recorder = std::make_unique<Recorder>(
-        hooks.record_path, game, RecordingInfo{scenario.name, scenario.variant, seed, "0.1.0"},
-        10.0, hooks.record_sink);
+        hooks.record_path, game,
+        RecordingInfo{scenario.name, scenario.variant, seed, std::string(core::kVersion)}, 10.0,
+        hooks.record_sink);
   }
   for (int i = 0; i < game.robot_count(); ++i) {
     const RobotSpec& spec = scenario.robots.at(static_cast<std::size_t>(i));

@@ -1,9 +1,11 @@
 // SPDX-License-Identifier: MIT
 #include "llsf/sim/scenario.h"
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <utility>
 
 #include "llsf/comm/hub_config.h"
@@ -365,6 +367,12 @@ Scenario read_scenario_map(const core::ConfigNode& root, const std::string& file
 
 ScenarioFile load_scenario(const std::string& path) {
   const std::string text = read_text(path);
+  // A test hook, not for users: a deliberate bug (std::logic_error) when LLSF_TEST_INTERNAL_ERROR
+  // is set, so that tests/app/exit_code_test.cpp sees llsfsim tell a bug (exit code 3) from bad
+  // input (2) through every command that loads a scenario.
+  if (const char* hook = std::getenv("LLSF_TEST_INTERNAL_ERROR"); hook != nullptr && *hook != 0) {
+    throw std::logic_error("LLSF_TEST_INTERNAL_ERROR is set (a test hook)");
+  }
   ScenarioFile out;
   out.file = path;
   const core::ConfigNode first = core::ConfigNode::parse(text, path);

@@ -1,7 +1,10 @@
 // SPDX-License-Identifier: MIT
 #include "llsf/sim/skill_brain.h"
 
+#include <string>
 #include <utility>
+
+#include "llsf/core/data_dir.h"
 
 namespace llsf::sim {
 
@@ -19,7 +22,7 @@ lua::SkillEngineConfig with_defaults(lua::SkillEngineConfig c, const Game& game,
 
 std::vector<std::string> skill_library_dirs(SkillLevel level, std::string_view library_dir) {
   const std::string base =
-      library_dir.empty() ? std::string(LLSF_SKILL_LIBRARY_DIR) : std::string(library_dir);
+      library_dir.empty() ? core::data_dir() + "/lua/skills" : std::string(library_dir);
   std::vector<std::string> dirs{base};
   if (level == SkillLevel::kSymbolic) dirs.push_back(base + "/symbolic");
   return dirs;

@@ -13,10 +13,7 @@
 #include <sstream>
 
 #include "llsf/core/rng.h"
-
-#ifndef LLSF_VERSION
-#define LLSF_VERSION "unknown"
-#endif
+#include "llsf/core/version.h"
 
 namespace llsf::sim {
 
@@ -244,7 +241,7 @@ std::string join_seeds(const std::vector<std::uint64_t>& seeds) {
 
 }  // namespace
 
-std::string_view llsfsim_version() { return LLSF_VERSION; }
+std::string_view llsfsim_version() { return core::kVersion; }
 
 // ---- StatsStore ------------------------------------------------------------------------------
 

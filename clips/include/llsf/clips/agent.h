@@ -18,6 +18,7 @@
 #include "llsf/clips/lock_manager.h"
 #include "llsf/clips/skill_runner.h"
 #include "llsf/clips/value.h"
+#include "llsf/core/error.h"
 #include "llsf/core/geometry.h"
 #include "llsf/core/sim_time.h"
 
@@ -32,9 +33,9 @@ namespace llsf::clips {
 
 /// Bad agent code: a syntax or semantic error while loading. The message reads
 /// "file.clp:LINE: [ID] what (in defrule MAIN::name)", one line per error.
-class AgentLoadError : public std::runtime_error {
+class AgentLoadError : public core::UserError {
  public:
-  using std::runtime_error::runtime_error;
+  using core::UserError::UserError;
 };
 
 /// Log level of an agent's output.

@@ -14,6 +14,7 @@
 
 #include "llsf/clips/agent.h"
 #include "llsf/core/sim_time.h"
+#include "llsf/core/version.h"
 #include "llsf/sim/game.h"
 #include "llsf/sim/skill_brain.h"
 
@@ -27,7 +28,7 @@ struct RecordingInfo {
   std::string scenario;
   std::string variant;
   std::uint64_t seed = 0;
-  std::string llsfsim_version = "0.1.0";
+  std::string llsfsim_version{core::kVersion};
 };
 
 /// Receives every line of a recording as it is written (without the newline), e.g. for a live

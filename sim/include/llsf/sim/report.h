@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "llsf/core/error.h"
 #include "llsf/core/rng.h"
 #include "llsf/sim/stats_store.h"
 
@@ -76,13 +77,13 @@ std::vector<RunValues> run_values(const StatsStore& store, std::int64_t batch_id
 std::string to_json(const BatchReport& r, const std::vector<RunValues>& runs);
 
 /// The viewer's bundle (`report.js`) is not in the viewer directory.
-class ViewerBundleMissing : public std::runtime_error {
+class ViewerBundleMissing : public core::UserError {
  public:
-  using std::runtime_error::runtime_error;
+  using core::UserError::UserError;
 };
 
 /// Where the viewer's bundle is looked for: $LLSF_VIEWER_DIR if set and not empty, else
-/// viewer/dist of the source tree (built by `make viewer`).
+/// viewer/dist under core::data_dir() (built by `make viewer`).
 std::string viewer_dir();
 
 /// A self-contained HTML page of the report: a small template, `dir`/report.js inlined, and

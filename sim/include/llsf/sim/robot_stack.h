@@ -24,6 +24,7 @@
 #include "llsf/lua/robot_api.h"
 #include "llsf/planner/navigator.h"
 #include "llsf/sim/game_config.h"
+#include "llsf/sim/perception.h"
 
 namespace llsf::sim {
 
@@ -39,14 +40,6 @@ struct RobotPercept {
   /// Hackathon: the colour (index into HackathonConfig::colours, -1 none) of each entry of
   /// `pucks`; empty outside the variant.
   std::span<const int> puck_colours;
-};
-
-/// Static description of a device for the light detection: its pose (heading = the facing, the
-/// direction its front looks onto the field) and its front (the RFID zone centre).
-struct DeviceView {
-  std::string name;
-  core::Pose2D pose;
-  core::Vec2 front{0.0, 0.0};
 };
 
 /// A change of the world a symbolic skill asked for (lua::RobotApi::symbolic_*); the Game
@@ -135,7 +128,7 @@ class RobotStack final : public lua::RobotApi {
   // --- lua::RobotApi -----------------------------------------------------------------------
   SimTime now() const override { return now_; }
   std::string_view name() const override { return name_; }
-  lua::PoseEstimate pose() const override { return pose_; }
+  lua::PoseEstimate pose() const override { return localization_.estimate(); }
   void goto_place(std::string_view place, bool forward_only) override;
   void goto_pose(const core::Pose2D& pose, bool forward_only) override;
   lua::NavState navigator() const override;
@@ -144,11 +137,12 @@ class RobotStack final : public lua::RobotApi {
   bool puck_in_holder() const override { return puck_in_holder_; }
   double ir_distance_m() const override { return ir_distance_m_; }
   lua::OpticalSensors optical() const override { return optical_; }
-  lua::LightReading light() const override { return light_; }
-  std::span<const lua::PuckSighting> pucks() const override { return sightings_; }
+  lua::LightReading light() const override { return light_.reading(); }
+  std::span<const lua::PuckSighting> pucks() const override { return puck_vision_.sightings(); }
   lua::LaserView laser() const override { return laser_; }
   std::span<const lua::ColourPuckSighting> colour_pucks() const override {
-    return colour_sightings_;
+    return colour_camera_ ? colour_camera_->sightings()
+                          : std::span<const lua::ColourPuckSighting>{};
   }
   const lua::RescueInfo* rescue() const override { return rescue_ ? &*rescue_ : nullptr; }
   std::optional<lua::PlaceInfo> place(std::string_view name) const override;
@@ -171,22 +165,6 @@ class RobotStack final : public lua::RobotApi {
 
  private:
   enum class Drive : std::uint8_t { kIdle, kNavigator, kMotor };
-  /// A light reading of one vision frame (before the delay).
-  struct Frame {
-    SimTime stamp;
-    lua::LightReading reading;
-  };
-
-  void sense_localization(const RobotPercept& p);
-  void sense_light(const RobotPercept& p);
-  void sense_light_vision(const RobotPercept& p);
-  void sense_pucks(const RobotPercept& p);
-  void sense_colour_pucks(const RobotPercept& p);
-  /// The nearest device whose front is in front of `pose` (within the range and the heading
-  /// cone, with the robot on the front's side); with `vision` the robot must also stand within
-  /// the facing cone of the device. -1 if none.
-  int device_in_front(const core::Pose2D& pose, bool vision) const;
-  void set_light(const lua::LightReading& r, SimTime now);
 
   std::string name_;
   int index_;
@@ -218,49 +196,18 @@ class RobotStack final : public lua::RobotApi {
   /// Applies the motor caps and the jam to a command; may start or end a jam.
   kinematic::MotorCommand handle(kinematic::MotorCommand c, bool motor);
 
-  // Localization.
-  core::RandomStream loc_rng_;
-  lua::PoseEstimate pose_;
-  core::Pose2D est_ref_;  ///< estimate at the last correction
-  core::Pose2D odo_ref_;  ///< odometry at the last correction
-  bool teleported_ = false;
-  core::Pose2D teleport_from_;
-  core::Pose2D teleport_to_;
-  SimTime next_correction_;
-
-  // Holder, optical, laser.
+  // Holder, optical, laser: the world's readings as they are.
   bool puck_in_holder_ = false;
   double ir_distance_m_ = 0.0;
   lua::OpticalSensors optical_;
   lua::LaserView laser_;
 
-  // Light detection.
-  core::RandomStream light_rng_;
-  lua::LightReading light_;
-  SimTime light_next_frame_;
-  int light_device_ = -1;         ///< device observed by the vision frames, -1 none
-  SimTime light_observed_since_;  ///< first frame of the current device
-  /// Recent frames of the current device: stamp and lit lamps (bit 0 red, 1 yellow, 2 green).
-  std::vector<std::pair<SimTime, std::uint8_t>> lit_history_;
-  int lit_head_ = 0;
-  int lit_count_ = 0;
-  std::vector<Frame> frames_;  ///< ring buffer of vision frames awaiting their delay
-  int frame_head_ = 0;         ///< index of the oldest frame
-  int frame_count_ = 0;
-
-  // Puck detection.
-  SimTime puck_next_frame_;
-  std::vector<lua::PuckSighting> sightings_;
-  std::vector<core::Vec2> scratch_;
-  std::vector<int> cluster_;
-
-  // Hackathon: the colour camera and the task.
-  std::optional<ColourCameraConfig> camera_;
-  std::vector<std::string> colour_names_;
-  core::RandomStream colour_rng_;
-  SimTime colour_next_frame_;
-  std::vector<lua::ColourPuckSighting> colour_sightings_;
-  std::optional<lua::RescueInfo> rescue_;
+  // Perception models (perception.h).
+  Localization localization_;
+  LightDetection light_;
+  PuckVision puck_vision_;
+  std::optional<ColourCamera> colour_camera_;  ///< hackathon only
+  std::optional<lua::RescueInfo> rescue_;      ///< hackathon only
 };
 
 }  // namespace llsf::sim

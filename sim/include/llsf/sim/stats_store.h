@@ -14,18 +14,19 @@
 #include <utility>
 #include <vector>
 
+#include "llsf/core/error.h"
 #include "llsf/sim/runner.h"
 
 namespace llsf::sim {
 
 /// The store could not be opened, read or written (the message names the file and SQLite's
 /// reason).
-class StatsError : public std::runtime_error {
+class StatsError : public core::UserError {
  public:
-  using std::runtime_error::runtime_error;
+  using core::UserError::UserError;
 };
 
-/// The version of llsfsim recorded with every run ("0.1.0").
+/// The version of llsfsim recorded with every run (core::kVersion).
 std::string_view llsfsim_version();
 
 /// What identifies a batch and what is recorded with it.
