@@ -7,8 +7,10 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <map>
+#include <nlohmann/json.hpp>
 
 namespace llsf::bench {
 
@@ -29,8 +31,15 @@ Registration::Registration(const char* name, const char* description, std::funct
 
 void report(const std::string& bench, const std::string& metric, double value,
             const std::string& unit) {
-  std::printf("{\"bench\": \"%s\", \"metric\": \"%s\", \"value\": %.6g, \"unit\": \"%s\"}\n",
-              bench.c_str(), metric.c_str(), value, unit.c_str());
+  // 6 significant digits, as "%.6g" rounds them; dump() writes the shortest text of that value.
+  char digits[32];
+  std::snprintf(digits, sizeof digits, "%.6g", value);
+  const nlohmann::ordered_json line = {{"bench", bench},
+                                       {"metric", metric},
+                                       {"value", std::strtod(digits, nullptr)},
+                                       {"unit", unit}};
+  std::printf("%s\n",
+              line.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace).c_str());
   std::fflush(stdout);
 }
 

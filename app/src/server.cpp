@@ -122,11 +122,15 @@ struct Reply {
   bool api = true;  ///< not cached (static files are revalidated instead)
 };
 
+/// JSON text; invalid UTF-8 (a file name, a parse error quoting a broken line) becomes U+FFFD
+/// instead of an exception.
+std::string dump(const json& j) { return j.dump(-1, ' ', false, json::error_handler_t::replace); }
+
 Reply error_reply(http::status status, const std::string& message) {
-  return {status, "application/json", json{{"error", message}}.dump() + "\n", true};
+  return {status, "application/json", dump(json{{"error", message}}) + "\n", true};
 }
 
-Reply json_reply(const json& j) { return {http::status::ok, "application/json", j.dump(), true}; }
+Reply json_reply(const json& j) { return {http::status::ok, "application/json", dump(j), true}; }
 
 /// The request target's path as decoded segments; nullopt with `error` set for a target that
 /// is not a plain path below the root (traversal, encoded or not, backslashes, NUL, bad

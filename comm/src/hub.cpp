@@ -3,7 +3,7 @@
 #include "llsf/comm/hub.h"
 
 #include <algorithm>
-#include <cstdio>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "llsf/core/assert.h"
@@ -368,115 +368,72 @@ const PeerCounters& Hub::peer_counters(PeerId p) const {
 
 namespace {
 
-void append_json_string(std::string& out, std::string_view s) {
-  out += '"';
-  for (const char ch : s) {
-    if (ch == '"' || ch == '\\') {
-      out += '\\';
-      out += ch;
-    } else if (static_cast<unsigned char>(ch) < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", ch);
-      out += buf;
-    } else {
-      out += ch;
-    }
-  }
-  out += '"';
-}
+using Json = nlohmann::ordered_json;  // keys in the order written: a stable, readable object
 
-void append_counters(std::string& out, const TrafficCounters& c) {
-  out += "\"sent\": " + std::to_string(c.sent) + ", \"delivered\": " + std::to_string(c.delivered);
-  out += ", \"dropped\": {";
+/// `head`'s keys, then the counters'.
+Json with_counters(Json head, const TrafficCounters& c) {
+  Json dropped = Json::object();
   for (int i = 0; i < kDropCauseCount; ++i) {
-    if (i) out += ", ";
-    out += '"';
-    out += drop_cause_name(static_cast<DropCause>(i));
-    out += "\": " + std::to_string(c.dropped[static_cast<std::size_t>(i)]);
+    dropped[drop_cause_name(static_cast<DropCause>(i))] = c.dropped[static_cast<std::size_t>(i)];
   }
-  out += "}, \"bytes_sent\": " + std::to_string(c.bytes_sent) +
-         ", \"bytes_delivered\": " + std::to_string(c.bytes_delivered);
   const DelayHistogram& h = c.delay;
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.6f", h.mean_ms());
-  out += ", \"delay_ms\": {\"count\": " + std::to_string(h.count) + ", \"mean\": " + buf;
-  std::snprintf(buf, sizeof buf, "%.6f", static_cast<double>(h.min_ns) * 1e-6);
-  out += std::string(", \"min\": ") + buf;
-  std::snprintf(buf, sizeof buf, "%.6f", static_cast<double>(h.max_ns) * 1e-6);
-  out += std::string(", \"max\": ") + buf + ", \"buckets\": [";
-  for (int b = 0; b < DelayHistogram::kBuckets; ++b) {
-    if (b) out += ", ";
-    out += std::to_string(h.counts[static_cast<std::size_t>(b)]);
-  }
-  out += "]}";
+  head["sent"] = c.sent;
+  head["delivered"] = c.delivered;
+  head["dropped"] = std::move(dropped);
+  head["bytes_sent"] = c.bytes_sent;
+  head["bytes_delivered"] = c.bytes_delivered;
+  head["delay_ms"] = {{"count", h.count},
+                      {"mean", h.mean_ms()},
+                      {"min", static_cast<double>(h.min_ns) * 1e-6},
+                      {"max", static_cast<double>(h.max_ns) * 1e-6},
+                      {"buckets", h.counts}};
+  return head;
 }
 
 }  // namespace
 
 std::string Hub::counters_json() const {
-  std::string out = "{\"delay_bucket_upper_ms\": [";
-  for (std::size_t b = 0; b < DelayHistogram::kBucketUpperMs.size(); ++b) {
-    if (b) out += ", ";
-    out += std::to_string(DelayHistogram::kBucketUpperMs[b]);
-  }
-  out += "], \"links\": [";
-  bool first = true;
+  Json links = Json::array();
   for (int f = 0; f < peer_count(); ++f) {
     for (int t = 0; t < peer_count(); ++t) {
       const TrafficCounters& c = link_counters(PeerId(f), PeerId(t));
       if (c.sent == 0) continue;
-      if (!first) out += ", ";
-      first = false;
-      out += "{\"from\": ";
-      append_json_string(out, peer_name(PeerId(f)));
-      out += ", \"to\": ";
-      append_json_string(out, peer_name(PeerId(t)));
-      out += ", ";
-      append_counters(out, c);
-      out += '}';
+      links.push_back(
+          with_counters({{"from", peer_name(PeerId(f))}, {"to", peer_name(PeerId(t))}}, c));
     }
   }
-  out += "], \"types\": [";
-  first = true;
+  Json types = Json::array();
   for (int i = 0; i < static_cast<int>(type_counters_.size()); ++i) {
     const TrafficCounters& c = type_counters_[static_cast<std::size_t>(i)];
     if (c.sent == 0) continue;
-    if (!first) out += ", ";
-    first = false;
     const MessageKey k = registry_->key_at(i);
-    out += "{\"type\": ";
-    append_json_string(out, registry_->name_at(i));
-    out += ", \"component_id\": " + std::to_string(k.component_id) +
-           ", \"msg_type\": " + std::to_string(k.msg_type) + ", ";
-    append_counters(out, c);
-    out += '}';
+    types.push_back(with_counters({{"type", registry_->name_at(i)},
+                                   {"component_id", k.component_id},
+                                   {"msg_type", k.msg_type}},
+                                  c));
   }
   if (unregistered_counters_.sent > 0) {
-    if (!first) out += ", ";
-    out += "{\"type\": \"(unregistered)\", ";
-    append_counters(out, unregistered_counters_);
-    out += '}';
+    types.push_back(with_counters({{"type", "(unregistered)"}}, unregistered_counters_));
   }
-  out += "], \"peers\": [";
+  Json peers = Json::array();
   for (int p = 0; p < peer_count(); ++p) {
     const PeerCounters& c = peer_counters(PeerId(p));
-    if (p) out += ", ";
-    out += "{\"name\": ";
-    append_json_string(out, peer_name(PeerId(p)));
-    out += ", \"channel\": ";
-    append_json_string(out, peers_[static_cast<std::size_t>(p)].channel);
-    out += ", \"broadcasts\": " + std::to_string(c.broadcasts) +
-           ", \"bytes\": " + std::to_string(c.bytes) + ", \"malformed\": {";
+    Json malformed = Json::object();
     for (int e = 1; e < kFrameErrorCount; ++e) {
-      if (e > 1) out += ", ";
-      out += '"';
-      out += frame_error_name(static_cast<FrameError>(e));
-      out += "\": " + std::to_string(c.malformed[static_cast<std::size_t>(e)]);
+      malformed[std::string(frame_error_name(static_cast<FrameError>(e)))] =
+          c.malformed[static_cast<std::size_t>(e)];
     }
-    out += "}}";
+    peers.push_back({{"name", peer_name(PeerId(p))},
+                     {"channel", peers_[static_cast<std::size_t>(p)].channel},
+                     {"broadcasts", c.broadcasts},
+                     {"bytes", c.bytes},
+                     {"malformed", std::move(malformed)}});
   }
-  out += "]}";
-  return out;
+  const Json j = {{"delay_bucket_upper_ms", DelayHistogram::kBucketUpperMs},
+                  {"links", std::move(links)},
+                  {"types", std::move(types)},
+                  {"peers", std::move(peers)}};
+  return j.dump(-1, ' ', false, Json::error_handler_t::replace);
 }
 
 }  // namespace llsf::comm

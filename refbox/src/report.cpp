@@ -2,142 +2,105 @@
 // Deterministic JSON rendering of the game report.
 #include "llsf/refbox/report.h"
 
-#include <cstdio>
+#include <nlohmann/json.hpp>
 
 namespace llsf::refbox {
 
 namespace {
 
-/// Seconds with 3 decimals from integer nanoseconds (no floating point: identical everywhere).
-std::string secs(SimTime t) {
-  const std::int64_t ms = t.ns() / 1000000;
-  const std::int64_t a = ms < 0 ? -ms : ms;
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%s%lld.%03lld", ms < 0 ? "-" : "",
-                static_cast<long long>(a / 1000), static_cast<long long>(a % 1000));
-  return buf;
-}
+using Json = nlohmann::ordered_json;  // fixed key order: the same report, the same bytes
 
-std::string quote(std::string_view s) {
-  std::string r = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') {
-      r += '\\';
-      r += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(c));
-      r += buf;
-    } else {
-      r += c;
-    }
-  }
-  return r + "\"";
-}
+/// Seconds with (at most) 3 decimals from whole milliseconds: one correctly rounded division,
+/// identical everywhere.
+Json secs(SimTime t) { return static_cast<double>(t.ns() / 1000000) / 1000.0; }
 
-std::string dev(DeviceId d) { return is_valid_device(d) ? quote(device_name(d)) : "null"; }
-std::string id_or_null(int v, bool valid) { return valid ? std::to_string(v) : "null"; }
+Json dev(DeviceId d) { return is_valid_device(d) ? Json(device_name(d)) : Json(nullptr); }
+Json id_or_null(int v, bool valid) { return valid ? Json(v) : Json(nullptr); }
 
-void params_json(std::string& o, const GameParams& p) {
-  o += "{\"machine_types\": {";
+Json params_json(const GameParams& p) {
+  Json types = Json::object();
   for (int i = 0; i < kProductionMachineCount; ++i) {
-    if (i) o += ", ";
-    o += quote(kDeviceNames[i]) + ": " + quote(to_string(p.machine_types[i]));
+    types[std::string(kDeviceNames[i])] = to_string(p.machine_types[i]);
   }
-  o += "}, \"proc_time_s\": {";
+  Json proc = Json::object();
+  Json lights = Json::object();
   for (int t = 0; t < 5; ++t) {
-    if (t) o += ", ";
-    o += "\"T" + std::to_string(t + 1) + "\": " + std::to_string(p.proc_time_s[t]);
+    proc["T" + std::to_string(t + 1)] = p.proc_time_s[t];
+    lights["T" + std::to_string(t + 1)] = light_code_string(p.light_codes[t]);
   }
-  o += "}, \"light_codes\": {";
-  for (int t = 0; t < 5; ++t) {
-    if (t) o += ", ";
-    o += "\"T" + std::to_string(t + 1) + "\": " + quote(light_code_string(p.light_codes[t]));
+  Json down = Json::array();
+  for (const DownTime& d : p.down_times) {
+    down.push_back({{"machine", dev(d.device)}, {"start_s", d.start_s}, {"end_s", d.end_s}});
   }
-  o += "}, \"order_quantities\": [";
-  for (int i = 0; i < kRegularOrderCount; ++i) {
-    if (i) o += ", ";
-    o += std::to_string(p.order_quantities[i]);
+  Json gates = Json::array();
+  for (const GatePeriod& g : p.gate_schedule) {
+    gates.push_back({{"gate", dev(g.gate)}, {"start_s", g.start_s}, {"end_s", g.end_s}});
   }
-  o += "], \"late_order_start_s\": [" + std::to_string(p.late_order_start_s[0]) + ", " +
-       std::to_string(p.late_order_start_s[1]) + "], \"down_times\": [";
-  for (std::size_t i = 0; i < p.down_times.size(); ++i) {
-    const DownTime& d = p.down_times[i];
-    if (i) o += ", ";
-    o += "{\"machine\": " + dev(d.device) + ", \"start_s\": " + std::to_string(d.start_s) +
-         ", \"end_s\": " + std::to_string(d.end_s) + "}";
-  }
-  o += "], \"gate_schedule\": [";
-  for (std::size_t i = 0; i < p.gate_schedule.size(); ++i) {
-    const GatePeriod& g = p.gate_schedule[i];
-    if (i) o += ", ";
-    o += "{\"gate\": " + dev(g.gate) + ", \"start_s\": " + std::to_string(g.start_s) +
-         ", \"end_s\": " + std::to_string(g.end_s) + "}";
-  }
-  o += "]}";
+  return {{"machine_types", std::move(types)},          {"proc_time_s", std::move(proc)},
+          {"light_codes", std::move(lights)},           {"order_quantities", p.order_quantities},
+          {"late_order_start_s", p.late_order_start_s}, {"down_times", std::move(down)},
+          {"gate_schedule", std::move(gates)}};
 }
 
 }  // namespace
 
 std::string to_json(const GameReport& r) {
-  std::string o;
-  o.reserve(4096 + 160 * (r.awards.size() + r.machine_history.size() + r.deliveries.size()));
-  o += "{\n  \"rules\": " + quote(r.rules) + ",\n  \"team\": " + quote(r.team) +
-       ",\n  \"seed\": " + std::to_string(r.seed) +
-       ",\n  \"final_state\": " + quote(to_string(r.final_state)) +
-       ",\n  \"final_phase\": " + quote(to_string(r.final_phase)) +
-       ",\n  \"mode\": " + quote(to_string(r.mode)) +
-       ",\n  \"overtime\": " + (r.overtime ? "true" : "false") + ",\n  \"params\": ";
-  if (r.params) {
-    params_json(o, *r.params);
-  } else {
-    o += "null";
+  Json totals = Json::array();
+  for (const PhaseTotal& t : r.phase_totals) {
+    totals.push_back({{"phase", to_string(t.phase)}, {"sum", t.sum}, {"counted", t.counted}});
   }
-  o += ",\n  \"total_points\": " + std::to_string(r.total_points) + ",\n  \"phase_totals\": [";
-  for (std::size_t i = 0; i < r.phase_totals.size(); ++i) {
-    const PhaseTotal& t = r.phase_totals[i];
-    o += std::string(i ? ", " : "") + "{\"phase\": " + quote(to_string(t.phase)) +
-         ", \"sum\": " + std::to_string(t.sum) + ", \"counted\": " + std::to_string(t.counted) +
-         "}";
+  Json awards = Json::array();
+  for (const PointsAward& a : r.awards) {
+    awards.push_back({{"t", secs(a.game_time)},
+                      {"phase", to_string(a.phase)},
+                      {"points", a.points},
+                      {"reason", to_string(a.reason)},
+                      {"device", dev(a.device)},
+                      {"order", id_or_null(a.order.value(), a.order.valid())},
+                      {"puck", id_or_null(a.puck.value(), a.puck.valid())}});
   }
-  o += "],\n  \"awards\": [";
-  for (std::size_t i = 0; i < r.awards.size(); ++i) {
-    const PointsAward& a = r.awards[i];
-    o += std::string(i ? ",\n    " : "\n    ") + "{\"t\": " + secs(a.game_time) +
-         ", \"phase\": " + quote(to_string(a.phase)) + ", \"points\": " + std::to_string(a.points) +
-         ", \"reason\": " + quote(to_string(a.reason)) + ", \"device\": " + dev(a.device) +
-         ", \"order\": " + id_or_null(a.order.value(), a.order.valid()) +
-         ", \"puck\": " + id_or_null(a.puck.value(), a.puck.valid()) + "}";
+  Json orders = Json::array();
+  for (const OrderSummary& s : r.orders) {
+    orders.push_back({{"id", s.id.value()},
+                      {"product", to_string(s.product)},
+                      {"requested", s.requested},
+                      {"delivered", s.delivered},
+                      {"window", Json::array({s.window_begin_s, s.window_end_s})},
+                      {"late", s.late}});
   }
-  o += "],\n  \"orders\": [";
-  for (std::size_t i = 0; i < r.orders.size(); ++i) {
-    const OrderSummary& s = r.orders[i];
-    o += std::string(i ? ",\n    " : "\n    ") + "{\"id\": " + std::to_string(s.id.value()) +
-         ", \"product\": " + quote(to_string(s.product)) +
-         ", \"requested\": " + std::to_string(s.requested) +
-         ", \"delivered\": " + std::to_string(s.delivered) + ", \"window\": [" +
-         std::to_string(s.window_begin_s) + ", " + std::to_string(s.window_end_s) +
-         "], \"late\": " + (s.late ? "true" : "false") + "}";
+  Json deliveries = Json::array();
+  for (const DeliveryRecord& d : r.deliveries) {
+    deliveries.push_back({{"t", secs(d.game_time)},
+                          {"gate", dev(d.gate)},
+                          {"puck", d.puck.value()},
+                          {"product", to_string(d.product)},
+                          {"order", id_or_null(d.order.value(), d.order.valid())},
+                          {"points", d.points}});
   }
-  o += "],\n  \"deliveries\": [";
-  for (std::size_t i = 0; i < r.deliveries.size(); ++i) {
-    const DeliveryRecord& d = r.deliveries[i];
-    o += std::string(i ? ",\n    " : "\n    ") + "{\"t\": " + secs(d.game_time) +
-         ", \"gate\": " + dev(d.gate) + ", \"puck\": " + std::to_string(d.puck.value()) +
-         ", \"product\": " + quote(to_string(d.product)) +
-         ", \"order\": " + id_or_null(d.order.value(), d.order.valid()) +
-         ", \"points\": " + std::to_string(d.points) + "}";
+  Json history = Json::array();
+  for (const MachineHistoryEntry& h : r.machine_history) {
+    history.push_back({{"t", secs(h.game_time)},
+                       {"phase", to_string(h.phase)},
+                       {"device", dev(h.device)},
+                       {"from", to_string(h.from)},
+                       {"to", to_string(h.to)},
+                       {"puck", id_or_null(h.puck.value(), h.puck.valid())}});
   }
-  o += "],\n  \"machine_history\": [";
-  for (std::size_t i = 0; i < r.machine_history.size(); ++i) {
-    const MachineHistoryEntry& h = r.machine_history[i];
-    o += std::string(i ? ",\n    " : "\n    ") + "{\"t\": " + secs(h.game_time) +
-         ", \"phase\": " + quote(to_string(h.phase)) + ", \"device\": " + dev(h.device) +
-         ", \"from\": " + quote(to_string(h.from)) + ", \"to\": " + quote(to_string(h.to)) +
-         ", \"puck\": " + id_or_null(h.puck.value(), h.puck.valid()) + "}";
-  }
-  o += "]\n}\n";
-  return o;
+  const Json j = {{"rules", r.rules},
+                  {"team", r.team},
+                  {"seed", r.seed},
+                  {"final_state", to_string(r.final_state)},
+                  {"final_phase", to_string(r.final_phase)},
+                  {"mode", to_string(r.mode)},
+                  {"overtime", r.overtime},
+                  {"params", r.params ? params_json(*r.params) : Json(nullptr)},
+                  {"total_points", r.total_points},
+                  {"phase_totals", std::move(totals)},
+                  {"awards", std::move(awards)},
+                  {"orders", std::move(orders)},
+                  {"deliveries", std::move(deliveries)},
+                  {"machine_history", std::move(history)}};
+  return j.dump(2, ' ', false, Json::error_handler_t::replace) + "\n";
 }
 
 std::string_view to_string(AwardReason r) {

@@ -4,9 +4,10 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
-#include <cstdio>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string_view>
 #include <unordered_map>
@@ -18,42 +19,21 @@ namespace llsf::sim {
 
 namespace {
 
-std::string quote(std::string_view s) {
-  std::string out = "\"";
-  for (const char c : s) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", c);
-          out += buf;
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out + "\"";
+using Json = nlohmann::ordered_json;  // keys in the order written (docs/recording.md)
+
+/// `v` rounded to `decimals` places exactly as "%.*f" rounds it, -0 as 0: dump() then writes
+/// the shortest text of that value ("1.5" for 1.500), the same number for every reader.
+double fixed(double v, int decimals) {
+  char buf[64];
+  const auto [end, ec] =
+      std::to_chars(buf, buf + sizeof buf, v, std::chars_format::fixed, decimals);
+  if (ec != std::errc()) return v;  // too large for the buffer: far off the field anyway
+  double out = v;
+  std::from_chars(buf, end, out);
+  return out == 0.0 ? 0.0 : out;
 }
 
-std::string num(double v, int decimals) {
-  char buf[48];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  std::string s(buf);
-  if (s == "-0" || s == "-0.0" || s == "-0.00" || s == "-0.000") s.erase(0, 1);
-  return s;
-}
+Json xy(core::Vec2 p) { return Json::array({fixed(p.x(), 3), fixed(p.y(), 3)}); }
 
 int lamp(kinematic::LampState s) { return static_cast<int>(s); }  // 0 off, 1 on, 2 blink
 
@@ -98,18 +78,21 @@ struct Recorder::Impl {
   bool score_known = false;
   LineSink sink;
 
-  void write(const std::string& s) {
+  void write(const Json& j) {
     if (file == nullptr && !sink) return;
-    if (file != nullptr &&
-        (gzwrite(file, s.data(), static_cast<unsigned>(s.size())) != static_cast<int>(s.size()) ||
-         gzputc(file, '\n') < 0)) {
+    // Invalid UTF-8 (a robot's or a skill's text) becomes U+FFFD instead of an exception.
+    line = j.dump(-1, ' ', false, Json::error_handler_t::replace);
+    if (file != nullptr && (gzwrite(file, line.data(), static_cast<unsigned>(line.size())) !=
+                                static_cast<int>(line.size()) ||
+                            gzputc(file, '\n') < 0)) {
       throw core::UserError(path + ": cannot write the recording");
     }
-    if (sink) sink(s);
+    if (sink) sink(line);
     ++lines;
   }
-  std::string head(SimTime t, const char* event) {
-    return "{\"t\": " + num(t.seconds(), 2) + ", \"e\": \"" + event + "\"";
+  /// An event line's start: {"t": .., "e": event}.
+  static Json event(SimTime t, const char* name) {
+    return Json{{"t", fixed(t.seconds(), 2)}, {"e", name}};
   }
 };
 
@@ -129,66 +112,68 @@ Recorder::Recorder(const std::string& path, const Game& game, const RecordingInf
   m.period = SimTime::period_of_hz(pose_rate_hz);
   m.next_frame = game.time();
   const kinematic::WorldConfig& w = game.config().world;
-  std::string h =
-      "{\"format\": \"llsfsim-recording\", \"version\": " + std::to_string(kRecordingVersion) +
-      ", \"scenario\": " + quote(info.scenario) + ", \"variant\": " + quote(info.variant) +
-      ", \"seed\": " + std::to_string(info.seed) + ", \"llsfsim\": " + quote(info.llsfsim_version) +
-      ", \"pose_hz\": " + num(pose_rate_hz, 3) +
-      ", \"field\": {\"width\": " + num(w.field.width_m, 3) +
-      ", \"height\": " + num(w.field.height_m, 3) + "}, \"devices\": [";
+  Json h = {
+      {"format", "llsfsim-recording"},
+      {"version", kRecordingVersion},
+      {"scenario", info.scenario},
+      {"variant", info.variant},
+      {"seed", info.seed},
+      {"llsfsim", info.llsfsim_version},
+      {"pose_hz", fixed(pose_rate_hz, 3)},
+      {"field", {{"width", fixed(w.field.width_m, 3)}, {"height", fixed(w.field.height_m, 3)}}}};
+  Json devices = Json::array();
   for (int i = 0; i < kinematic::kDeviceCount; ++i) {
     const kinematic::DeviceConfig& d = w.devices[static_cast<std::size_t>(i)];
     const core::OrientedBox box = d.footprint();
-    h += std::string(i ? ", " : "") +
-         "{\"name\": " + quote(kinematic::device_name(core::DeviceId(i))) +
-         ", \"x\": " + num(d.pose.x, 3) + ", \"y\": " + num(d.pose.y, 3) +
-         ", \"ori\": " + num(d.pose.theta, 3) + ", \"box\": [" + num(box.pose.x, 3) + ", " +
-         num(box.pose.y, 3) + ", " + num(2.0 * box.half_extents.x(), 3) + ", " +
-         num(2.0 * box.half_extents.y(), 3) + ", " + num(box.pose.theta, 3) + "]}";
+    devices.push_back(
+        {{"name", kinematic::device_name(core::DeviceId(i))},
+         {"x", fixed(d.pose.x, 3)},
+         {"y", fixed(d.pose.y, 3)},
+         {"ori", fixed(d.pose.theta, 3)},
+         {"box", Json::array({fixed(box.pose.x, 3), fixed(box.pose.y, 3),
+                              fixed(2.0 * box.half_extents.x(), 3),
+                              fixed(2.0 * box.half_extents.y(), 3), fixed(box.pose.theta, 3)})}});
   }
-  h += "], \"robots\": [";
+  h["devices"] = std::move(devices);
+  Json robots = Json::array();
+  Json jerseys = Json::array();
   for (int i = 0; i < game.robot_count(); ++i) {
     m.robot_names.emplace_back(game.robot(i).name());
-    h += std::string(i ? ", " : "") + quote(game.robot(i).name());
+    robots.push_back(game.robot(i).name());
+    jerseys.push_back(w.robots.at(static_cast<std::size_t>(i)).jersey_or(i));
   }
-  h += "], \"jerseys\": [";
-  for (int i = 0; i < game.robot_count(); ++i) {
-    h += std::string(i ? ", " : "") +
-         std::to_string(w.robots.at(static_cast<std::size_t>(i)).jersey_or(i));
-  }
-  h += "], \"robot_radius\": " + num(w.robot.radius_m, 3) +
-       ", \"puck_radius\": " + num(w.puck.radius_m, 4);
+  h["robots"] = std::move(robots);
+  h["jerseys"] = std::move(jerseys);
+  h["robot_radius"] = fixed(w.robot.radius_m, 3);
+  h["puck_radius"] = fixed(w.puck.radius_m, 4);
   // Extra obstacles and the hackathon's task (only when present; docs/recording.md).
   if (!w.obstacles.empty()) {
-    h += ", \"obstacles\": [";
-    for (std::size_t i = 0; i < w.obstacles.size(); ++i) {
-      const kinematic::ObstacleConfig& o = w.obstacles[i];
-      h += std::string(i ? ", " : "") + "{\"name\": " + quote(o.name) + ", \"box\": [" +
-           num(o.pose.x, 3) + ", " + num(o.pose.y, 3) + ", " + num(o.size_x_m, 3) + ", " +
-           num(o.size_y_m, 3) + ", " + num(o.pose.theta, 3) + "]}";
+    Json obstacles = Json::array();
+    for (const kinematic::ObstacleConfig& o : w.obstacles) {
+      obstacles.push_back(
+          {{"name", o.name},
+           {"box", Json::array({fixed(o.pose.x, 3), fixed(o.pose.y, 3), fixed(o.size_x_m, 3),
+                                fixed(o.size_y_m, 3), fixed(o.pose.theta, 3)})}});
     }
-    h += "]";
+    h["obstacles"] = std::move(obstacles);
   }
   if (const HackathonLayout* layout = game.hackathon_layout()) {
     const HackathonConfig& hc = *game.config().hackathon;
     const kinematic::Rect& a = hc.safe_area;
-    h += ", \"hackathon\": {\"safe_area\": [" + num(a.lo.x(), 3) + ", " + num(a.lo.y(), 3) + ", " +
-         num(a.hi.x(), 3) + ", " + num(a.hi.y(), 3) + "], \"safe_place\": " + quote(hc.safe_place) +
-         ", \"colours\": [";
-    for (std::size_t i = 0; i < hc.colours.size(); ++i) {
-      h += std::string(i ? ", " : "") + "{\"name\": " + quote(hc.colours[i].name) +
-           ", \"decoy\": " + (hc.colours[i].decoy ? "true" : "false") + "}";
+    Json colours = Json::array();
+    for (const auto& c : hc.colours) colours.push_back({{"name", c.name}, {"decoy", c.decoy}});
+    Json pucks = Json::object();
+    for (const HackathonPuck& p : layout->pucks) {
+      pucks[std::to_string(p.id.value())] = hc.colours[static_cast<std::size_t>(p.colour)].name;
     }
-    h += "], \"pucks\": {";
-    for (std::size_t i = 0; i < layout->pucks.size(); ++i) {
-      const HackathonPuck& p = layout->pucks[i];
-      h += std::string(i ? ", " : "") + quote(std::to_string(p.id.value())) + ": " +
-           quote(hc.colours[static_cast<std::size_t>(p.colour)].name);
-    }
-    h += "}, \"points_per_puck\": " + std::to_string(hc.points_per_puck) +
-         ", \"decoy_penalty\": " + std::to_string(hc.decoy_penalty) + "}";
+    h["hackathon"] = {{"safe_area", Json::array({fixed(a.lo.x(), 3), fixed(a.lo.y(), 3),
+                                                 fixed(a.hi.x(), 3), fixed(a.hi.y(), 3)})},
+                      {"safe_place", hc.safe_place},
+                      {"colours", std::move(colours)},
+                      {"pucks", std::move(pucks)},
+                      {"points_per_puck", hc.points_per_puck},
+                      {"decoy_penalty", hc.decoy_penalty}};
   }
-  h += "}";
   m.write(h);
 }
 
@@ -209,12 +194,13 @@ void Recorder::close() {
 std::int64_t Recorder::lines() const { return impl_->lines; }
 
 void Recorder::skill(const SkillStatusChange& c) {
-  Impl& m = *impl_;
-  std::string s = m.head(c.time, "skill") + ", \"robot\": " + quote(c.robot) + ", \"status\": \"" +
-                  lua::to_string(c.status) + "\", \"string\": " + quote(c.skill_string);
-  if (!c.result.empty()) s += ", \"result\": " + quote(c.result);
-  if (!c.error.empty()) s += ", \"error\": " + quote(c.error);
-  m.write(s + "}");
+  Json j = Impl::event(c.time, "skill");
+  j["robot"] = c.robot;
+  j["status"] = lua::to_string(c.status);
+  j["string"] = c.skill_string;
+  if (!c.result.empty()) j["result"] = c.result;
+  if (!c.error.empty()) j["error"] = c.error;
+  impl_->write(j);
 }
 
 std::string recording_file_name(const std::string& scenario, const std::string& variant,
@@ -230,19 +216,27 @@ std::string recording_file_name(const std::string& scenario, const std::string& 
 }
 
 void Recorder::agent(const clips::LogRecord& r) {
-  impl_->write(impl_->head(r.time, "agent") + ", \"robot\": " + quote(r.agent) + ", \"level\": \"" +
-               clips::to_string(r.level) + "\", \"text\": " + quote(r.text) + "}");
+  Json j = Impl::event(r.time, "agent");
+  j["robot"] = r.agent;
+  j["level"] = clips::to_string(r.level);
+  j["text"] = r.text;
+  impl_->write(j);
 }
 
 void Recorder::lock(const std::string& robot, const clips::LockEvent& e) {
-  impl_->write(impl_->head(e.time, "lock") + ", \"robot\": " + quote(robot) +
-               ", \"resource\": " + quote(e.resource) + ", \"from\": \"" +
-               clips::to_string(e.from) + "\", \"to\": \"" + clips::to_string(e.to) + "\"}");
+  Json j = Impl::event(e.time, "lock");
+  j["robot"] = robot;
+  j["resource"] = e.resource;
+  j["from"] = clips::to_string(e.from);
+  j["to"] = clips::to_string(e.to);
+  impl_->write(j);
 }
 
 void Recorder::note(SimTime t, const std::string& robot, const std::string& text) {
-  impl_->write(impl_->head(t, "note") + ", \"robot\": " + quote(robot) +
-               ", \"text\": " + quote(text) + "}");
+  Json j = Impl::event(t, "note");
+  j["robot"] = robot;
+  j["text"] = text;
+  impl_->write(j);
 }
 
 void Recorder::frame(const Game& game) {
@@ -256,55 +250,64 @@ void Recorder::frame(const Game& game) {
     m.state_known = true;
     m.phase = rb.phase();
     m.state = rb.state();
-    m.write(m.head(t, "game") + ", \"phase\": " + quote(refbox::to_string(m.phase)) +
-            ", \"state\": " + quote(refbox::to_string(m.state)) +
-            ", \"points\": " + std::to_string(rb.points()) + "}");
+    Json j = Impl::event(t, "game");
+    j["phase"] = refbox::to_string(m.phase);
+    j["state"] = refbox::to_string(m.state);
+    j["points"] = rb.points();
+    m.write(j);
   }
   if (!m.plan_written && rb.params()) {
     m.plan_written = true;
-    std::string s = m.head(t, "plan") + ", \"types\": {";
+    Json types = Json::object();
     for (int i = 0; i < refbox::kProductionMachineCount; ++i) {
-      s += std::string(i ? ", " : "") + quote(kinematic::device_name(core::DeviceId(i))) + ": " +
-           quote(refbox::to_string(rb.params()->machine_types[static_cast<std::size_t>(i)]));
+      types[std::string(kinematic::device_name(core::DeviceId(i)))] =
+          refbox::to_string(rb.params()->machine_types[static_cast<std::size_t>(i)]);
     }
-    m.write(s + "}}");
+    Json j = Impl::event(t, "plan");
+    j["types"] = std::move(types);
+    m.write(j);
   }
   const auto& awards = rb.awards();
   for (; m.awards < awards.size(); ++m.awards) {
     const refbox::PointsAward& a = awards[m.awards];
-    std::string s = m.head(t, "award") + ", \"points\": " + std::to_string(a.points) +
-                    ", \"reason\": " + quote(refbox::to_string(a.reason)) +
-                    ", \"total\": " + std::to_string(rb.points());
-    if (a.device.valid()) s += ", \"device\": " + quote(kinematic::device_name(a.device));
-    if (a.order.valid()) s += ", \"order\": " + std::to_string(a.order.value());
-    if (a.puck.valid()) s += ", \"puck\": " + std::to_string(a.puck.value());
-    m.write(s + "}");
+    Json j = Impl::event(t, "award");
+    j["points"] = a.points;
+    j["reason"] = refbox::to_string(a.reason);
+    j["total"] = rb.points();
+    if (a.device.valid()) j["device"] = kinematic::device_name(a.device);
+    if (a.order.valid()) j["order"] = a.order.value();
+    if (a.puck.valid()) j["puck"] = a.puck.value();
+    m.write(j);
   }
   for (int i = 0; i < kinematic::kDeviceCount; ++i) {
     const kinematic::SignalLights l = world.lights(core::DeviceId(i));
     auto& last = m.lights[static_cast<std::size_t>(i)];
     if (m.lights_known && l == last) continue;
     last = l;
-    m.write(m.head(t, "lights") + ", \"d\": " + quote(kinematic::device_name(core::DeviceId(i))) +
-            ", \"l\": [" + std::to_string(lamp(l.red)) + ", " + std::to_string(lamp(l.yellow)) +
-            ", " + std::to_string(lamp(l.green)) + "]}");
+    Json j = Impl::event(t, "lights");
+    j["d"] = kinematic::device_name(core::DeviceId(i));
+    j["l"] = Json::array({lamp(l.red), lamp(l.yellow), lamp(l.green)});
+    m.write(j);
   }
   m.lights_known = true;
   const kinematic::WorldEvents& ev = game.last_events();
   for (const kinematic::RfidEvent& e : ev.rfid) {
-    m.write(m.head(t, "rfid") + ", \"d\": " + quote(kinematic::device_name(e.device)) +
-            ", \"puck\": " + std::to_string(e.puck.value()) +
-            ", \"in\": " + (e.kind == kinematic::RfidEventKind::kEntered ? "true" : "false") + "}");
+    Json j = Impl::event(t, "rfid");
+    j["d"] = kinematic::device_name(e.device);
+    j["puck"] = e.puck.value();
+    j["in"] = e.kind == kinematic::RfidEventKind::kEntered;
+    m.write(j);
   }
   for (const kinematic::CollisionEvent& c : ev.collisions) {
-    std::string s = m.head(t, "collision") + ", \"kind\": \"" + collision_kind(c.kind) +
-                    "\", \"robot\": " + quote(m.robot_names.at(c.robot.value()));
+    Json j = Impl::event(t, "collision");
+    j["kind"] = collision_kind(c.kind);
+    j["robot"] = m.robot_names.at(c.robot.value());
     if (c.kind == kinematic::CollisionKind::kRobotRobot) {
-      s += ", \"other\": " + quote(m.robot_names.at(c.other_robot.value()));
+      j["other"] = m.robot_names.at(c.other_robot.value());
     } else if (c.kind == kinematic::CollisionKind::kRobotDevice) {
-      s += ", \"other\": " + quote(kinematic::device_name(c.device));
+      j["other"] = kinematic::device_name(c.device);
     }
-    m.write(s + "}");
+    m.write(j);
   }
 
   // Jams of the robot profiles: when a robot jams at a device and when it gets free.
@@ -314,10 +317,11 @@ void Recorder::frame(const Game& game) {
     if (d == last) continue;
     const int device = d >= 0 ? d : last;
     last = d;
-    m.write(m.head(t, "jam") +
-            ", \"robot\": " + quote(m.robot_names.at(static_cast<std::size_t>(i))) +
-            ", \"d\": " + quote(kinematic::device_name(core::DeviceId(device))) +
-            ", \"jammed\": " + (d >= 0 ? "true" : "false") + "}");
+    Json j = Impl::event(t, "jam");
+    j["robot"] = m.robot_names.at(static_cast<std::size_t>(i));
+    j["d"] = kinematic::device_name(core::DeviceId(device));
+    j["jammed"] = d >= 0;
+    m.write(j);
   }
 
   if (t < m.next_frame) return;
@@ -335,28 +339,27 @@ void Recorder::frame(const Game& game) {
                    [](const core::Vec2& a, const core::Vec2& b) { return (a - b).norm() < 1e-3; }))
       continue;
     last = now;
-    std::string e = m.head(t, "path") +
-                    ", \"robot\": " + quote(m.robot_names.at(static_cast<std::size_t>(i))) +
-                    ", \"points\": [";
-    for (std::size_t k = 0; k < now.size(); ++k) {
-      e += std::string(k ? ", " : "") + "[" + num(now[k].x(), 3) + ", " + num(now[k].y(), 3) + "]";
-    }
-    m.write(e + "]}");
+    Json points = Json::array();
+    for (const core::Vec2& p : now) points.push_back(xy(p));
+    Json j = Impl::event(t, "path");
+    j["robot"] = m.robot_names.at(static_cast<std::size_t>(i));
+    j["points"] = std::move(points);
+    m.write(j);
   }
 
   // Pose frame: robots (true pose, believed pose, held puck), pucks that moved, removed pucks.
-  std::string& s = m.line;
-  s = "{\"t\": " + num(t.seconds(), 2) + ", \"f\": 1, \"r\": [";
+  Json robots = Json::array();
   for (int i = 0; i < game.robot_count(); ++i) {
     const core::Pose2D p = world.robot_pose(core::RobotId(i));
     const lua::PoseEstimate b = game.robot(i).pose();
     const auto held = game.puck_in_pocket(i);
-    s += std::string(i ? ", " : "") + "[" + num(p.x, 3) + ", " + num(p.y, 3) + ", " +
-         num(p.theta, 3) + ", " + num(b.pose.x, 3) + ", " + num(b.pose.y, 3) + ", " +
-         num(b.pose.theta, 3) + ", " + std::to_string(held ? held->value() : 0) + "]";
+    robots.push_back(
+        Json::array({fixed(p.x, 3), fixed(p.y, 3), fixed(p.theta, 3), fixed(b.pose.x, 3),
+                     fixed(b.pose.y, 3), fixed(b.pose.theta, 3), held ? held->value() : 0}));
   }
-  s += "]";
-  std::string moved, removed;
+  Json f = {{"t", fixed(t.seconds(), 2)}, {"f", 1}, {"r", std::move(robots)}};
+  Json moved = Json::array();
+  Json removed = Json::array();
   std::unordered_map<std::uint32_t, bool> present;
   for (const core::PuckId id : world.pucks()) {
     const core::Vec2 p = world.puck_position(id);
@@ -367,26 +370,25 @@ void Recorder::frame(const Game& game) {
       continue;
     }
     m.puck_pos[id.value()] = {p.x(), p.y()};
-    moved += std::string(moved.empty() ? "" : ", ") + "[" + std::to_string(id.value()) + ", " +
-             num(p.x(), 3) + ", " + num(p.y(), 3) + "]";
+    moved.push_back(Json::array({id.value(), fixed(p.x(), 3), fixed(p.y(), 3)}));
   }
   for (auto it = m.puck_pos.begin(); it != m.puck_pos.end();) {
     if (present.count(it->first) == 0) {
-      removed += std::string(removed.empty() ? "" : ", ") + std::to_string(it->first);
+      removed.push_back(it->first);
       it = m.puck_pos.erase(it);
     } else {
       ++it;
     }
   }
-  if (!moved.empty()) s += ", \"p\": [" + moved + "]";
-  if (!removed.empty()) s += ", \"pr\": [" + removed + "]";
+  if (!moved.empty()) f["p"] = std::move(moved);
+  if (!removed.empty()) f["pr"] = std::move(removed);
   const std::int64_t dropped = game.hub().total_counters().dropped_total();
   if (dropped != m.dropped) {
-    s += ", \"drops\": " + std::to_string(dropped - m.dropped);
+    f["drops"] = dropped - m.dropped;
     m.dropped = dropped;
     // By sender robot: copies of its messages dropped on any link.
     const comm::Hub& hub = game.hub();
-    std::string by;
+    Json by = Json::object();
     for (int i = 0; i < game.robot_count(); ++i) {
       const comm::PeerId from = game.robot_peer(i);
       std::int64_t n = 0;
@@ -395,28 +397,27 @@ void Recorder::frame(const Game& game) {
       }
       std::int64_t& last = m.robot_dropped[static_cast<std::size_t>(i)];
       if (n != last) {
-        by += std::string(by.empty() ? "" : ", ") +
-              quote(m.robot_names.at(static_cast<std::size_t>(i))) + ": " +
-              std::to_string(n - last);
+        by[m.robot_names.at(static_cast<std::size_t>(i))] = n - last;
         last = n;
       }
     }
-    if (!by.empty()) s += ", \"drops_from\": {" + by + "}";
+    if (!by.empty()) f["drops_from"] = std::move(by);
   }
-  m.write(s + "}");
+  m.write(f);
 
   // The hackathon score, at the frame rate, when it changed.
   if (const std::optional<HackathonScore> score = game.hackathon_score()) {
     if (!m.score_known || score->points != m.score.points || score->rescued != m.score.rescued ||
         score->decoys != m.score.decoys || score->in_safe_area != m.score.in_safe_area) {
       if (m.score_known || score->rescued != 0 || score->decoys != 0) {
-        std::string ids;
-        for (const core::PuckId id : score->in_safe_area) {
-          ids += (ids.empty() ? "" : ", ") + std::to_string(id.value());
-        }
-        m.write(m.head(t, "rescue") + ", \"points\": " + std::to_string(score->points) +
-                ", \"rescued\": " + std::to_string(score->rescued) +
-                ", \"decoys\": " + std::to_string(score->decoys) + ", \"pucks\": [" + ids + "]}");
+        Json ids = Json::array();
+        for (const core::PuckId id : score->in_safe_area) ids.push_back(id.value());
+        Json j = Impl::event(t, "rescue");
+        j["points"] = score->points;
+        j["rescued"] = score->rescued;
+        j["decoys"] = score->decoys;
+        j["pucks"] = std::move(ids);
+        m.write(j);
       }
       m.score = *score;
       m.score_known = true;
@@ -428,19 +429,23 @@ void Recorder::frame(const Game& game) {
     auto it = m.puck_states.find(p.id.value());
     if (it != m.puck_states.end() && it->second == p.state) continue;
     m.puck_states[p.id.value()] = p.state;
-    m.write(m.head(t, "puck") + ", \"id\": " + std::to_string(p.id.value()) +
-            ", \"state\": " + quote(refbox::to_string(p.state)) + "}");
+    Json j = Impl::event(t, "puck");
+    j["id"] = p.id.value();
+    j["state"] = refbox::to_string(p.state);
+    m.write(j);
   }
   for (const refbox::Order& o : rb.orders()) {
     if (!o.active) continue;
     auto it = m.delivered.find(o.id.value());
     if (it != m.delivered.end() && it->second == o.quantity_delivered) continue;
     m.delivered[o.id.value()] = o.quantity_delivered;
-    m.write(m.head(t, "order") + ", \"id\": " + std::to_string(o.id.value()) +
-            ", \"product\": " + quote(refbox::to_string(o.product)) +
-            ", \"requested\": " + std::to_string(o.quantity_requested) +
-            ", \"delivered\": " + std::to_string(o.quantity_delivered) + ", \"window\": [" +
-            std::to_string(o.window_begin_s) + ", " + std::to_string(o.window_end_s) + "]}");
+    Json j = Impl::event(t, "order");
+    j["id"] = o.id.value();
+    j["product"] = refbox::to_string(o.product);
+    j["requested"] = o.quantity_requested;
+    j["delivered"] = o.quantity_delivered;
+    j["window"] = Json::array({o.window_begin_s, o.window_end_s});
+    m.write(j);
   }
 }
 
@@ -470,40 +475,38 @@ std::vector<RecordingLine> read_recording(const std::string& path) {
     ++number;
     while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.pop_back();
     if (line.empty()) continue;
-    if (line.front() != '{' || line.back() != '}') fail("not a JSON object");
+    Json j;
+    try {
+      j = Json::parse(line);
+    } catch (const Json::parse_error& e) {
+      fail(std::string("not a JSON object (") + e.what() + ")");
+    }
+    if (!j.is_object()) fail("not a JSON object");
     RecordingLine r;
-    r.json = line;
-    auto field = [&](std::string_view key) -> std::string {
-      const std::string k = "\"" + std::string(key) + "\": ";
-      const auto p = line.find(k);
-      if (p == std::string::npos) return {};
-      std::size_t b = p + k.size();
-      std::size_t e = b;
-      if (line[b] == '"') {
-        e = line.find('"', b + 1);
-        return e == std::string::npos ? std::string() : line.substr(b + 1, e - b - 1);
-      }
-      while (e < line.size() && line[e] != ',' && line[e] != '}') ++e;
-      return line.substr(b, e - b);
-    };
     if (number == 1) {
-      if (field("format") != "llsfsim-recording") fail("not an llsfsim recording");
-      if (field("version") != std::to_string(kRecordingVersion)) {
-        fail("recording version " + field("version") + " (this llsfsim reads version " +
-             std::to_string(kRecordingVersion) + ")");
+      const auto format = j.find("format");
+      if (format == j.end() || *format != "llsfsim-recording") fail("not an llsfsim recording");
+      const auto version = j.find("version");
+      if (version == j.end() || *version != kRecordingVersion) {
+        fail("recording version " + (version == j.end() ? "(none)" : version->dump()) +
+             " (this llsfsim reads version " + std::to_string(kRecordingVersion) + ")");
       }
       r.kind = "header";
     } else {
-      const std::string t = field("t");
-      if (t.empty()) fail("a line without a time \"t\"");
-      try {
-        r.t = std::stod(t);
-      } catch (const std::exception&) {
-        fail("bad time '" + t + "'");
+      const auto t = j.find("t");
+      if (t == j.end()) fail("a line without a time \"t\"");
+      if (!t->is_number()) fail("bad time " + t->dump());
+      r.t = t->get<double>();
+      const auto e = j.find("e");
+      if (j.contains("f")) {
+        r.kind = "frame";
+      } else if (e != j.end() && e->is_string() && !e->get_ref<const std::string&>().empty()) {
+        r.kind = e->get<std::string>();
+      } else {
+        fail("a line that is neither a frame nor an event");
       }
-      r.kind = line.find("\"f\": 1") != std::string::npos ? "frame" : field("e");
-      if (r.kind.empty()) fail("a line that is neither a frame nor an event");
     }
+    r.json = std::move(line);
     out.push_back(std::move(r));
   }
   gzclose(f);

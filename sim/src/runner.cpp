@@ -5,9 +5,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <ctime>
 #include <map>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
 
@@ -476,62 +479,73 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
 }
 
 std::string to_json(const RunResult& r) {
-  std::ostringstream o;
-  auto str = [](const std::string& s) {
-    std::string out = "\"";
-    for (const char c : s) {
-      if (c == '"' || c == '\\') out += '\\';
-      out += c;
-    }
-    return out + "\"";
-  };
-  o << "{\"scenario\": " << str(r.scenario) << ", \"variant\": " << str(r.variant)
-    << ", \"seed\": " << r.seed << ", \"profile\": " << str(r.profile)
-    << ", \"game_time_s\": " << r.game_time_s << ", \"points\": " << r.points
-    << ", \"exploration_points\": " << r.exploration_points
-    << ", \"production_points\": " << r.production_points
-    << ", \"exploration_reports\": " << r.exploration_reports
-    << ", \"exploration_correct\": " << r.exploration_correct
-    << ", \"deliveries\": " << r.deliveries << ", \"orders\": [";
-  for (std::size_t i = 0; i < r.orders.size(); ++i) {
-    const OrderResult& x = r.orders[i];
-    o << (i ? ", " : "") << "{\"id\": " << x.id << ", \"product\": " << str(x.product)
-      << ", \"requested\": " << x.requested << ", \"delivered\": " << x.delivered
-      << ", \"window\": [" << x.window_begin_s << ", " << x.window_end_s << "]}";
+  using Json = nlohmann::ordered_json;  // keys in the order documented (docs/llsfsim.md)
+  // JSON has no NaN or infinity: null instead.
+  auto number = [](double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); };
+  Json orders = Json::array();
+  for (const OrderResult& x : r.orders) {
+    orders.push_back({{"id", x.id},
+                      {"product", x.product},
+                      {"requested", x.requested},
+                      {"delivered", x.delivered},
+                      {"window", Json::array({x.window_begin_s, x.window_end_s})}});
   }
-  o << "], \"products\": {\"P1\": " << r.products_p1 << ", \"P2\": " << r.products_p2
-    << ", \"P3\": " << r.products_p3 << "}, \"recycled\": " << r.recycled
-    << ", \"recycle_points\": " << r.recycle_points << ", \"collisions\": " << r.collisions
-    << ", \"skill_failures\": " << r.skill_failures
-    << ", \"agent_runtime_errors\": " << r.agent_runtime_errors
-    << ", \"locks\": {\"grants\": " << r.lock_grants << ", \"refusals\": " << r.lock_refusals
-    << ", \"waits\": " << r.lock_waits << ", \"wait_s\": " << r.lock_wait_s
-    << ", \"wait_max_s\": " << r.lock_wait_max_s << ", \"hold_max_s\": " << r.lock_hold_max_s
-    << "}, \"first_complex_s\": " << r.first_complex_s << ", \"role_changes\": " << r.role_changes
-    << ", \"first_role_change_s\": " << r.first_role_change_s
-    << ", \"storage_min\": " << r.storage_min << ", \"storage_empty_s\": " << r.storage_empty_s
-    << ", \"jams\": " << r.jams << ", \"jammed_at_end\": " << r.jammed_at_end
-    << ", \"skill_failure_streak_max\": " << r.skill_failure_streak_max
-    << ", \"messages_sent\": " << r.messages_sent
-    << ", \"messages_dropped\": " << r.messages_dropped << ", \"cpu_s\": " << r.cpu_s
-    << ", \"real_time_factor\": " << r.real_time_factor << ", \"result_hash\": \"" << std::hex
-    << r.result_hash << std::dec << "\", \"passed\": " << (r.passed() ? "true" : "false")
-    << ", \"tests\": [";
-  for (std::size_t i = 0; i < r.tests.size(); ++i) {
-    const TestVerdict& t = r.tests[i];
-    o << (i ? ", " : "") << "{\"name\": " << str(t.name)
-      << ", \"passed\": " << (t.passed ? "true" : "false") << ", \"detail\": " << str(t.detail)
-      << "}";
+  Json tests = Json::array();
+  for (const TestVerdict& t : r.tests) {
+    tests.push_back({{"name", t.name}, {"passed", t.passed}, {"detail", t.detail}});
   }
-  o << "]";
+  char hash[17];
+  std::snprintf(hash, sizeof hash, "%llx", static_cast<unsigned long long>(r.result_hash));
+  Json j = {{"scenario", r.scenario},
+            {"variant", r.variant},
+            {"seed", r.seed},
+            {"profile", r.profile},
+            {"game_time_s", number(r.game_time_s)},
+            {"points", r.points},
+            {"exploration_points", r.exploration_points},
+            {"production_points", r.production_points},
+            {"exploration_reports", r.exploration_reports},
+            {"exploration_correct", r.exploration_correct},
+            {"deliveries", r.deliveries},
+            {"orders", std::move(orders)},
+            {"products", {{"P1", r.products_p1}, {"P2", r.products_p2}, {"P3", r.products_p3}}},
+            {"recycled", r.recycled},
+            {"recycle_points", r.recycle_points},
+            {"collisions", r.collisions},
+            {"skill_failures", r.skill_failures},
+            {"agent_runtime_errors", r.agent_runtime_errors},
+            {"locks",
+             {{"grants", r.lock_grants},
+              {"refusals", r.lock_refusals},
+              {"waits", r.lock_waits},
+              {"wait_s", number(r.lock_wait_s)},
+              {"wait_max_s", number(r.lock_wait_max_s)},
+              {"hold_max_s", number(r.lock_hold_max_s)}}},
+            {"first_complex_s", number(r.first_complex_s)},
+            {"role_changes", r.role_changes},
+            {"first_role_change_s", number(r.first_role_change_s)},
+            {"storage_min", r.storage_min},
+            {"storage_empty_s", number(r.storage_empty_s)},
+            {"jams", r.jams},
+            {"jammed_at_end", r.jammed_at_end},
+            {"skill_failure_streak_max", r.skill_failure_streak_max},
+            {"messages_sent", r.messages_sent},
+            {"messages_dropped", r.messages_dropped},
+            {"cpu_s", number(r.cpu_s)},
+            {"real_time_factor", number(r.real_time_factor)},
+            {"result_hash", hash},
+            {"passed", r.passed()},
+            {"tests", std::move(tests)}};
   if (r.hackathon) {
     const HackathonScore& h = *r.hackathon;
-    o << ", \"hackathon\": {\"points\": " << h.points << ", \"rescued\": " << h.rescued
-      << ", \"decoys\": " << h.decoys << ", \"rescuable\": " << h.rescuable
-      << ", \"total_pucks\": " << h.total_pucks << "}";
+    j["hackathon"] = {{"points", h.points},
+                      {"rescued", h.rescued},
+                      {"decoys", h.decoys},
+                      {"rescuable", h.rescuable},
+                      {"total_pucks", h.total_pucks}};
   }
-  o << "}";
-  return o.str();
+  // One line; invalid UTF-8 (a scenario name from a file) becomes U+FFFD.
+  return j.dump(-1, ' ', false, Json::error_handler_t::replace);
 }
 
 }  // namespace llsf::sim

@@ -3,6 +3,8 @@
 // game report's JSON rendering.
 #include <doctest/doctest.h>
 
+#include <algorithm>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "fixture.h"
@@ -154,10 +156,20 @@ TEST_CASE("the game report holds plan, awards, totals, orders, deliveries and ma
   CHECK(m5 == 2);
   const std::string json = to_json(r);
   CHECK(json == to_json(g.rb.report()));
-  CHECK(json.find("\"total_points\": 10") != std::string::npos);
-  CHECK(json.find("\"reason\": \"DELIVERY\"") != std::string::npos);
-  CHECK(json.find("\"machine_types\": {\"M1\": \"T1\"") != std::string::npos);
-  CHECK(json.find("{\"gate\": \"D1\", \"start_s\": 0, \"end_s\": 300}") != std::string::npos);
-  CHECK(json.find("\"device\": \"M5\", \"from\": \"IDLE\", \"to\": \"PROCESSING\"") !=
-        std::string::npos);
+  const nlohmann::ordered_json j = nlohmann::ordered_json::parse(json);
+  CHECK(j.begin().key() == "rules");
+  CHECK(j["total_points"] == 10);
+  CHECK(j["awards"][1]["reason"] == "DELIVERY");
+  CHECK(j["params"]["machine_types"].begin().key() == "M1");
+  CHECK(j["params"]["machine_types"]["M1"] == "T1");
+  const auto& gates = j["params"]["gate_schedule"];
+  CHECK(std::find(gates.begin(), gates.end(),
+                  nlohmann::ordered_json{{"gate", "D1"}, {"start_s", 0}, {"end_s", 300}}) !=
+        gates.end());
+  bool m5_processing = false;
+  for (const auto& h : j["machine_history"]) {
+    m5_processing =
+        m5_processing || (h["device"] == "M5" && h["from"] == "IDLE" && h["to"] == "PROCESSING");
+  }
+  CHECK(m5_processing);
 }

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "llsf/sim/recording.h"
@@ -17,6 +18,7 @@
 
 using namespace llsf;
 using namespace llsf::sim;
+using Json = nlohmann::json;
 
 namespace {
 
@@ -40,8 +42,7 @@ TEST_CASE("a full game is recorded: 10 Hz frames, events, well under 5 MB, reada
   const std::vector<RecordingLine> lines = read_recording(path);
   REQUIRE(lines.size() > 10000);
   CHECK(lines[0].kind == "header");
-  CHECK(lines[0].json.find("\"robots\": [\"robot1\", \"robot2\", \"robot3\"]") !=
-        std::string::npos);
+  CHECK(Json::parse(lines[0].json)["robots"] == Json{"robot1", "robot2", "robot3"});
   std::map<std::string, int> kinds;
   double last_t = 0.0;
   bool ordered = true;
@@ -65,8 +66,7 @@ TEST_CASE("a full game is recorded: 10 Hz frames, events, well under 5 MB, reada
   int award_points = 0;
   for (const RecordingLine& l : lines) {
     if (l.kind != "award") continue;
-    const auto p = l.json.find("\"points\": ");
-    award_points += std::stoi(l.json.substr(p + 10));
+    award_points += Json::parse(l.json).at("points").get<int>();
   }
   CHECK(award_points == r.exploration_points + r.production_points);
   CHECK(r.recording == path);
@@ -77,10 +77,10 @@ TEST_CASE("a full game is recorded: 10 Hz frames, events, well under 5 MB, reada
   int grants = 0, refusals = 0;
   for (const RecordingLine& l : lines) {
     if (l.kind != "lock") continue;
-    CHECK(l.json.find("\"robot\": \"robot") != std::string::npos);
-    if (l.json.find("\"to\": \"ACCEPTED\"") != std::string::npos) ++grants;
-    if (l.json.find("\"from\": \"REQUESTED\", \"to\": \"REFUSED\"") != std::string::npos)
-      ++refusals;
+    const Json j = Json::parse(l.json);
+    CHECK(j.at("robot").get<std::string>().rfind("robot", 0) == 0);
+    if (j.at("to") == "ACCEPTED") ++grants;
+    if (j.at("from") == "REQUESTED" && j.at("to") == "REFUSED") ++refusals;
   }
   MESSAGE("locks: ", r.lock_grants, " grants, ", r.lock_refusals, " refusals, ", r.lock_waits,
           " waits, ", r.lock_wait_s, " s, longest ", r.lock_wait_max_s, " s");
@@ -107,8 +107,9 @@ TEST_CASE("a line sink gets every recorded line, with or without a file") {
   for (std::size_t i = 0; i < lines.size(); ++i) CHECK(lines[i].json == sunk[i]);
   bool path_seen = false;
   for (const std::string& l : sunk) {
-    if (l.find("\"e\": \"path\", \"robot\": \"robot") != std::string::npos &&
-        l.find("\"points\": [[") != std::string::npos)
+    const Json j = Json::parse(l);
+    if (j.value("e", "") == "path" && j.at("robot").get<std::string>().rfind("robot", 0) == 0 &&
+        !j.at("points").empty() && j.at("points")[0].size() == 2)
       path_seen = true;
   }
   CHECK(path_seen);
@@ -134,18 +135,17 @@ TEST_CASE("radio drops are recorded per frame and per sender robot") {
   const RunResult r = run_game(s, 1, hooks);
   REQUIRE(r.messages_dropped > 0);
   // Every frame's drops_from sums to at most its drops (the refbox's drops are not a robot's).
-  auto number_after = [](const std::string& l, std::size_t at) { return std::stol(l.substr(at)); };
   long drops = 0, by_robots = 0;
   for (const std::string& l : lines) {
-    const auto d = l.find("\"drops\": ");
-    if (d == std::string::npos) continue;
-    const long frame_drops = number_after(l, d + 9);
+    const Json j = Json::parse(l);
+    if (!j.contains("drops")) continue;
+    const long frame_drops = j.at("drops").get<long>();
     drops += frame_drops;
     long frame_by = 0;
-    for (const char* robot : {"robot1", "robot2", "robot3"}) {
-      const auto b = l.find("\"" + std::string(robot) + "\": ", l.find("\"drops_from\""));
-      if (l.find("\"drops_from\"") != std::string::npos && b != std::string::npos)
-        frame_by += number_after(l, b + 10);
+    const Json by = j.value("drops_from", Json::object());
+    for (const auto& [robot, n] : by.items()) {
+      CHECK(robot.rfind("robot", 0) == 0);
+      frame_by += n.get<long>();
     }
     CHECK(frame_by <= frame_drops);
     by_robots += frame_by;

@@ -75,8 +75,8 @@ struct GameReport {
   friend bool operator==(const GameReport&, const GameReport&) = default;
 };
 
-/// The report as JSON: fixed key order, times as seconds with 3 decimals, names for enums;
-/// the same report always gives the same bytes.
+/// The report as JSON (indented): fixed key order, times as seconds (whole milliseconds), names
+/// for enums; the same report always gives the same bytes.
 std::string to_json(const GameReport& report);
 
 }  // namespace llsf::refbox
