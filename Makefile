@@ -13,7 +13,7 @@ help:
 	@echo "make demo         the kinematic world demo (three robots, no refbox)"
 	@echo "make test         install deps, check formatting, build with -Werror, run the whole test"
 	@echo "                  suite, clang-tidy on the files changed since main, the batch tests"
-	@echo "                  under ThreadSanitizer (docs/lint.md)"
+	@echo "                  under ThreadSanitizer (docs/testing.md)"
 	@echo "make lint         clang-tidy (.clang-tidy) over every project source and test"
 	@echo "make test-tsan    build the batch tests with ThreadSanitizer (build/tsan) and run them"
 	@echo "make install      build Release, install into PREFIX (default /usr/local; docs/install.md)"
