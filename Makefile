@@ -48,15 +48,19 @@ demo: build-release
 # clang-tidy on the files changed since main (`make lint`: all), the batch tests under TSan.
 test: check-format build-ci
 	ctest --preset ci -j $(JOBS)
-	@$(MAKE) --no-print-directory lint-changed
-	@$(MAKE) --no-print-directory test-tsan
+	@scripts/lint --changed
+	$(tsan_batch_tests)
 
 # The batch tests (worker threads) under ThreadSanitizer: only the libraries and the one test
 # binary they need are built (build/tsan).
+define tsan_batch_tests
+@cmake --preset tsan >/dev/null
+@cmake --build --preset tsan-batch -j $(JOBS)
+ctest --preset tsan-batch -j $(JOBS)
+endef
+
 test-tsan: deps
-	@cmake --preset tsan >/dev/null
-	@cmake --build --preset tsan-batch -j $(JOBS)
-	ctest --preset tsan-batch -j $(JOBS)
+	$(tsan_batch_tests)
 
 lint: build-ci
 	@scripts/lint
