@@ -3,14 +3,19 @@
 JOBS ?= $(shell nproc)
 PREFIX ?= /usr/local
 
-.PHONY: all deps viewer run demo test install build-release build-ci bench format check-format clean help
+.PHONY: all deps viewer run demo test test-tsan lint lint-changed install build-release build-ci bench \
+        format check-format clean help
 
 all: build-release
 
 help:
 	@echo "make run          install deps, build Release, play the default scenario (llsfsim run)"
 	@echo "make demo         the kinematic world demo (three robots, no refbox)"
-	@echo "make test         install deps, build with -Werror, run the whole test suite"
+	@echo "make test         install deps, check formatting, build with -Werror, run the whole test"
+	@echo "                  suite, clang-tidy on the files changed since main, the batch tests"
+	@echo "                  under ThreadSanitizer (docs/testing.md)"
+	@echo "make lint         clang-tidy (.clang-tidy) over every project source and test"
+	@echo "make test-tsan    build the batch tests with ThreadSanitizer (build/tsan) and run them"
 	@echo "make install      build Release, install into PREFIX (default /usr/local; docs/install.md)"
 	@echo "make bench        build Release and run every benchmark (bench/run)"
 	@echo "make viewer       build the browser front end (viewer/dist/report.js; scripts/build-viewer)"
@@ -39,8 +44,29 @@ run: build-release
 demo: build-release
 	./build/release/kinematic/llsf-world-demo $(ARGS)
 
-test: build-ci
+# The whole suite: formatting first (fails in seconds), the -Werror build and every test,
+# clang-tidy on the files changed since main (`make lint`: all), the batch tests under TSan.
+test: check-format build-ci
 	ctest --preset ci -j $(JOBS)
+	@scripts/lint --changed
+	$(tsan_batch_tests)
+
+# The batch tests (worker threads) under ThreadSanitizer: only the libraries and the one test
+# binary they need are built (build/tsan).
+define tsan_batch_tests
+@cmake --preset tsan >/dev/null
+@cmake --build --preset tsan-batch -j $(JOBS)
+ctest --preset tsan-batch -j $(JOBS)
+endef
+
+test-tsan: deps
+	$(tsan_batch_tests)
+
+lint: build-ci
+	@scripts/lint
+
+lint-changed: build-ci
+	@scripts/lint --changed
 
 install: build-release
 	cmake --install build/release --prefix $(PREFIX)
@@ -51,8 +77,8 @@ bench: deps
 format:
 	scripts/format
 
-check-format:
-	scripts/format --check
+check-format: deps
+	@scripts/format --check
 
 clean:
 	rm -rf build

@@ -475,7 +475,7 @@ bool is_name_char(char ch) {
 /// validate() error ("devices.M4: ...") can be reported at the line the value came from.
 class Loader {
  public:
-  explicit Loader(ConfigNode root) : root_(std::move(root)) {}
+  explicit Loader(const ConfigNode& root) : root_(root) {}
 
   WorldConfig load(WorldConfig c) {
     root_.require_map();

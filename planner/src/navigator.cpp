@@ -76,7 +76,7 @@ const char* to_string(NavOutcome outcome) {
 }
 
 Navigator::Navigator(Planner& planner, ControllerConfig config, core::RandomStream rng)
-    : planner_(&planner), config_(std::move(config)), rng_(rng), follower_(config_) {
+    : planner_(&planner), config_(config), rng_(rng), follower_(config_) {
   config_.validate();
 }
 

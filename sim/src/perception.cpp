@@ -50,7 +50,7 @@ lua::Lamp& lamp_of(lua::LightReading& r, int i) {
 
 Localization::Localization(const LocalizationConfig& config, const core::Pose2D& start,
                            core::RandomStream rng)
-    : c_(config), rng_(std::move(rng)) {
+    : c_(config), rng_(rng) {
   pose_.pose = start;
   est_ref_ = start;
   odo_ref_ = start;
@@ -106,7 +106,7 @@ void Localization::update(SimTime now, const core::Pose2D& truth,
 
 LightDetection::LightDetection(const LightDetectionConfig& config, std::vector<DeviceView> devices,
                                core::RandomStream rng)
-    : c_(config), devices_(std::move(devices)), rng_(std::move(rng)) {
+    : c_(config), devices_(std::move(devices)), rng_(rng) {
   observed_since_ = kNever;
   // Frames within one blink period (inclusive at both ends), plus slack.
   lit_history_.resize(
@@ -333,7 +333,7 @@ void PuckVision::update(SimTime now, const core::Pose2D& truth, std::span<const 
 
 ColourCamera::ColourCamera(const ColourCameraConfig& config, std::vector<std::string> colour_names,
                            core::RandomStream rng)
-    : c_(config), colour_names_(std::move(colour_names)), rng_(std::move(rng)) {
+    : c_(config), colour_names_(std::move(colour_names)), rng_(rng) {
   sightings_.reserve(64);
 }
 

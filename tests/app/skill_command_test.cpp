@@ -35,8 +35,9 @@ TEST_CASE("llsfsim skill runs strings in turn and prints status changes with gam
 }
 
 TEST_CASE("llsfsim skill --skills DIR takes one directory; the skill strings follow") {
-  const Run r = llsfsim({"skill", "--skills", LLSF_SOURCE_DIR "/lua/skills/examples",
-                         "say_hello{who=\"tour\"}", "goto_place{place=\"M5\"}"});
+  const std::string examples = std::string(LLSF_SOURCE_DIR) + "/lua/skills/examples";
+  const Run r = llsfsim(
+      {"skill", "--skills", examples, "say_hello{who=\"tour\"}", "goto_place{place=\"M5\"}"});
   INFO(r.out, r.err);
   CHECK(r.code == 0);
   CHECK(has(r.out, "robot1 FINAL  say_hello{who=\"tour\"}"));

@@ -183,8 +183,8 @@ TEST_CASE("random queries: every path keeps the required clearance") {
   const double r = p.config().inflated_radius_m();
   int detours = 0;
   for (int k = 0; k < 300; ++k) {
-    const Vec2 a = pts[rng.uniform_int(0, static_cast<int>(pts.size()) - 1)];
-    const Vec2 b = pts[rng.uniform_int(0, static_cast<int>(pts.size()) - 1)];
+    const Vec2& a = pts[rng.uniform_int(0, static_cast<int>(pts.size()) - 1)];
+    const Vec2& b = pts[rng.uniform_int(0, static_cast<int>(pts.size()) - 1)];
     const PlanResult res =
         p.plan({{a.x(), a.y(), 0.0}, {b.x(), b.y(), 1.0}, {}, 0.0, rng.next_u64()});
     REQUIRE(res.status == PlanStatus::kFound);
@@ -280,8 +280,8 @@ TEST_CASE("two games planning in parallel threads do not change each other's pat
     const auto pts = free_grid(p, 0.4);
     std::vector<std::vector<Vec2>> paths;
     for (int k = 0; k < 150; ++k) {
-      const Vec2 a = pts[rng.uniform_int(0, static_cast<int>(pts.size()) - 1)];
-      const Vec2 b = pts[rng.uniform_int(0, static_cast<int>(pts.size()) - 1)];
+      const Vec2& a = pts[rng.uniform_int(0, static_cast<int>(pts.size()) - 1)];
+      const Vec2& b = pts[rng.uniform_int(0, static_cast<int>(pts.size()) - 1)];
       const std::vector<DiscObstacle> obs{{1, 0.5 * (a + b), 0.2}};
       const PlanResult res =
           p.plan({{a.x(), a.y(), 0.0}, {b.x(), b.y(), 0.0}, obs, 0.0, rng.next_u64()});

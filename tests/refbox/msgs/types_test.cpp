@@ -424,11 +424,13 @@ TEST_CASE("msgs: every enum has exactly the spec's values") {
         google::protobuf::DescriptorPool::generated_pool()->FindEnumTypeByName(row.enum_name);
     REQUIRE(e != nullptr);
     CHECK(e->value_count() == static_cast<int>(row.values.size()));
-    for (const auto& [name, number] : row.values) {
+    // Not a structured binding: CAPTURE's lambda cannot capture one before clang 16 (clang-tidy).
+    for (const auto& value : row.values) {
+      const auto& name = value.first;
       CAPTURE(name);
       const auto* v = e->FindValueByName(name);
       REQUIRE(v != nullptr);
-      CHECK(v->number() == number);
+      CHECK(v->number() == value.second);
     }
     // Declared in the spec's order: the first value is the default of an unset optional field.
     CHECK(std::string(e->value(0)->name()) == row.values.front().first);
