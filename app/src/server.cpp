@@ -502,11 +502,11 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     const std::optional<std::vector<std::string>> path =
         split_target(std::string_view(req.target().data(), req.target().size()), error);
     if (!path) {
-      send(std::move(req), error_reply(http::status::bad_request, error));
+      send(req, error_reply(http::status::bad_request, error));
       return;
     }
     if (req.method() != http::verb::get) {
-      send(std::move(req), error_reply(http::status::method_not_allowed, "only GET is served"));
+      send(req, error_reply(http::status::method_not_allowed, "only GET is served"));
       return;
     }
     const bool live_route = path->size() == 2 && (*path)[0] == "api" && (*path)[1] == "live";
@@ -515,7 +515,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
       std::make_shared<WsSession>(stream_.release_socket(), server_)->accept(std::move(req));
       return;
     }
-    send(std::move(req), server_.handle(*path));
+    send(req, server_.handle(*path));
   }
 
   void send(const http::request<http::string_body>& req, Reply reply, bool close = false) {
