@@ -18,6 +18,7 @@
 #include "harness.h"
 #include "llsf/refbox/protocol.h"
 #include "llsf/sim/agent_brain.h"
+#include "llsf/sim/driver.h"
 #include "llsf/sim/game.h"
 #include "llsf/study/runner.h"
 #include "llsf/study/scenario.h"
@@ -69,22 +70,21 @@ GameResult play(std::uint64_t seed, double loss, bool locks, const AgentVariant&
     config.hub.loss_model = comm::LossModel::kPerLink;
     config.hub.loss_probability = loss;
   }
-  sim::Game game(config);
-  std::vector<std::unique_ptr<sim::AgentBrain>> brains;
-  std::vector<std::unique_ptr<TimedBrain>> timed;
+  std::vector<std::unique_ptr<TimedBrain>> timed;  // (destroyed after the driver's brains)
+  sim::GameDriver driver(config);
+  sim::Game& game = driver.game();
   for (int i = 0; i < game.robot_count(); ++i) {
     sim::AgentBrainConfig c;
     c.agent_files = {LLSF_SOURCE_DIR "/clips/agents/common",
                      std::string(LLSF_SOURCE_DIR "/clips/agents/") + agent.dir};
     c.config = agent.config;
     c.locks = locks;
-    brains.push_back(std::make_unique<sim::AgentBrain>(game, i, c));
-    timed.push_back(std::make_unique<TimedBrain>(*brains.back()));
-    game.set_brain(i, timed.back().get());
+    timed.push_back(std::make_unique<TimedBrain>(driver.plug_agent(i, c)));
+    driver.plug(i, timed.back().get());
   }
-  game.start(refbox::GamePhase::kExploration);
+  driver.start(refbox::GamePhase::kExploration);
   const double t0 = bench::cpu_seconds();
-  game.run_until(core::SimTime::from_sec(180 + 900));
+  driver.run_until(core::SimTime::from_sec(180 + 900));
   GameResult r;
   r.wall_cpu = bench::cpu_seconds() - t0;
   const sim::GameSummary s = game.summary();
@@ -99,8 +99,9 @@ GameResult play(std::uint64_t seed, double loss, bool locks, const AgentVariant&
     cycles += t->cycles;
   }
   r.agent_us_per_cycle = cycles > 0 ? cpu * 1e6 / static_cast<double>(cycles) : 0.0;
-  for (const auto& b : brains) r.runtime_errors += b->agent().runtime_errors();
-  for (int i = 0; i < game.robot_count(); ++i) game.set_brain(i, nullptr);
+  for (int i = 0; i < game.robot_count(); ++i) {
+    r.runtime_errors += driver.agent(i)->agent().runtime_errors();
+  }
   if (std::getenv("LLSF_BENCH_VERBOSE") != nullptr) {
     std::fprintf(
         stderr,

@@ -9,6 +9,7 @@
 
 #include "harness.h"
 #include "llsf/refbox/protocol.h"
+#include "llsf/sim/driver.h"
 #include "llsf/sim/game.h"
 
 using namespace llsf;
@@ -43,21 +44,21 @@ struct Run {
 Run game_loop() {
   sim::GameConfig config;  // the 2013 world (3 robots, laser on), ground-truth levels
   config.seed = 2013;
-  sim::Game game(config);
-  game.start(refbox::GamePhase::kProduction);
   std::vector<LoopBrain> brains{LoopBrain({"M1_look", "D2_look", "M8_look", "INS_2"}),
                                 LoopBrain({"M4_look", "R1_look", "M9_look", "WAIT_INS"}),
                                 LoopBrain({"M10_look", "TST_look", "M5_look", "LATE_ORDER"})};
-  for (int i = 0; i < 3; ++i) game.set_brain(i, &brains[static_cast<std::size_t>(i)]);
+  sim::GameDriver driver(config);
+  const sim::Game& game = driver.game();
+  driver.start(refbox::GamePhase::kProduction);
+  for (int i = 0; i < 3; ++i) driver.plug(i, &brains[static_cast<std::size_t>(i)]);
   const core::SimTime end = core::SimTime::from_sec(kSimSeconds);
   const double t0 = bench::cpu_seconds();
-  game.run_until(end);
+  driver.run_until(end);
   const double cpu = bench::cpu_seconds() - t0;
   Run r;
   r.us_per_tick = cpu * 1e6 / static_cast<double>(game.ticks());
   r.real_time_factor = kSimSeconds / cpu;
   for (const auto& b : brains) r.arrivals += b.arrivals;
-  for (int i = 0; i < 3; ++i) game.set_brain(i, nullptr);
   return r;
 }
 

@@ -12,6 +12,7 @@
 
 #include "harness.h"
 #include "llsf/refbox/protocol.h"
+#include "llsf/sim/driver.h"
 #include "llsf/sim/game.h"
 #include "llsf/sim/skill_brain.h"
 
@@ -34,9 +35,10 @@ Run skill_loop(sim::SkillLevel level) {
   config.seed = 2013;
   config.world.robots.resize(1);
   config.levels.skill = level;
-  sim::Game game(config);
-  game.start(refbox::GamePhase::kProduction);
-  game.step();
+  sim::GameDriver driver(config);
+  const sim::Game& game = driver.game();
+  driver.start(refbox::GamePhase::kProduction);
+  driver.run_until(game.time() + game.config().world.physics.step);
   // A T1 (the game plan is fixed by the seed).
   std::string t1 = "M1";
   for (int i = 0; i < refbox::kProductionMachineCount; ++i) {
@@ -46,13 +48,14 @@ Run skill_loop(sim::SkillLevel level) {
       break;
     }
   }
-  sim::SkillBrain brain(game, 0);
+  sim::SkillBrain& brain = driver.plug_skills(0);
   Run r;
   int step = 0;
   int round = 0;
   const core::SimTime end = core::SimTime::from_sec(kSimSeconds);
   const double t0 = bench::cpu_seconds();
-  while (game.time() < end) {
+  // Gives the robot its next skill when the last one ended; before every tick.
+  auto next_skill = [&] {
     if (brain.engine().status() != lua::SkillStatus::kRunning) {
       if (brain.engine().status() == lua::SkillStatus::kFailed) {
         ++r.failures;
@@ -82,8 +85,12 @@ Run skill_loop(sim::SkillLevel level) {
           break;
       }
     }
-    game.step();
-  }
+  };
+  next_skill();
+  driver.run_until(end, [&](const sim::Game&) {
+    next_skill();
+    return false;
+  });
   const double cpu = bench::cpu_seconds() - t0;
   r.real_time_factor = kSimSeconds / cpu;
   r.us_per_tick = cpu * 1e6 / static_cast<double>(game.ticks());

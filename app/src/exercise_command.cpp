@@ -28,6 +28,7 @@
 #include "llsf/core/data_dir.h"
 #include "llsf/core/error.h"
 #include "llsf/core/version.h"
+#include "llsf/sim/driver.h"
 #include "llsf/sim/game.h"
 #include "llsf/sim/skill_brain.h"
 #include "llsf/study/recording.h"
@@ -415,16 +416,15 @@ int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err)
   // The game and one skill engine per robot, each with the library plus the participant's file.
   sim::GameConfig config = ex.scenario.game;
   config.seed = seed;
-  sim::Game game(config);
+  sim::GameDriver driver(config);
+  sim::Game& game = driver.game();
   const SkillDir skill_dir(o.skill_file, ex.skill);
   lua::SkillEngineConfig ec = ex.scenario.skills;
   if (ec.skill_dirs.empty()) ec.skill_dirs = sim::skill_library_dirs(config.levels.skill);
   ec.skill_dirs.push_back(skill_dir.dir());
   ec.hot_reload = false;
-  std::vector<std::unique_ptr<sim::SkillBrain>> brains;
-  for (int i = 0; i < game.robot_count(); ++i) {
-    brains.push_back(std::make_unique<sim::SkillBrain>(game, i, ec));
-  }
+  std::vector<sim::SkillBrain*> brains;  // owned by the driver
+  for (int i = 0; i < game.robot_count(); ++i) brains.push_back(&driver.plug_skills(i, ec));
   const std::string& user = o.skill_file;
   for (const lua::SkillInfo& s : brains.front()->engine().skills()) {
     if (s.name != ex.skill || s.load_error.empty()) continue;
@@ -530,11 +530,10 @@ int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err)
   }
   int failed = -1;  // the robot whose skill failed
   bool ended = false;
-  while (game.time() < end) {
-    game.step();
+  driver.run_until(end, [&](const sim::Game&) {
     if (recorder) recorder->frame(game);
     pacer.wait(game.time().seconds());
-    if (!game.skills_cycled()) continue;  // skill states change only in the skill cycle
+    if (!game.skills_cycled()) return false;  // skill states change only in the skill cycle
     bool running = false;
     for (std::size_t i = 0; i < brains.size(); ++i) {
       lua::SkillEngine& e = brains[i]->engine();
@@ -557,10 +556,10 @@ int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err)
       }
       if (e.status() == lua::SkillStatus::kRunning) running = true;
     }
-    if (failed >= 0) break;
+    if (failed >= 0) return true;
     if (!running) {
       ended = true;
-      break;
+      return true;
     }
     if (game.time() >= next_progress) {
       if (!o.quiet) {
@@ -573,7 +572,8 @@ int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err)
       }
       next_progress += SimTime::from_seconds(ex.progress_s);
     }
-  }
+    return false;
+  });
   if (recorder) recorder->close();
   feed.finish();
 

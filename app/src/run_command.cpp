@@ -21,6 +21,7 @@
 #include "llsf/clips/agent.h"
 #include "llsf/core/error.h"
 #include "llsf/sim/agent_brain.h"
+#include "llsf/sim/driver.h"
 #include "llsf/study/recording.h"
 #include "llsf/study/runner.h"
 #include "llsf/study/scenario.h"
@@ -233,9 +234,8 @@ int check(const std::vector<std::string>& files, std::ostream& out, std::ostream
       for (const study::Scenario& s : f.variants) {
         seeds += s.seeds.size();
         // Build the game and every brain: agent files are parsed, skill files loaded.
-        sim::Game game(s.game);
-        std::vector<std::unique_ptr<sim::AgentBrain>> brains;
-        for (int i = 0; i < game.robot_count(); ++i) {
+        sim::GameDriver driver(s.game);
+        for (int i = 0; i < driver.game().robot_count(); ++i) {
           const study::RobotSpec& spec = s.robots.at(static_cast<std::size_t>(i));
           if (spec.agent.empty()) continue;
           sim::AgentBrainConfig c;
@@ -243,8 +243,8 @@ int check(const std::vector<std::string>& files, std::ostream& out, std::ostream
           c.config = spec.config;
           c.skills = s.skills;
           c.locks = spec.locks;
-          brains.push_back(std::make_unique<sim::AgentBrain>(game, i, c));
-          for (const std::string& e : brains.back()->skills().engine().load_errors()) {
+          const sim::AgentBrain& brain = driver.plug_agent(i, c);
+          for (const std::string& e : brain.skills().engine().load_errors()) {
             throw core::ConfigError("skill file error: " + e);
           }
         }

@@ -14,6 +14,7 @@
 #include "commands.h"
 #include "llsf/app/cli.h"
 #include "llsf/refbox/protocol.h"
+#include "llsf/sim/driver.h"
 #include "llsf/sim/game.h"
 #include "llsf/sim/skill_brain.h"
 
@@ -94,13 +95,14 @@ int run_skill(const SkillOptions& o, std::ostream& out, std::ostream& err) {
         << " robot(s) on the field (--robots)\n";
     return kExitBadInput;
   }
-  sim::Game game(config);
+  sim::GameDriver driver(config);
+  sim::Game& game = driver.game();
   const int index = o.robot - 1;
 
   lua::SkillEngineConfig ec;
   ec.skill_dirs = sim::skill_library_dirs(config.levels.skill, o.library_dir);
   for (const std::string& d : o.skill_dirs) ec.skill_dirs.push_back(d);
-  sim::SkillBrain brain(game, index, ec);
+  sim::SkillBrain& brain = driver.plug_skills(index, ec);
   if (o.list) {
     print_skills(brain, out);
     return kExitOk;
@@ -124,8 +126,8 @@ int run_skill(const SkillOptions& o, std::ostream& out, std::ostream& err) {
   });
 
   // The refbox: the chosen phase, running.
-  if (o.phase != "pre_game") game.start(phase_of(o.phase));
-  game.run_until(game.time() + SimTime::from_seconds(o.after_s));
+  if (o.phase != "pre_game") driver.start(phase_of(o.phase));
+  driver.run_until(game.time() + SimTime::from_seconds(o.after_s));
   if (!o.quiet) {
     out << stamp(game.time()) << " game: seed " << o.seed << ", " << o.robots << " robot(s), "
         << o.phase << ", skills " << o.level << ", robot " << robot_name << "\n";
@@ -144,17 +146,20 @@ int run_skill(const SkillOptions& o, std::ostream& out, std::ostream& err) {
       return kExitBadInput;
     }
     const SimTime end = game.time() + SimTime::from_seconds(o.timeout_s);
-    while (brain.engine().status() == lua::SkillStatus::kRunning && game.time() < end) {
-      game.step();
-      if (!o.trace) continue;
-      for (const std::string& n : names) {
-        const std::string st = brain.engine().skill_state(n);
-        std::string& last = states[n];
-        if (st == last) continue;
-        if (!st.empty())
-          out << stamp(game.time()) << " " << robot_name << "   " << n << ": " << st << "\n";
-        last = st;
-      }
+    if (brain.engine().status() == lua::SkillStatus::kRunning) {
+      driver.run_until(end, [&](const sim::Game&) {
+        if (o.trace) {
+          for (const std::string& n : names) {
+            const std::string st = brain.engine().skill_state(n);
+            std::string& last = states[n];
+            if (st == last) continue;
+            if (!st.empty())
+              out << stamp(game.time()) << " " << robot_name << "   " << n << ": " << st << "\n";
+            last = st;
+          }
+        }
+        return brain.engine().status() != lua::SkillStatus::kRunning;
+      });
     }
     if (brain.engine().status() == lua::SkillStatus::kRunning) {
       out << stamp(game.time()) << " " << robot_name << " TIMEOUT  " << s << " still running after "

@@ -26,8 +26,7 @@ std::vector<std::string> agent_files(const std::vector<std::string>& entries) {
 }
 
 AgentBrain::AgentBrain(Game& game, int index, AgentBrainConfig config, clips::LogSink log,
-                       clips::LockListener locks)
-    : game_(game), index_(index) {
+                       clips::LockListener locks) {
   skills_ = std::make_unique<SkillBrain>(game, index, std::move(config.skills));
   const RobotStack& stack = game.robot(index);
   clips::AgentConfig ac;
@@ -57,10 +56,9 @@ AgentBrain::AgentBrain(Game& game, int index, AgentBrainConfig config, clips::Lo
   io.lock_events = std::move(locks);
   agent_ = std::make_unique<clips::AgentHost>(std::move(ac), std::move(io));
   for (const std::string& f : agent_files(config.agent_files)) agent_->load_file(f);
-  game_.set_brain(index_, this);  // replaces the SkillBrain, which this brain drives
 }
 
-AgentBrain::~AgentBrain() { game_.set_brain(index_, nullptr); }
+AgentBrain::~AgentBrain() = default;
 
 void AgentBrain::on_skill_cycle(lua::RobotApi& robot) { skills_->on_skill_cycle(robot); }
 

@@ -117,17 +117,11 @@ planner::FieldMap field_map_from_world(const kinematic::WorldConfig& w) {
 
 // --- construction ----------------------------------------------------------------------------
 
-Game::Game(GameConfig config) : config_(std::move(config)), rng_(config_.seed) {
-  config_.validate();
-  // The hackathon variant: boxes, the coloured pucks of this seed, the safe place.
-  if (config_.hackathon) {
-    const HackathonConfig& h = *config_.hackathon;
-    hackathon_layout_ = generate_hackathon_layout(h, config_.world, rng_);
-    apply_hackathon_layout(h, *hackathon_layout_, config_.world);
-    config_.planner.places.extra.push_back(
-        {h.safe_place,
-         hackathon_safe_pose(h, config_.world, config_.planner.places.held_puck_offset_m)});
-    for (const HackathonPuck& p : hackathon_layout_->pucks) {
+Game::Game(GameConfig config)
+    : config_(prepare_game_config(std::move(config))), rng_(config_.seed) {
+  // The hackathon variant: the colour of every puck of the layout, by puck id.
+  if (config_.hackathon_layout) {
+    for (const HackathonPuck& p : config_.hackathon_layout->pucks) {
       const auto id = static_cast<std::size_t>(p.id.value());
       if (id >= puck_colour_by_id_.size()) puck_colour_by_id_.resize(id + 1, -1);
       puck_colour_by_id_[id] = p.colour;
@@ -164,8 +158,10 @@ Game::Game(GameConfig config) : config_(std::move(config)), rng_(config_.seed) {
                                                    robot_names, devices, rng_));
     const comm::PeerId peer = hub_->add_peer(start.name, std::string(kTeamChannel));
     robot_peers_.push_back(peer);
-    stacks_.back()->radio().hub_ = hub_.get();
-    stacks_.back()->radio().peer_ = peer;
+    const auto slot = static_cast<std::size_t>(peer.value());
+    if (slot >= robot_of_peer_.size()) robot_of_peer_.resize(slot + 1, -1);
+    robot_of_peer_[slot] = i;
+    stacks_.back()->radio().attach(*hub_, peer);
     // Beacons staggered by one tick per robot, then every beacon_period.
     next_beacon_.push_back(dt * (i + 1));
     beacon_seq_.push_back(0);
@@ -197,6 +193,11 @@ RobotStack* Game::robot(std::string_view name) {
 }
 
 void Game::set_brain(int index, RobotBrain* brain) { robot(index).set_brain(brain); }
+
+int Game::robot_of(comm::PeerId peer) const {
+  const auto slot = static_cast<std::size_t>(peer.value());
+  return peer.valid() && slot < robot_of_peer_.size() ? robot_of_peer_[slot] : -1;
+}
 
 refbox::ReceiveResult Game::controller_command(const google::protobuf::Message& message) {
   refbox::ReceiveResult r = protocol_->receive(message, refbox::Origin::stream(0));
@@ -392,7 +393,8 @@ void Game::step() {
       continue;
     }
     const std::unique_ptr<google::protobuf::Message> msg = hub_->decode(d);
-    const int from = d.from.value() - refbox_peer_.value() - 1;  // robot index
+    const int from = robot_of(d.from);
+    if (from < 0) continue;  // (only robots are peers of the simulated radio)
     const refbox::ReceiveResult r =
         protocol_->receive(*msg, refbox::Origin::peer(robot_host(from), kRobotPort));
     if (r.status == refbox::ReceiveStatus::kRejected) {
@@ -410,11 +412,9 @@ void Game::step() {
         Received r;
         r.message = std::move(msg);
         r.from = hub_->peer_name(d.from);
-        for (int k = 0; k < n; ++k) {
-          if (robot_peers_[static_cast<std::size_t>(k)] == d.from) r.from_id = k + 1;
-        }
+        r.from_id = robot_of(d.from) + 1;  // 0 for the refbox
         r.at = now;
-        radio.inbox_.push_back(std::move(r));
+        radio.deliver(std::move(r));
       }
     }
   }
@@ -431,7 +431,7 @@ void Game::step() {
     // World::pucks() also lists removed pucks (see docs/sim.md, "Notes on other modules").
     if (!world_->has_puck(p)) continue;
     puck_positions_.push_back(world_->puck_position(p));
-    if (hackathon_layout_) {
+    if (config_.hackathon_layout) {
       const auto id = static_cast<std::size_t>(p.value());
       puck_colours_.push_back(id < puck_colour_by_id_.size() ? puck_colour_by_id_[id] : -1);
     }
@@ -466,7 +466,7 @@ void Game::step() {
     next_agent_ += agent_period_;
     for (auto& s : stacks_) {
       if (s->brain() != nullptr) s->brain()->on_agent_cycle(*s, s->radio());
-      s->radio().inbox_.clear();
+      s->radio().clear_inbox();
     }
   }
 
@@ -553,13 +553,13 @@ core::Vec2 Game::free_storage_spot() const {
 // --- summary ---------------------------------------------------------------------------------
 
 std::optional<HackathonScore> Game::hackathon_score() const {
-  if (!hackathon_layout_) return std::nullopt;
+  if (!config_.hackathon_layout) return std::nullopt;
   std::vector<HackathonPuckState> states;
   std::vector<core::PuckId> held;
   for (int r = 0; r < robot_count(); ++r) {
     if (const auto p = puck_in_pocket(r)) held.push_back(*p);
   }
-  for (const HackathonPuck& p : hackathon_layout_->pucks) {
+  for (const HackathonPuck& p : config_.hackathon_layout->pucks) {
     HackathonPuckState s;
     s.id = p.id;
     s.on_field = world_->has_puck(p.id);
@@ -567,7 +567,7 @@ std::optional<HackathonScore> Game::hackathon_score() const {
     s.held = std::find(held.begin(), held.end(), p.id) != held.end();
     states.push_back(s);
   }
-  return score_hackathon(*config_.hackathon, *hackathon_layout_, states);
+  return score_hackathon(*config_.hackathon, *config_.hackathon_layout, states);
 }
 
 GameSummary Game::summary() const {

@@ -121,4 +121,16 @@ void GameConfig::validate() const {
   }
 }
 
+GameConfig prepare_game_config(GameConfig config) {
+  config.validate();
+  if (!config.hackathon || config.hackathon_layout) return config;
+  const HackathonConfig& h = *config.hackathon;
+  config.hackathon_layout = generate_hackathon_layout(h, config.world, core::Rng(config.seed));
+  apply_hackathon_layout(h, *config.hackathon_layout, config.world);
+  config.planner.places.extra.push_back(
+      {h.safe_place,
+       hackathon_safe_pose(h, config.world, config.planner.places.held_puck_offset_m)});
+  return config;
+}
+
 }  // namespace llsf::sim

@@ -280,7 +280,7 @@ void RobotStack::symbolic_drop(const core::Vec2& point) {
 void RobotStack::sense(const RobotPercept& p) {
   LLSF_ASSERT(p.sensors != nullptr);
   now_ = p.now;
-  radio_.now_ = p.now;
+  radio_.set_time(p.now);
   true_pose_ = p.true_pose;
   const kinematic::RobotSensors& s = *p.sensors;
   puck_in_holder_ = s.ir.puck_detected;

@@ -31,11 +31,9 @@ std::vector<std::string> skill_library_dirs(SkillLevel level, std::string_view l
 SkillBrain::SkillBrain(Game& game, int index, lua::SkillEngineConfig config)
     : game_(game),
       index_(index),
-      engine_(with_defaults(std::move(config), game, index), game.robot(index)) {
-  game_.set_brain(index_, this);
-}
+      engine_(with_defaults(std::move(config), game, index), game.robot(index)) {}
 
-SkillBrain::~SkillBrain() { game_.set_brain(index_, nullptr); }
+SkillBrain::~SkillBrain() = default;
 
 lua::ExecResult SkillBrain::exec(std::string_view skill_string) {
   lua::ExecResult r = engine_.exec(skill_string);

@@ -18,6 +18,7 @@
 #include "llsf/core/version.h"
 #include "llsf/refbox/protocol.h"
 #include "llsf/sim/agent_brain.h"
+#include "llsf/sim/driver.h"
 #include "llsf/study/recording.h"
 
 namespace llsf::study {
@@ -40,11 +41,19 @@ double cpu_seconds() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
-void start_game(sim::Game& g, StartMode start) {
-  if (start == StartMode::kNone) return;  // the refbox stays in PRE_GAME
-  g.start(start == StartMode::kExploration  ? refbox::GamePhase::kExploration
-          : start == StartMode::kProduction ? refbox::GamePhase::kProduction
-                                            : refbox::GamePhase::kPreGame);
+/// The phase a scenario's `start` starts the game in; nullopt: no command (PRE_GAME).
+std::optional<refbox::GamePhase> start_phase(StartMode start) {
+  switch (start) {
+    case StartMode::kNone:
+      return std::nullopt;
+    case StartMode::kExploration:
+      return refbox::GamePhase::kExploration;
+    case StartMode::kProduction:
+      return refbox::GamePhase::kProduction;
+    case StartMode::kGame:
+      break;
+  }
+  return refbox::GamePhase::kPreGame;
 }
 
 int deliveries_of(const refbox::Refbox& rb) {
@@ -209,15 +218,16 @@ bool RunResult::passed() const {
 RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks& hooks) {
   sim::GameConfig config = scenario.game;
   config.seed = seed;
-  sim::Game game(config);
-  LockWaits lock_waits;  // before the brains, which call it
+  // What the brains call, declared before the driver that owns them (destroyed after them).
+  LockWaits lock_waits;
   LockHolds lock_holds;
   FailureStreaks streaks;
   int role_changes = 0;
   double first_role_change_s = -1.0;
-  std::vector<std::unique_ptr<sim::AgentBrain>> brains;
   int skill_failures = 0;
   std::unique_ptr<Recorder> recorder;
+  sim::GameDriver driver(config);
+  sim::Game& game = driver.game();
   if (!hooks.record_path.empty() || hooks.record_sink) {
     recorder = std::make_unique<Recorder>(
         hooks.record_path, game,
@@ -248,9 +258,8 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
       lock_holds.on(name, e, game.robot(i).jammed());
       if (recorder) recorder->lock(name, e);
     };
-    brains.push_back(
-        std::make_unique<sim::AgentBrain>(game, i, c, std::move(log), std::move(locks)));
-    brains.back()->skills().set_listener(
+    sim::AgentBrain& brain = driver.plug_agent(i, c, std::move(log), std::move(locks));
+    brain.skills().set_listener(
         [&skill_failures, &hooks, &recorder, &streaks, &game, i](const sim::SkillStatusChange& ch) {
           if (recorder) recorder->skill(ch);
           if (hooks.skill) hooks.skill(ch);
@@ -293,7 +302,9 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
         break;
       case TestCase::Kind::kNoAgentErrors: {
         int errors = 0;
-        for (const auto& b : brains) errors += b->agent().runtime_errors();
+        for (int k = 0; k < game.robot_count(); ++k) {
+          if (const sim::AgentBrain* b = driver.agent(k)) errors += b->agent().runtime_errors();
+        }
         value = errors;
         d << errors << " agent runtime errors";
         break;
@@ -320,7 +331,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   };
 
   game.enable_profile(hooks.profile);
-  start_game(game, scenario.start);
+  driver.start(start_phase(scenario.start));
   const core::SimTime end = scenario.duration;
   core::SimTime next_progress = hooks.progress_every;
   const double t0 = cpu_seconds();
@@ -335,8 +346,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   int storage_min = pucks_in(game, storage);
   double storage_empty_s = storage_min == 0 ? 0.0 : -1.0;
   core::SimTime next_storage_sample = core::SimTime::from_sec(1);
-  while (game.time() < end) {
-    game.step();
+  driver.run_until(end, [&](const sim::Game&) {
     if (game.time() >= next_storage_sample) {
       next_storage_sample += core::SimTime::from_sec(1);
       const int n = pucks_in(game, storage);
@@ -367,7 +377,8 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
       hooks.progress(game);
       next_progress += hooks.progress_every;
     }
-  }
+    return false;
+  });
   const double cpu = cpu_seconds() - t0;
 
   RunResult r;
@@ -430,7 +441,10 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   r.deliveries = static_cast<int>(rb.report().deliveries.size());
   r.collisions = s.collisions_robot_robot + s.collisions_robot_wall + s.collisions_robot_device;
   r.skill_failures = skill_failures;
-  for (const auto& b : brains) r.agent_runtime_errors += b->agent().runtime_errors();
+  for (int k = 0; k < game.robot_count(); ++k) {
+    if (const sim::AgentBrain* b = driver.agent(k))
+      r.agent_runtime_errors += b->agent().runtime_errors();
+  }
   lock_waits.finish(game.time(), r);
   lock_hold_max_s = lock_holds.finish(game.time(), [&game](const std::string& robot) {
     for (int i = 0; i < game.robot_count(); ++i) {

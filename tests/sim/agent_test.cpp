@@ -43,6 +43,7 @@ struct AgentGame {
                           r.text.data());
             }
           }));
+      game.set_brain(i, brains.back().get());
     }
   }
   static GameConfig make_config(int robots, std::uint64_t seed) {
@@ -128,6 +129,8 @@ TEST_CASE("protobuf round trip: CLIPS on one robot -> radio -> CLIPS on another"
   Game game(test::small_game(2, 3));
   AgentBrain a(game, 0, {});
   AgentBrain b(game, 1, {});
+  game.set_brain(0, &a);
+  game.set_brain(1, &b);
   a.agent().load_string(
       "(defrule send (time $?) (not (sent)) =>\n"
       "  (bind ?m (pb-create \"llsf_agent_msgs.WorldmodelChange\"))\n"

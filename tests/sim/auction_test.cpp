@@ -332,6 +332,7 @@ Points play(const std::vector<std::string>& agent, std::uint64_t seed, double lo
                         clips::to_string(r.level), static_cast<int>(r.text.size()), r.text.data());
           }
         }));
+    game.set_brain(i, brains.back().get());
   }
   test::start_phase(game, refbox::GamePhase::kProduction);
   game.run_until(core::SimTime::from_sec(900));

@@ -257,6 +257,7 @@ function LEAVE:init() self.args["leave_puck"] = {distance = 0.3} end
   ec.skill_dirs = skill_library_dirs(c.levels.skill);
   ec.skill_dirs.push_back(dir);
   SkillBrain brain(game, 0, ec);
+  game.set_brain(0, &brain);
   REQUIRE(brain.engine().load_errors().empty());
   REQUIRE(brain.exec("rescue_one{}"));
   const SimTime end = SimTime::from_sec(120);

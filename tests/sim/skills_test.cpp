@@ -56,6 +56,7 @@ TEST_CASE("the skill library loads at both levels") {
     config.levels.skill = level;
     Game g(config);
     SkillBrain brain(g, 0);
+    g.set_brain(0, &brain);
     CHECK(brain.engine().load_errors().empty());
     for (const auto& e : brain.engine().load_errors()) MESSAGE(e);
     CHECK(brain.engine().skills().size() >= 11);
@@ -73,6 +74,7 @@ TEST_CASE("get_s0 then finish_puck_at a T1: the refbox makes it an S1") {
     const auto t1 = test::machine_of_type(g.refbox(), refbox::MachineType::kT1, 200);
     REQUIRE(t1);
     SkillBrain brain(g, 0);
+    g.set_brain(0, &brain);
     Outcome o = run_skill(g, brain, "get_s0{}", 120);
     INFO(o.error);
     REQUIRE(o.status == lua::SkillStatus::kFinal);
@@ -95,6 +97,7 @@ struct ProductionGame {
     test::start_phase(game, refbox::GamePhase::kProduction);
     game.step();
     brain = std::make_unique<SkillBrain>(game, 0);
+    game.set_brain(0, brain.get());
   }
   static GameConfig config(SkillLevel level, std::uint64_t seed) {
     GameConfig c = test::small_game(1, seed);
@@ -206,6 +209,7 @@ int explore_all(DetectionLevel light, std::uint64_t seed) {
   test::start_phase(g, refbox::GamePhase::kExploration);
   g.step();
   SkillBrain brain(g, 0);
+  g.set_brain(0, &brain);
   int correct = 0;
   for (int i = 0; i < refbox::kProductionMachineCount; ++i) {
     const Outcome o = run_skill(g, brain, "explore_machine{place=\"" + machine_name(i) + "\"}", 60);

@@ -101,6 +101,7 @@ TEST_CASE("jersey numbers: per robot in `each`, in the agent, the beacons and th
   AgentBrainConfig c;
   c.agent_files = s.robots[1].agent;
   AgentBrain brain(game, 1, c);
+  game.set_brain(1, &brain);
   brain.agent().start(SimTime{});  // (reset): the identity globals
   CHECK(brain.agent().eval("?*ROBOT-NUMBER*").number() == doctest::Approx(3.0));
   std::string header;

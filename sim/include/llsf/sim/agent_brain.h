@@ -43,7 +43,9 @@ struct AgentBrainConfig {
 /// `entries` with every directory replaced by its *.clp files in name order.
 std::vector<std::string> agent_files(const std::vector<std::string>& entries);
 
-/// Plugs itself into robot `index` of `game` (which must outlive it) on construction.
+/// Robot `index`'s CLIPS agent with the skill engine it drives (its own, not plugged: the agent
+/// brain cycles it). Its owner plugs it into the game (GameDriver::plug_agent, or
+/// Game::set_brain) and unplugs it before destroying it; the game must outlive it.
 class AgentBrain final : public RobotBrain, private clips::SkillRunner {
  public:
   /// Loads the agent files; throws clips::AgentLoadError for bad agent code and
@@ -58,6 +60,7 @@ class AgentBrain final : public RobotBrain, private clips::SkillRunner {
   clips::AgentHost& agent() { return *agent_; }
   const clips::AgentHost& agent() const { return *agent_; }
   SkillBrain& skills() { return *skills_; }
+  const SkillBrain& skills() const { return *skills_; }
 
   void on_skill_cycle(lua::RobotApi& robot) override;
   void on_agent_cycle(lua::RobotApi& robot, RobotRadio& radio) override;
@@ -71,8 +74,6 @@ class AgentBrain final : public RobotBrain, private clips::SkillRunner {
   std::string skill_string() const override;
   std::string result() const override;
 
-  Game& game_;
-  int index_;
   std::unique_ptr<SkillBrain> skills_;
   std::unique_ptr<clips::AgentHost> agent_;
 };

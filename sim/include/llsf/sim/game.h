@@ -62,7 +62,8 @@ struct GameSummary {
 /// not thread-safe; games in different threads are independent.
 class Game {
  public:
-  /// Validates `config` (throws core::ConfigError) and builds everything: world, refbox +
+  /// Completes `config` with prepare_game_config() (validation, the hackathon layout; throws
+  /// core::ConfigError), then builds everything from it and never changes it: world, refbox +
   /// protocol adapter (hub peer "refbox" on "*"), hub with the refbox and agent messages
   /// registered, planner, and a RobotStack + hub peer (channel "team") per world robot.
   explicit Game(GameConfig config);
@@ -116,6 +117,8 @@ class Game {
   RobotStack* robot(std::string_view name);
   /// The hub peer of robot `index`.
   comm::PeerId robot_peer(int index) const { return robot_peers_.at(std::size_t(index)); }
+  /// The index of the robot that is hub peer `peer`, or -1 (the refbox, an unknown peer).
+  int robot_of(comm::PeerId peer) const;
 
   /// Plugs `brain` (borrowed; must outlive the game or be unset with nullptr) into robot `index`.
   void set_brain(int index, RobotBrain* brain);
@@ -134,7 +137,7 @@ class Game {
 
   /// The hackathon variant's puck layout of this game (GameConfig::hackathon), or nullptr.
   const HackathonLayout* hackathon_layout() const {
-    return hackathon_layout_ ? &*hackathon_layout_ : nullptr;
+    return config_.hackathon_layout ? &*config_.hackathon_layout : nullptr;
   }
   /// The hackathon score now (pucks released in the safe area), or nullopt outside the variant.
   std::optional<HackathonScore> hackathon_score() const;
@@ -167,7 +170,7 @@ class Game {
   core::Vec2 free_storage_spot() const;
   bool insertion_slot_occupied() const;
 
-  GameConfig config_;
+  const GameConfig config_;  // frozen: prepare_game_config() before anything is built
   core::Rng rng_;
   std::unique_ptr<kinematic::World> world_;
   std::unique_ptr<refbox::RefboxProtocol> protocol_;
@@ -177,6 +180,7 @@ class Game {
   std::unique_ptr<planner::Planner> planner_;
   std::vector<std::unique_ptr<RobotStack>> stacks_;
   std::vector<comm::PeerId> robot_peers_;
+  std::vector<int> robot_of_peer_;  // by PeerId value: robot index, -1 for other peers
   std::function<void(const Game&)> tick_hook_;
 
   const kinematic::WorldEvents* events_ = nullptr;
@@ -200,7 +204,6 @@ class Game {
   std::vector<int> puck_colours_;  // hackathon: colour index per entry of puck_positions_
 
   // The hackathon variant.
-  std::optional<HackathonLayout> hackathon_layout_;
   std::vector<int> puck_colour_by_id_;  // indexed by puck id; -1: no colour
   std::array<kinematic::SignalLights, kinematic::kDeviceCount> lights_{};
 

@@ -160,10 +160,20 @@ struct GameConfig {
   /// the pucks by a coloured layout drawn from the seed, adds the safe place to the planner and
   /// gives every robot the colour camera and the rescue interface.
   std::optional<HackathonConfig> hackathon;
+  /// The hackathon variant's puck layout for `seed`, drawn and applied to `world` and
+  /// `planner` by prepare_game_config() before a Game is built (never set it by hand).
+  std::optional<HackathonLayout> hackathon_layout;
 
   /// Throws core::ConfigError "game.<field>: reason" for the first bad field (the world,
   /// refbox, protocol, hub and navigation configs are validated by their own validate()).
   void validate() const;
 };
+
+/// The configuration a Game plays, complete before the game is built (a Game never changes its
+/// config): validated, and in the hackathon variant with the layout of `config.seed` drawn
+/// (generate_hackathon_layout, stream "sim/hackathon/layout"), put into the world (boxes added,
+/// pucks replaced) and the safe place added to the planner's places. A config whose layout is
+/// drawn already is returned unchanged (after validation). Throws core::ConfigError.
+GameConfig prepare_game_config(GameConfig config);
 
 }  // namespace llsf::sim

@@ -73,9 +73,21 @@ class RobotRadio {
   /// Returns what the hub said (kNone = accepted). Requires the stack to be attached to a hub.
   comm::FrameError broadcast(const google::protobuf::Message& message);
 
+  // The game's side (tick steps 5, 6 and 8).
+  /// Connects the radio to `hub` as `peer` (the game, when it builds the robot).
+  void attach(comm::Hub& hub, comm::PeerId peer) {
+    hub_ = &hub;
+    peer_ = peer;
+  }
+  comm::PeerId peer() const { return peer_; }
+  /// Sets the time stamp of the robot's broadcasts (the stack, when it senses).
+  void set_time(SimTime now) { now_ = now; }
+  /// Appends a message the robot received to the inbox.
+  void deliver(Received message) { inbox_.push_back(std::move(message)); }
+  /// Empties the inbox (after the agent cycle, brain or not).
+  void clear_inbox() { inbox_.clear(); }
+
  private:
-  friend class RobotStack;
-  friend class Game;
   comm::Hub* hub_ = nullptr;
   comm::PeerId peer_;
   SimTime now_;

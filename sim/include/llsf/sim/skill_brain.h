@@ -29,8 +29,9 @@ struct SkillStatusChange {
   std::string result;  ///< what the skills reported when the string ended
 };
 
-/// Runs a skill engine as robot `index`'s brain (on_skill_cycle). Plugs itself into the game on
-/// construction and out on destruction; the game must outlive it.
+/// Runs a skill engine as robot `index`'s brain (on_skill_cycle). Its owner plugs it into the
+/// game (GameDriver::plug_skills, or Game::set_brain) and unplugs it before destroying it; the
+/// game must outlive it.
 class SkillBrain final : public RobotBrain {
  public:
   /// `config.skill_dirs` empty: the skill library of the game's skill level. The engine's rate

@@ -1,0 +1,129 @@
+// SPDX-License-Identifier: MIT
+// GameDriver (the one way to play a game), the frozen GameConfig, and the radio's game side.
+#include "llsf/sim/driver.h"
+
+#include <doctest/doctest.h>
+#include <llsf_agent_msgs/LockMessage.pb.h>
+
+#include <string>
+
+#include "fixture.h"
+
+using namespace llsf;
+using namespace llsf::sim;
+
+namespace {
+
+AgentBrainConfig llsf2013_agent() {
+  AgentBrainConfig c;
+  c.agent_files = {LLSF_SOURCE_DIR "/clips/agents/common",
+                   LLSF_SOURCE_DIR "/clips/agents/llsf2013"};
+  return c;
+}
+
+/// Counts its cycles; plugged by its owner.
+struct CountingBrain final : RobotBrain {
+  int skill_cycles = 0;
+  void on_skill_cycle(lua::RobotApi&) override { ++skill_cycles; }
+};
+
+}  // namespace
+
+TEST_CASE("GameDriver: owns and plugs brains, starts the refbox, stops when the hook asks") {
+  GameDriver driver(test::small_game(2, 3));
+  Game& game = driver.game();
+  CHECK(game.robot(0).brain() == nullptr);  // no brain until one is plugged
+  SkillBrain& skills = driver.plug_skills(0);
+  CHECK(game.robot(0).brain() == &skills);
+  CHECK(driver.skills(0) == &skills);
+  CHECK(driver.agent(0) == nullptr);
+  AgentBrain& agent = driver.plug_agent(0, llsf2013_agent());  // replaces the skill engine
+  CHECK(game.robot(0).brain() == &agent);
+  CHECK(driver.skills(0) == nullptr);
+  CHECK(driver.agent(0) == &agent);
+  CountingBrain mine;
+  driver.plug(1, &mine);
+  CHECK(game.robot(1).brain() == &mine);
+  CHECK_THROWS(driver.plug_skills(2));  // two robots only
+
+  driver.start(refbox::GamePhase::kExploration);
+  int ticks = 0;
+  const bool stopped = driver.run_until(core::SimTime::from_sec(10), [&](const Game& g) {
+    ++ticks;
+    return g.time() >= core::SimTime::from_sec(2);
+  });
+  CHECK(stopped);
+  CHECK(game.time() == core::SimTime::from_sec(2));
+  CHECK(ticks == game.ticks());
+  CHECK(game.refbox().phase() == refbox::GamePhase::kExploration);
+  CHECK(mine.skill_cycles == 60);  // 30 Hz
+  CHECK_FALSE(driver.run_until(core::SimTime::from_sec(3)));
+  CHECK(game.time() == core::SimTime::from_sec(3));
+  driver.plug(1, nullptr);
+}
+
+TEST_CASE("GameDriver: no start leaves the refbox in PRE_GAME; same config, same game") {
+  auto play = [](std::optional<refbox::GamePhase> phase) {
+    GameDriver driver(test::small_game(1, 5));
+    driver.plug_agent(0, llsf2013_agent());
+    driver.start(phase);
+    driver.run_until(core::SimTime::from_sec(20));
+    return driver.game().summary();
+  };
+  const GameSummary none = play(std::nullopt);
+  CHECK(none.phase == refbox::GamePhase::kPreGame);
+  const GameSummary a = play(refbox::GamePhase::kExploration);
+  const GameSummary b = play(refbox::GamePhase::kExploration);
+  CHECK(a.phase == refbox::GamePhase::kExploration);
+  CHECK(a.world_hash == b.world_hash);
+  CHECK(a.refbox_hash == b.refbox_hash);
+  CHECK(a.world_hash != none.world_hash);
+}
+
+TEST_CASE("prepare_game_config: the hackathon layout is drawn before the game, once") {
+  GameConfig c = test::small_game(1, 11);
+  c.hackathon = HackathonConfig{};
+  const GameConfig prepared = prepare_game_config(c);
+  REQUIRE(prepared.hackathon_layout);
+  CHECK(prepared.world.obstacles.size() == c.world.obstacles.size() + 4);
+  CHECK(prepared.planner.places.extra.size() == c.planner.places.extra.size() + 1);
+  // Idempotent: a prepared config is taken as it is.
+  const GameConfig twice = prepare_game_config(prepared);
+  CHECK(twice.world.obstacles.size() == prepared.world.obstacles.size());
+  CHECK(twice.planner.places.extra.size() == prepared.planner.places.extra.size());
+  // The game plays the prepared config and never changes it.
+  Game game(c);
+  REQUIRE(game.config().hackathon_layout);
+  CHECK(game.config().world.obstacles.size() == prepared.world.obstacles.size());
+  REQUIRE(game.hackathon_layout() != nullptr);
+  CHECK(game.hackathon_layout()->pucks.size() == prepared.hackathon_layout->pucks.size());
+  for (std::size_t i = 0; i < prepared.hackathon_layout->pucks.size(); ++i) {
+    CHECK(game.hackathon_layout()->pucks[i].position.x() ==
+          prepared.hackathon_layout->pucks[i].position.x());
+  }
+  // Without the variant nothing is added.
+  const GameConfig plain = prepare_game_config(test::small_game(1, 11));
+  CHECK_FALSE(plain.hackathon_layout);
+  CHECK(plain.world.obstacles.size() == test::small_game(1, 11).world.obstacles.size());
+}
+
+TEST_CASE("the radio's game side: robots by hub peer, inbox filled and cleared by the game") {
+  Game game(test::small_game(3, 2));
+  for (int i = 0; i < 3; ++i) {
+    CHECK(game.robot_of(game.robot_peer(i)) == i);
+    CHECK(game.robot(i).radio().peer() == game.robot_peer(i));
+  }
+  CHECK(game.robot_of(game.refbox_peer()) == -1);
+  CHECK(game.robot_of(comm::PeerId()) == -1);
+
+  RobotRadio radio;
+  Received r;
+  r.message = std::make_unique<llsf_agent_msgs::LockMessage>();
+  r.from = "robot2";
+  r.from_id = 2;
+  radio.deliver(std::move(r));
+  REQUIRE(radio.inbox().size() == 1);
+  CHECK(radio.inbox()[0].from_id == 2);
+  radio.clear_inbox();
+  CHECK(radio.inbox().empty());
+}
