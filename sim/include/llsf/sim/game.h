@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Game: the game loop. Owns the world, the refbox (behind its protocol adapter), the radio hub,
 // the planner and one RobotStack per robot, and steps them in the tick order of
-// ARCHITECTURE.md ("One tick"), written in Game::step(). Knows no file formats and no CLI: the
+// docs/architecture.md ("One tick"), written in Game::step(). Knows no file formats and no CLI: the
 // scenario runner builds a GameConfig and drives this loop.
 #pragma once
 
