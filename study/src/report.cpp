@@ -142,12 +142,24 @@ BatchReport make_report(const StatsStore& store, std::int64_t batch_id, std::uin
   return r;
 }
 
+namespace {
+/// A CSV field in double quotes, quotes inside doubled (RFC 4180).
+std::string csv_quoted(const std::string& field) {
+  std::string out = "\"";
+  for (const char c : field) {
+    if (c == '"') out += '"';
+    out += c;
+  }
+  return out + "\"";
+}
+}  // namespace
+
 std::string to_csv(const BatchReport& r) {
   std::string out = "variant,statistic,n,mean,median,q1,q3,min,max,pass_rate\n";
   for (const VariantReport& v : r.variants) {
     const double rate = v.runs > 0 ? static_cast<double>(v.passed) / v.runs : 0.0;
     for (const StatSummary& s : v.stats) {
-      out += "\"" + v.variant + "\"," + s.name + "," + std::to_string(s.n) + "," + fmt(s.mean) +
+      out += csv_quoted(v.variant) + "," + s.name + "," + std::to_string(s.n) + "," + fmt(s.mean) +
              "," + fmt(s.median) + "," + fmt(s.q1) + "," + fmt(s.q3) + "," + fmt(s.min) + "," +
              fmt(s.max) + "," + fmt(rate) + "\n";
     }

@@ -82,6 +82,10 @@ TEST_CASE("a report summarises each variant and bounds the difference of means")
   const std::string csv = to_csv(r);
   CHECK(csv.rfind("variant,statistic,n,mean,median,q1,q3,min,max,pass_rate\n", 0) == 0);
   CHECK(csv.find("\"a\",points,5,13,13,12,14,11,15,0.8") != std::string::npos);
+  // A quote in a variant name is doubled (RFC 4180), not left to end the field.
+  BatchReport quoted = r;
+  quoted.variants[0].variant = "config=\"P3\"";
+  CHECK(to_csv(quoted).find("\"config=\"\"P3\"\"\",points,") != std::string::npos);
   CHECK_THROWS_AS(make_report(store, 999), StatsError);
   std::filesystem::remove(path);
 }
