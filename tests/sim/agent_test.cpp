@@ -11,6 +11,7 @@
 
 #include "fixture.h"
 #include "llsf/sim/agent_brain.h"
+#include "llsf/sim/driver.h"
 #include "llsf/sim/game.h"
 
 using namespace llsf;
@@ -21,29 +22,26 @@ namespace {
 struct AgentGame {
   AgentGame(int robots, std::uint64_t seed, clips::ConfigEntries config, bool print = false,
             bool locks = false)
-      : game(make_config(robots, seed)) {
+      : driver(make_config(robots, seed)), game(driver.game()) {
     for (int i = 0; i < robots; ++i) {
       AgentBrainConfig c;
       c.agent_files = {LLSF_SOURCE_DIR "/clips/agents/common",
                        LLSF_SOURCE_DIR "/clips/agents/llsf2013"};
       c.config = config;
       c.locks = locks;
-      brains.push_back(
-          std::make_unique<AgentBrain>(game, i, c, [this, print](const clips::LogRecord& r) {
-            if (r.level >= clips::LogLevel::kWarn) ++warnings;
-            const std::string_view text = r.text;
-            if (text.find("task GET_S0 failed") != std::string_view::npos) {
-              get_s0_failures.emplace_back(text);
-            }
-            if (text.find("role change") != std::string_view::npos) ++role_changes;
-            if (text.find("took a consumed puck") != std::string_view::npos) ++consumed_taken;
-            if (print || r.level == clips::LogLevel::kError) {
-              std::printf("%8.2f %s %s: %.*s\n", r.time.seconds(), std::string(r.agent).c_str(),
-                          clips::to_string(r.level), static_cast<int>(r.text.size()),
-                          r.text.data());
-            }
-          }));
-      game.set_brain(i, brains.back().get());
+      brains.push_back(&driver.plug_agent(i, c, [this, print](const clips::LogRecord& r) {
+        if (r.level >= clips::LogLevel::kWarn) ++warnings;
+        const std::string_view text = r.text;
+        if (text.find("task GET_S0 failed") != std::string_view::npos) {
+          get_s0_failures.emplace_back(text);
+        }
+        if (text.find("role change") != std::string_view::npos) ++role_changes;
+        if (text.find("took a consumed puck") != std::string_view::npos) ++consumed_taken;
+        if (print || r.level == clips::LogLevel::kError) {
+          std::printf("%8.2f %s %s: %.*s\n", r.time.seconds(), std::string(r.agent).c_str(),
+                      clips::to_string(r.level), static_cast<int>(r.text.size()), r.text.data());
+        }
+      }));
     }
   }
   static GameConfig make_config(int robots, std::uint64_t seed) {
@@ -55,8 +53,9 @@ struct AgentGame {
     for (const auto& b : brains) n += b->agent().runtime_errors();
     return n;
   }
-  Game game;
-  std::vector<std::unique_ptr<AgentBrain>> brains;
+  GameDriver driver;
+  Game& game;
+  std::vector<AgentBrain*> brains;  // owned by the driver
   int warnings = 0;
   std::vector<std::string> get_s0_failures;  ///< "task GET_S0 failed: ..." of every robot
   int role_changes = 0;
