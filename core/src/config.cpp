@@ -229,6 +229,12 @@ void ConfigNode::no_other_keys() const {
   }
 }
 
+void ConfigNode::check_keys(std::initializer_list<std::string_view> allowed) const {
+  if (!is_map()) return;
+  for (auto a : allowed) impl_->asked->ask(impl_->path, a);
+  no_other_keys();
+}
+
 double ConfigNode::as_double() const {
   if (!is_scalar()) fail("expected a number, got " + describe(impl_->node));
   const std::string& s = impl_->node.Scalar();
