@@ -19,8 +19,8 @@
 #include "llsf/refbox/protocol.h"
 #include "llsf/sim/agent_brain.h"
 #include "llsf/sim/game.h"
-#include "llsf/sim/runner.h"
-#include "llsf/sim/scenario.h"
+#include "llsf/study/runner.h"
+#include "llsf/study/scenario.h"
 
 using namespace llsf;
 
@@ -170,24 +170,24 @@ LLSF_BENCH(
 
 LLSF_BENCH(full_game,
            "scenarios/default.yaml: a whole 3-robot game (1080 s), CPU and where the tick goes") {
-  const sim::ScenarioFile f = sim::load_scenario(LLSF_SOURCE_DIR "/scenarios/default.yaml");
-  sim::RunHooks plain;
-  std::vector<sim::RunResult> runs;
+  const study::ScenarioFile f = study::load_scenario(LLSF_SOURCE_DIR "/scenarios/default.yaml");
+  study::RunHooks plain;
+  std::vector<study::RunResult> runs;
   const double cpu = bench::median_of(5, [&] {
-    runs.push_back(sim::run_game(f.variants[0], 1, plain));
+    runs.push_back(study::run_game(f.variants[0], 1, plain));
     return runs.back().cpu_s;
   });
   bench::report("full_game", "cpu_s", cpu, "s");
   bench::report("full_game", "real_time_factor", 1080.0 / cpu, "x");
   bench::report("full_game", "points", runs.back().points, "points");
   // The split, from one profiled run (the clock reads add a little).
-  sim::RunHooks prof;
+  study::RunHooks prof;
   prof.profile = true;
   const std::string rec = (std::filesystem::temp_directory_path() /
                            ("llsf_bench_full_game_" + std::to_string(getpid()) + ".jsonl.gz"))
                               .string();
   prof.record_path = rec;  // recorded, as llsfsim run does
-  const sim::RunResult p = sim::run_game(f.variants[0], 1, prof);
+  const study::RunResult p = study::run_game(f.variants[0], 1, prof);
   std::filesystem::remove(rec);
   double total = 0.0;
   for (const auto& [name, s] : p.time_split) total += s;

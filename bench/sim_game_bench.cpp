@@ -19,10 +19,10 @@
 #include <vector>
 
 #include "harness.h"
-#include "llsf/sim/batch.h"
-#include "llsf/sim/runner.h"
-#include "llsf/sim/scenario.h"
-#include "llsf/sim/stats_store.h"
+#include "llsf/study/batch.h"
+#include "llsf/study/runner.h"
+#include "llsf/study/scenario.h"
+#include "llsf/study/stats_store.h"
 
 using namespace llsf;
 
@@ -52,9 +52,9 @@ ChildGame game_in_child() {
   if (pid < 0) return g;
   if (pid == 0) {
     close(fds[0]);
-    const sim::ScenarioFile f = sim::load_scenario(kScenario);
+    const study::ScenarioFile f = study::load_scenario(kScenario);
     const double t0 = wall_now();
-    const sim::RunResult r = sim::run_game(f.variants[0], 1);
+    const study::RunResult r = study::run_game(f.variants[0], 1);
     const double wall = wall_now() - t0;
     char buf[128];
     const int n = std::snprintf(buf, sizeof buf, "%.6f %.3f %d", wall, r.game_time_s, r.points);
@@ -114,17 +114,17 @@ LLSF_BENCH(batch100,
                        ("llsf_bench_batch100_" + std::to_string(static_cast<long>(getpid())));
   fs::remove_all(dir);
   fs::create_directories(dir);
-  const sim::ScenarioFile f = sim::load_scenario(kScenario);
+  const study::ScenarioFile f = study::load_scenario(kScenario);
   double wall = 0.0;
   int played = 0;
   {
-    sim::StatsStore store((dir / "batch.db").string());
-    sim::BatchOptions o;
+    study::StatsStore store((dir / "batch.db").string());
+    study::BatchOptions o;
     o.runs = 100;
     o.jobs = 2;
     o.recordings_dir = (dir / "recordings").string();
     const double t0 = wall_now();
-    const sim::BatchResult b = sim::run_batch(f, "bench", store, o);
+    const study::BatchResult b = study::run_batch(f, "bench", store, o);
     wall = wall_now() - t0;
     played = b.played;
   }

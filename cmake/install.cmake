@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: MIT
 # `cmake --install`: the llsfsim command, the libraries (headers in include/llsf/<module>/), the
 # run-time data in share/llsfsim/ (where an installed llsfsim finds it: core/data_dir.h) and the
-# CMake package `llsfsim` (find_package(llsfsim CONFIG), targets llsf::core ... llsf::sim).
+# CMake package `llsfsim` (find_package(llsfsim CONFIG), targets llsf::core ... llsf::study).
 include(CMakePackageConfigHelpers)
 
 # Run-time data, in the source tree's layout (scenario files name their agents relative to

@@ -14,9 +14,9 @@
 #include "llsf/app/cli.h"
 #include "llsf/clips/agent.h"
 #include "llsf/core/error.h"
-#include "llsf/sim/batch.h"
-#include "llsf/sim/scenario.h"
-#include "llsf/sim/stats_store.h"
+#include "llsf/study/batch.h"
+#include "llsf/study/scenario.h"
+#include "llsf/study/stats_store.h"
 
 namespace llsf::app {
 
@@ -26,7 +26,7 @@ struct BatchCommandOptions {
   std::vector<std::string> scenarios;
   std::optional<int> runs;
   std::optional<int> jobs;
-  std::string db{sim::StatsStore::kDefaultPath};
+  std::string db{study::StatsStore::kDefaultPath};
   std::string recordings;  ///< "" = default_recordings_dir(db)
   bool no_record = false;
   bool quiet = false;
@@ -34,11 +34,11 @@ struct BatchCommandOptions {
 
 struct Loaded {
   std::string path;
-  sim::ScenarioFile file;
+  study::ScenarioFile file;
   std::string hash;
 };
 
-void print_summary(const Loaded& l, const sim::BatchResult& b, const std::string& db,
+void print_summary(const Loaded& l, const study::BatchResult& b, const std::string& db,
                    const std::string& recordings, std::ostream& out) {
   out << fmt::format("batch      {} ({}) #{} in {}: {} runs, {} played, {} stored before\n",
                      l.file.variants.front().name, l.path, b.batch_id, db, b.total, b.played,
@@ -50,7 +50,7 @@ void print_summary(const Loaded& l, const sim::BatchResult& b, const std::string
                      "mean", "median", "min", "max");
   int runs = 0;
   int failed = 0;
-  for (const sim::VariantSummary& v : b.variants) {
+  for (const study::VariantSummary& v : b.variants) {
     out << fmt::format("{:<32} {:>5} {:>7} {:>7.1f} {:>7.1f} {:>5} {:>5}\n",
                        v.variant.empty() ? "-" : v.variant, v.runs,
                        fmt::format("{}/{}", v.passed, v.runs), v.mean_points, v.median_points,
@@ -74,18 +74,18 @@ int batch(const BatchCommandOptions& o, std::ostream& out, std::ostream& err) {
   std::vector<Loaded> loaded;
   try {
     for (const std::string& path : o.scenarios) {
-      Loaded l{path, sim::load_scenario(path), sim::file_content_hash(path)};
-      for (const sim::Scenario& s : l.file.variants) (void)sim::batch_seeds(s, o.runs);
+      Loaded l{path, study::load_scenario(path), study::file_content_hash(path)};
+      for (const study::Scenario& s : l.file.variants) (void)study::batch_seeds(s, o.runs);
       loaded.push_back(std::move(l));
     }
   } catch (const core::UserError& e) {
     err << "llsfsim batch: " << e.what() << "\n";
     return kExitBadInput;
   }
-  std::optional<sim::StatsStore> store;
+  std::optional<study::StatsStore> store;
   try {
     store.emplace(o.db);
-  } catch (const sim::StatsError& e) {
+  } catch (const study::StatsError& e) {
     err << "llsfsim batch: " << e.what() << "\n";
     return kExitBadInput;
   }
@@ -95,15 +95,15 @@ int batch(const BatchCommandOptions& o, std::ostream& out, std::ostream& err) {
   BatchProgressPrinter progress("llsfsim batch", err, o.quiet);
   bool all_passed = true;
   for (const Loaded& l : loaded) {
-    sim::BatchOptions options;
+    study::BatchOptions options;
     options.runs = o.runs;
     options.jobs = o.jobs.value_or(0);
     if (!o.no_record)
       options.recordings_dir = o.recordings.empty() ? default_recordings_dir(o.db) : o.recordings;
-    const sim::BatchHooks hooks = progress.hooks();
-    sim::BatchResult b;
+    const study::BatchHooks hooks = progress.hooks();
+    study::BatchResult b;
     try {
-      b = sim::run_batch(l.file, l.hash, *store, options, hooks);
+      b = study::run_batch(l.file, l.hash, *store, options, hooks);
     } catch (const clips::AgentLoadError& e) {
       err << "llsfsim batch: agent error:\n" << e.what() << "\n";
       return kExitBadInput;

@@ -47,14 +47,14 @@ BatchProgressPrinter::BatchProgressPrinter(std::string command, std::ostream& er
       quiet_(quiet),
       bar_(&err == &std::cerr && isatty(STDERR_FILENO) != 0 && !quiet) {}
 
-sim::BatchHooks BatchProgressPrinter::hooks() {
-  sim::BatchHooks h;
+study::BatchHooks BatchProgressPrinter::hooks() {
+  study::BatchHooks h;
   h.stop = &g_interrupted;
-  h.stored = [this](const sim::RunResult& r, const sim::BatchProgress& p) { stored(r, p); };
+  h.stored = [this](const study::RunResult& r, const study::BatchProgress& p) { stored(r, p); };
   return h;
 }
 
-void BatchProgressPrinter::stored(const sim::RunResult& r, const sim::BatchProgress& p) {
+void BatchProgressPrinter::stored(const study::RunResult& r, const study::BatchProgress& p) {
   if (quiet_) return;
   const double eta = p.done > 0 ? p.elapsed_s / p.done * (p.to_play - p.done) : 0.0;
   if (bar_) {

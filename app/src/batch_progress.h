@@ -8,7 +8,7 @@
 #include <iosfwd>
 #include <string>
 
-#include "llsf/sim/batch.h"
+#include "llsf/study/batch.h"
 
 namespace llsf::app {
 
@@ -45,12 +45,12 @@ class BatchProgressPrinter {
 
   /// Hooks for run_batch: the progress output and SigintGuard::interrupted() as the stop flag.
   /// The printer must outlive the batch.
-  sim::BatchHooks hooks();
+  study::BatchHooks hooks();
   /// True if a bar is drawn (a line ended by "\r": end it before other output).
   bool bar() const { return bar_; }
 
  private:
-  void stored(const sim::RunResult& r, const sim::BatchProgress& p);
+  void stored(const study::RunResult& r, const study::BatchProgress& p);
 
   std::string command_;
   std::ostream& err_;

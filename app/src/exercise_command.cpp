@@ -29,10 +29,10 @@
 #include "llsf/core/error.h"
 #include "llsf/core/version.h"
 #include "llsf/sim/game.h"
-#include "llsf/sim/recording.h"
-#include "llsf/sim/scenario.h"
 #include "llsf/sim/skill_brain.h"
-#include "llsf/sim/stats_store.h"
+#include "llsf/study/recording.h"
+#include "llsf/study/scenario.h"
+#include "llsf/study/stats_store.h"
 #include "server.h"
 
 namespace llsf::app {
@@ -68,7 +68,7 @@ struct Exercise {
   bool repeat = false;  ///< call the skill again after FINAL until the time is up
   double progress_s = 10.0;
   Goal goal;
-  sim::Scenario scenario;
+  study::Scenario scenario;
 };
 
 bool is_identifier(const std::string& s) {
@@ -96,11 +96,11 @@ Exercise load_exercise(const std::string& dir) {
   // The world: a scenario map (docs/scenarios.md) that must switch on the hackathon.
   sc.require_map();
   if (!sc["name"].defined()) sc.set("name", core::ConfigNode::parse("'" + ex.name + "'", ex.file));
-  ex.scenario = sim::read_scenario_map(sc, ex.file);
+  ex.scenario = study::read_scenario_map(sc, ex.file);
   if (!ex.scenario.game.hackathon) {
     sc.fail("an exercise plays the hackathon variant: add `hackathon: {}` (docs/hackathon.md)");
   }
-  for (const sim::RobotSpec& r : ex.scenario.robots) {
+  for (const study::RobotSpec& r : ex.scenario.robots) {
     if (!r.agent.empty()) sc["robots"].fail("robots of an exercise run the skill, not an agent");
   }
 
@@ -448,20 +448,20 @@ int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err)
   try {
     ServerOptions so;
     so.db = "";
-    so.recordings = default_recordings_dir(std::string(sim::StatsStore::kDefaultPath));
+    so.recordings = default_recordings_dir(std::string(study::StatsStore::kDefaultPath));
     server = start_live_server(o.live, so, feed, out);
   } catch (const core::UserError& e) {  // cannot listen
     err << "llsfsim exercise: " << e.what() << "\n";
     return kExitBadInput;
   }
-  std::unique_ptr<sim::Recorder> recorder;
+  std::unique_ptr<study::Recorder> recorder;
   if (o.live.serve || !o.record.empty()) {
-    sim::LineSink sink;
+    study::LineSink sink;
     if (o.live.serve) sink = [&feed](std::string_view line) { feed.publish(line); };
     try {
-      recorder = std::make_unique<sim::Recorder>(
-          o.record, game, sim::RecordingInfo{ex.name, "", seed, std::string(core::kVersion)}, 10.0,
-          sink);
+      recorder = std::make_unique<study::Recorder>(
+          o.record, game, study::RecordingInfo{ex.name, "", seed, std::string(core::kVersion)},
+          10.0, sink);
     } catch (const core::UserError& e) {  // the recording cannot be written
       err << "llsfsim exercise: " << e.what() << "\n";
       return kExitBadInput;

@@ -20,9 +20,9 @@
 #include "llsf/app/cli.h"
 #include "llsf/clips/agent.h"
 #include "llsf/core/error.h"
-#include "llsf/sim/batch.h"
-#include "llsf/sim/experiment.h"
-#include "llsf/sim/stats_store.h"
+#include "llsf/study/batch.h"
+#include "llsf/study/experiment.h"
+#include "llsf/study/stats_store.h"
 
 namespace llsf::app {
 
@@ -30,7 +30,7 @@ namespace {
 
 struct ExperimentOptions {
   std::string file;
-  std::string db{sim::StatsStore::kDefaultPath};
+  std::string db{study::StatsStore::kDefaultPath};
   std::optional<int> runs;
   std::optional<int> jobs;
   std::string recordings;  ///< "" = default_recordings_dir(db)
@@ -64,19 +64,19 @@ bool write_file(const std::string& path, const std::string& text) {
 }
 
 /// Plays every batch of `e` the store lacks. Returns an exit code, or nullopt to go on.
-std::optional<int> play(const ExperimentOptions& o, const sim::Experiment& e,
-                        sim::StatsStore& store, std::ostream& out, std::ostream& err) {
+std::optional<int> play(const ExperimentOptions& o, const study::Experiment& e,
+                        study::StatsStore& store, std::ostream& out, std::ostream& err) {
   const SigintGuard sigint;
   BatchProgressPrinter progress("llsfsim experiment", err, o.quiet);
-  for (const sim::ExperimentBatch& eb : e.batches) {
-    sim::BatchOptions options;
+  for (const study::ExperimentBatch& eb : e.batches) {
+    study::BatchOptions options;
     options.runs = o.runs;
     options.jobs = o.jobs.value_or(0);
     if (!o.no_record)
       options.recordings_dir = o.recordings.empty() ? default_recordings_dir(o.db) : o.recordings;
-    sim::BatchResult b;
+    study::BatchResult b;
     try {
-      b = sim::run_batch(eb.scenario, eb.hash, store, options, progress.hooks());
+      b = study::run_batch(eb.scenario, eb.hash, store, options, progress.hooks());
     } catch (const clips::AgentLoadError& ex) {
       err << "llsfsim experiment: batch " << eb.name << ": agent error:\n" << ex.what() << "\n";
       return kExitBadInput;
@@ -88,7 +88,7 @@ std::optional<int> play(const ExperimentOptions& o, const sim::Experiment& e,
     if (!o.quiet) {
       int runs = 0;
       int failed = 0;
-      for (const sim::VariantSummary& v : b.variants) {
+      for (const study::VariantSummary& v : b.variants) {
         runs += v.runs;
         failed += v.runs - v.passed;
       }
@@ -110,12 +110,12 @@ std::optional<int> play(const ExperimentOptions& o, const sim::Experiment& e,
 
 int experiment(const ExperimentOptions& o, std::ostream& out, std::ostream& err) {
   // Load and check everything before the first game: bad input costs no time.
-  sim::Experiment e;
+  study::Experiment e;
   std::optional<std::string> update_text;
   try {
-    e = sim::load_experiment(o.file);
-    for (const sim::ExperimentBatch& b : e.batches) {
-      for (const sim::Scenario& s : b.scenario.variants) (void)sim::batch_seeds(s, o.runs);
+    e = study::load_experiment(o.file);
+    for (const study::ExperimentBatch& b : e.batches) {
+      for (const study::Scenario& s : b.scenario.variants) (void)study::batch_seeds(s, o.runs);
     }
   } catch (const core::UserError& ex) {
     err << "llsfsim experiment: " << ex.what() << "\n";
@@ -128,7 +128,7 @@ int experiment(const ExperimentOptions& o, std::ostream& out, std::ostream& err)
       return kExitBadInput;
     }
     try {
-      (void)sim::replace_between_markers(*update_text, e.name, "");
+      (void)study::replace_between_markers(*update_text, e.name, "");
     } catch (const std::invalid_argument& ex) {
       err << "llsfsim experiment: " << o.update << ": " << ex.what() << "\n";
       return kExitBadInput;
@@ -139,10 +139,10 @@ int experiment(const ExperimentOptions& o, std::ostream& out, std::ostream& err)
         << " (play the experiment first: llsfsim experiment " << o.file << ")\n";
     return kExitBadInput;
   }
-  std::optional<sim::StatsStore> store;
+  std::optional<study::StatsStore> store;
   try {
     store.emplace(o.db);
-  } catch (const sim::StatsError& ex) {
+  } catch (const study::StatsError& ex) {
     err << "llsfsim experiment: " << ex.what() << "\n";
     return kExitBadInput;
   }
@@ -152,28 +152,28 @@ int experiment(const ExperimentOptions& o, std::ostream& out, std::ostream& err)
   }
 
   // Evaluate and report.
-  sim::EvaluateOptions eo;
+  study::EvaluateOptions eo;
   eo.runs = o.runs;
-  sim::ExperimentResult r;
+  study::ExperimentResult r;
   try {
-    r = sim::evaluate(e, *store, eo);
+    r = study::evaluate(e, *store, eo);
   } catch (const core::ConfigError& ex) {
     err << "llsfsim experiment: " << ex.what() << "\n";
     return kExitBadInput;
-  } catch (const sim::StatsError& ex) {
+  } catch (const study::StatsError& ex) {
     err << "llsfsim experiment: " << ex.what() << "\n";
     return kExitBadInput;
   }
   if (!o.quiet) {
     if (!o.report_only) out << "\n";
-    out << sim::to_text(r);
-    for (const sim::BatchState& b : r.batches) {
+    out << study::to_text(r);
+    for (const study::BatchState& b : r.batches) {
       if (b.stored >= b.expected) continue;
       err << "llsfsim experiment: batch " << b.name << " holds " << b.stored << " of " << b.expected
           << " runs; `" << r.command << "` plays the missing ones\n";
     }
   }
-  const std::string markdown = sim::to_markdown(r);
+  const std::string markdown = study::to_markdown(r);
   if (!o.out.empty() && !write_file(o.out, markdown)) {
     err << "llsfsim experiment: cannot write " << o.out << "\n";
     return kExitBadInput;
@@ -184,7 +184,7 @@ int experiment(const ExperimentOptions& o, std::ostream& out, std::ostream& err)
     std::string updated;
     try {
       if (!now) throw std::invalid_argument("cannot read it");
-      updated = sim::replace_between_markers(*now, e.name, markdown);
+      updated = study::replace_between_markers(*now, e.name, markdown);
     } catch (const std::invalid_argument& ex) {
       err << "llsfsim experiment: " << o.update << ": " << ex.what() << "\n";
       return kExitBadInput;

@@ -10,8 +10,8 @@
 
 #include "commands.h"
 #include "llsf/app/cli.h"
-#include "llsf/sim/report.h"
-#include "llsf/sim/stats_store.h"
+#include "llsf/study/report.h"
+#include "llsf/study/stats_store.h"
 
 namespace llsf::app {
 
@@ -19,7 +19,7 @@ namespace {
 
 struct ReportOptions {
   std::optional<std::int64_t> batch;
-  std::string db{sim::StatsStore::kDefaultPath};
+  std::string db{study::StatsStore::kDefaultPath};
   std::string csv;
   std::string html;
   bool list = false;
@@ -27,10 +27,10 @@ struct ReportOptions {
 
 int report(const ReportOptions& o, std::ostream& out, std::ostream& err) {
   try {
-    const sim::StatsStore store(o.db);
-    const std::vector<sim::StoredBatch> batches = store.batches();
+    const study::StatsStore store(o.db);
+    const std::vector<study::StoredBatch> batches = store.batches();
     if (o.list) {
-      for (const sim::StoredBatch& b : batches) {
+      for (const study::StoredBatch& b : batches) {
         out << b.id << "  " << b.kind << "  " << b.scenario_name << "  " << b.scenario_file << "  "
             << b.variants << " variant(s) x " << b.runs_per_variant << " run(s)  "
             << (b.finished.empty() ? "unfinished" : "finished " + b.finished) << "\n";
@@ -40,7 +40,7 @@ int report(const ReportOptions& o, std::ostream& out, std::ostream& err) {
     std::optional<std::int64_t> id = o.batch;
     if (!id) {
       // The latest batch (of `llsfsim batch`, else any).
-      for (const sim::StoredBatch& b : batches) {
+      for (const study::StoredBatch& b : batches) {
         if (b.kind == "batch") id = b.id;
       }
       if (!id && !batches.empty()) id = batches.back().id;
@@ -49,11 +49,11 @@ int report(const ReportOptions& o, std::ostream& out, std::ostream& err) {
       err << "llsfsim report: " << o.db << " holds no batch (run llsfsim batch first)\n";
       return kExitBadInput;
     }
-    const sim::BatchReport r = sim::make_report(store, *id);
-    out << sim::to_text(r);
+    const study::BatchReport r = study::make_report(store, *id);
+    out << study::to_text(r);
     if (!o.csv.empty()) {
       std::ofstream f(o.csv);
-      f << sim::to_csv(r);
+      f << study::to_csv(r);
       if (!f) {
         err << "llsfsim report: cannot write " << o.csv << "\n";
         return kExitBadInput;
@@ -61,7 +61,7 @@ int report(const ReportOptions& o, std::ostream& out, std::ostream& err) {
     }
     if (!o.html.empty()) {
       const std::string page =
-          sim::to_html(r, sim::to_json(r, sim::run_values(store, *id)), sim::viewer_dir());
+          study::to_html(r, study::to_json(r, study::run_values(store, *id)), study::viewer_dir());
       // Written next to its place and renamed: a failed write leaves no half page behind.
       const std::string tmp = o.html + ".tmp";
       std::ofstream f(tmp, std::ios::binary);
@@ -73,10 +73,10 @@ int report(const ReportOptions& o, std::ostream& out, std::ostream& err) {
         return kExitBadInput;
       }
     }
-  } catch (const sim::ViewerBundleMissing& e) {
+  } catch (const study::ViewerBundleMissing& e) {
     err << "llsfsim report: " << e.what() << "\n";
     return kExitBadInput;
-  } catch (const sim::StatsError& e) {
+  } catch (const study::StatsError& e) {
     err << "llsfsim report: " << e.what() << "\n";
     return kExitBadInput;
   }

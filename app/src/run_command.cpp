@@ -21,10 +21,10 @@
 #include "llsf/clips/agent.h"
 #include "llsf/core/error.h"
 #include "llsf/sim/agent_brain.h"
-#include "llsf/sim/recording.h"
-#include "llsf/sim/runner.h"
-#include "llsf/sim/scenario.h"
-#include "llsf/sim/stats_store.h"
+#include "llsf/study/recording.h"
+#include "llsf/study/runner.h"
+#include "llsf/study/scenario.h"
+#include "llsf/study/stats_store.h"
 #include "server.h"
 
 namespace llsf::app {
@@ -37,21 +37,21 @@ struct RunOptions {
   std::string variant;
   bool json = false;
   bool quiet = false;
-  std::string db{sim::StatsStore::kDefaultPath};
+  std::string db{study::StatsStore::kDefaultPath};
   bool no_db = false;
   std::string record;  ///< "" = default_recordings_dir(db)/recording_file_name(...)
   bool no_record = false;
   LiveOptions live;  ///< --speed, --realtime, --serve, --port, --serve-exit
 };
 
-const sim::Scenario* pick_variant(const sim::ScenarioFile& f, const std::string& name,
-                                  std::ostream& err) {
+const study::Scenario* pick_variant(const study::ScenarioFile& f, const std::string& name,
+                                    std::ostream& err) {
   if (name.empty()) return &f.variants.front();
-  for (const sim::Scenario& s : f.variants) {
+  for (const study::Scenario& s : f.variants) {
     if (s.variant == name) return &s;
   }
   // A variant may also be named by its values only ("P3-P3" for "config=P3-P3").
-  for (const sim::Scenario& s : f.variants) {
+  for (const study::Scenario& s : f.variants) {
     const auto eq = s.variant.find('=');
     if (eq != std::string::npos && s.variant.find(',') == std::string::npos &&
         s.variant.substr(eq + 1) == name) {
@@ -59,11 +59,11 @@ const sim::Scenario* pick_variant(const sim::ScenarioFile& f, const std::string&
     }
   }
   err << "llsfsim run: " << f.file << " has no variant '" << name << "'; its variants:\n";
-  for (const sim::Scenario& s : f.variants) err << "  " << s.variant << "\n";
+  for (const study::Scenario& s : f.variants) err << "  " << s.variant << "\n";
   return nullptr;
 }
 
-void print_summary(const sim::RunResult& r, std::ostream& out) {
+void print_summary(const study::RunResult& r, std::ostream& out) {
   out << fmt::format("scenario   {}{}  seed {}\n", r.scenario,
                      r.variant.empty() ? "" : " [" + r.variant + "]", r.seed);
   out << fmt::format("points     {:4}   exploration {:4}   production {:4}\n", r.points,
@@ -75,7 +75,7 @@ void print_summary(const sim::RunResult& r, std::ostream& out) {
   if (!r.orders.empty()) {
     out << "orders     ";
     for (std::size_t i = 0; i < r.orders.size(); ++i) {
-      const sim::OrderResult& o = r.orders[i];
+      const study::OrderResult& o = r.orders[i];
       out << fmt::format("{}#{} {} {}/{} [{}-{} s]", i ? "\n           " : "", o.id, o.product,
                          o.delivered, o.requested, o.window_begin_s, o.window_end_s);
     }
@@ -108,40 +108,40 @@ void print_summary(const sim::RunResult& r, std::ostream& out) {
   out << fmt::format("speed      {:.0f} s of game in {:.2f} s CPU: {:.0f}x real time\n",
                      r.game_time_s, r.cpu_s, r.real_time_factor);
   out << fmt::format("result     {:016x}\n", r.result_hash);
-  for (const sim::TestVerdict& t : r.tests) {
+  for (const study::TestVerdict& t : r.tests) {
     out << fmt::format("test       {}  {}: {}\n", t.passed ? "PASS" : "FAIL", t.name, t.detail);
   }
 }
 
 int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
-  sim::ScenarioFile file;
+  study::ScenarioFile file;
   try {
-    file = sim::load_scenario(o.scenario);
+    file = study::load_scenario(o.scenario);
   } catch (const core::ConfigError& e) {
     err << "llsfsim run: " << e.what() << "\n";
     return kExitBadInput;
   }
-  const sim::Scenario* s = pick_variant(file, o.variant, err);
+  const study::Scenario* s = pick_variant(file, o.variant, err);
   if (s == nullptr) return kExitBadInput;
   const std::uint64_t seed = o.seed.value_or(s->seeds.front());
   // The statistics store is opened before playing so that a bad path costs no game.
-  std::optional<sim::StatsStore> store;
-  sim::BatchKey key;
+  std::optional<study::StatsStore> store;
+  study::BatchKey key;
   if (!o.no_db) {
     try {
       store.emplace(o.db);
-      key.kind = sim::BatchKey::Kind::kRun;
+      key.kind = study::BatchKey::Kind::kRun;
       key.scenario_file = o.scenario;
       key.scenario_name = s->name;
-      key.scenario_hash = sim::file_content_hash(o.scenario);
+      key.scenario_hash = study::file_content_hash(o.scenario);
       key.variants = static_cast<int>(file.variants.size());
       key.seeds = s->seeds;
-    } catch (const sim::StatsError& e) {
+    } catch (const study::StatsError& e) {
       err << "llsfsim run: " << e.what() << "\n";
       return kExitBadInput;
     }
   }
-  sim::RunHooks hooks;
+  study::RunHooks hooks;
   if (!o.no_record) {
     hooks.record_path = o.record;
     if (hooks.record_path.empty()) {
@@ -153,7 +153,7 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
             << ec.message() << "\n";
         return kExitBadInput;
       }
-      hooks.record_path = (dir / sim::recording_file_name(s->name, s->variant, seed)).string();
+      hooks.record_path = (dir / study::recording_file_name(s->name, s->variant, seed)).string();
     }
   }
   // Paced mode: sleep between ticks so that game time runs `speed` times as fast as the wall
@@ -187,9 +187,9 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
       std::fflush(stderr);
     };
   }
-  sim::RunResult r;
+  study::RunResult r;
   try {
-    r = sim::run_game(*s, seed, hooks);
+    r = study::run_game(*s, seed, hooks);
   } catch (const clips::AgentLoadError& e) {
     err << "llsfsim run: agent error:\n" << e.what() << "\n";
     return kExitBadInput;
@@ -208,13 +208,13 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
       const std::int64_t batch = store->open_batch(key);
       const std::int64_t run = store->add_run(batch, r, /*replace=*/true);
       stored_as = fmt::format("{} (batch {}, run {})", o.db, batch, run);
-    } catch (const sim::StatsError& e) {
+    } catch (const study::StatsError& e) {
       err << "llsfsim run: " << e.what() << "\n";
       return kExitBadInput;
     }
   }
   if (o.json) {
-    out << sim::to_json(r) << "\n";
+    out << study::to_json(r) << "\n";
   } else if (!o.quiet) {
     print_summary(r, out);
     if (!r.recording.empty()) out << fmt::format("recording  {}\n", r.recording);
@@ -228,15 +228,15 @@ int check(const std::vector<std::string>& files, std::ostream& out, std::ostream
   int bad = 0;
   for (const std::string& path : files) {
     try {
-      const sim::ScenarioFile f = sim::load_scenario(path);
+      const study::ScenarioFile f = study::load_scenario(path);
       std::size_t seeds = 0;
-      for (const sim::Scenario& s : f.variants) {
+      for (const study::Scenario& s : f.variants) {
         seeds += s.seeds.size();
         // Build the game and every brain: agent files are parsed, skill files loaded.
         sim::Game game(s.game);
         std::vector<std::unique_ptr<sim::AgentBrain>> brains;
         for (int i = 0; i < game.robot_count(); ++i) {
-          const sim::RobotSpec& spec = s.robots.at(static_cast<std::size_t>(i));
+          const study::RobotSpec& spec = s.robots.at(static_cast<std::size_t>(i));
           if (spec.agent.empty()) continue;
           sim::AgentBrainConfig c;
           c.agent_files = spec.agent;

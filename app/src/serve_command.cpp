@@ -9,14 +9,14 @@
 #include "commands.h"
 #include "llsf/app/cli.h"
 #include "llsf/core/error.h"
-#include "llsf/sim/stats_store.h"
+#include "llsf/study/stats_store.h"
 #include "server.h"
 
 namespace llsf::app {
 
 Action add_serve_command(CLI::App& app) {
   auto o = std::make_shared<ServerOptions>();
-  o->db = std::string(sim::StatsStore::kDefaultPath);
+  o->db = std::string(study::StatsStore::kDefaultPath);
   app.add_option("--bind", o->bind, "Address to listen on")->capture_default_str();
   app.add_option("--port", o->port, "Port to listen on (0: any free port)")
       ->capture_default_str()

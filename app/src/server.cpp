@@ -29,9 +29,9 @@
 
 #include "commands.h"
 #include "llsf/core/error.h"
-#include "llsf/sim/recording.h"
-#include "llsf/sim/report.h"
-#include "llsf/sim/stats_store.h"
+#include "llsf/study/recording.h"
+#include "llsf/study/report.h"
+#include "llsf/study/stats_store.h"
 
 namespace llsf::app {
 
@@ -220,17 +220,17 @@ Reply recording_reply(const fs::path& path, const std::string& shown_as) {
   std::error_code ec;
   if (!fs::is_regular_file(path, ec))
     return error_reply(http::status::not_found, "no recording " + shown_as);
-  std::vector<sim::RecordingLine> lines;
+  std::vector<study::RecordingLine> lines;
   try {
-    lines = sim::read_recording(path.string());
+    lines = study::read_recording(path.string());
   } catch (const std::runtime_error& e) {
     return error_reply(http::status::unprocessable_entity, e.what());
   }
   Reply r{http::status::ok, "application/x-ndjson", {}, true};
   std::size_t bytes = 0;
-  for (const sim::RecordingLine& l : lines) bytes += l.json.size() + 1;
+  for (const study::RecordingLine& l : lines) bytes += l.json.size() + 1;
   r.body.reserve(bytes);
-  for (const sim::RecordingLine& l : lines) {
+  for (const study::RecordingLine& l : lines) {
     r.body += l.json;
     r.body += '\n';
   }
@@ -247,7 +247,7 @@ class WsSession;
 struct ServerImpl {
   ServerOptions options;
   LiveFeed* feed = nullptr;
-  std::optional<sim::StatsStore> store;
+  std::optional<study::StatsStore> store;
   asio::io_context ioc{1};
   tcp::acceptor acceptor{ioc};
   std::vector<std::weak_ptr<WsSession>> ws_sessions;
@@ -261,10 +261,10 @@ struct ServerImpl {
   Reply handle_api(const std::vector<std::string>& path);
   Reply serve_static(const std::vector<std::string>& path);
   /// The statistics store, opened on first use if its file exists (nullptr if it does not).
-  sim::StatsStore* stats();
+  study::StatsStore* stats();
 };
 
-sim::StatsStore* ServerImpl::stats() {
+study::StatsStore* ServerImpl::stats() {
   if (store) return &*store;
   std::error_code ec;
   if (options.db.empty() || !fs::is_regular_file(options.db, ec)) return nullptr;
@@ -307,8 +307,8 @@ Reply ServerImpl::handle_api(const std::vector<std::string>& path) {
   // GET /api/batches
   if (n == 2 && at(1) == "batches") {
     json a = json::array();
-    if (sim::StatsStore* s = stats()) {
-      for (const sim::StoredBatch& b : s->batches()) {
+    if (study::StatsStore* s = stats()) {
+      for (const study::StoredBatch& b : s->batches()) {
         a.push_back({{"id", b.id},
                      {"kind", b.kind},
                      {"scenario_name", b.scenario_name},
@@ -324,17 +324,17 @@ Reply ServerImpl::handle_api(const std::vector<std::string>& path) {
   if (n == 4 && at(1) == "batches" && (at(3) == "runs" || at(3) == "report")) {
     const std::optional<std::int64_t> id = parse_id(at(2));
     if (!id) return error_reply(http::status::bad_request, "bad batch id '" + at(2) + "'");
-    sim::StatsStore* s = stats();
+    study::StatsStore* s = stats();
     if (s == nullptr || !s->batch(*id)) {
       return error_reply(http::status::not_found, fmt::format("no batch {}", *id));
     }
     if (at(3) == "report") {
       Reply r{http::status::ok, "application/json",
-              sim::to_json(sim::make_report(*s, *id), sim::run_values(*s, *id)), true};
+              study::to_json(study::make_report(*s, *id), study::run_values(*s, *id)), true};
       return r;
     }
     json a = json::array();
-    for (const sim::StoredRun& r : s->runs(*id)) {
+    for (const study::StoredRun& r : s->runs(*id)) {
       a.push_back({{"id", r.id},
                    {"variant", r.variant},
                    {"seed", r.seed},
@@ -349,8 +349,8 @@ Reply ServerImpl::handle_api(const std::vector<std::string>& path) {
   if (n == 4 && at(1) == "runs" && at(3) == "recording") {
     const std::optional<std::int64_t> id = parse_id(at(2));
     if (!id) return error_reply(http::status::bad_request, "bad run id '" + at(2) + "'");
-    if (sim::StatsStore* s = stats()) {
-      if (const std::optional<sim::StoredRun> r = s->run(*id)) {
+    if (study::StatsStore* s = stats()) {
+      if (const std::optional<study::StoredRun> r = s->run(*id)) {
         if (r->recording.empty()) {
           return error_reply(http::status::not_found, fmt::format("run {} has no recording", *id));
         }
@@ -562,7 +562,7 @@ void ServerImpl::accept() {
 Server::Server(ServerOptions options, LiveFeed* feed) : impl_(std::make_unique<ServerImpl>()) {
   ServerImpl& m = *impl_;
   if (options.recordings.empty()) options.recordings = default_recordings_dir(options.db);
-  if (options.viewer.empty()) options.viewer = sim::viewer_dir();
+  if (options.viewer.empty()) options.viewer = study::viewer_dir();
   m.options = std::move(options);
   m.feed = feed;
   const std::string& bind = m.options.bind;

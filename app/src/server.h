@@ -57,7 +57,7 @@ struct ServerOptions {
   /// The statistics store (opened when it exists; "" = none: no batches).
   std::string db = "llsfsim.db";
   std::string recordings;  ///< recordings below /api/recordings/ ("" = default_recordings_dir(db))
-  std::string viewer;      ///< the built front end ("" = sim::viewer_dir())
+  std::string viewer;      ///< the built front end ("" = study::viewer_dir())
   /// A WebSocket client further behind the live game than this is dropped.
   std::int64_t max_client_backlog_bytes = std::int64_t{64} << 20;
 };

@@ -8,8 +8,8 @@
 #include "llsf/core/error.h"
 #include "llsf/core/sim_time.h"
 #include "llsf/core/version.h"
-#include "llsf/sim/runner.h"
-#include "llsf/sim/scenario.h"
+#include "llsf/study/runner.h"
+#include "llsf/study/scenario.h"
 
 int main(int argc, char** argv) {
   // The library looks for its data (the skill library) in $LLSF_DATA_DIR, else beside the running
@@ -17,9 +17,9 @@ int main(int argc, char** argv) {
   ::setenv("LLSF_DATA_DIR", LLSFSIM_DATA_DIR, /*overwrite=*/0);
   const std::string file = argc > 1 ? argv[1] : llsf::core::data_dir() + "/scenarios/default.yaml";
   try {
-    llsf::sim::Scenario s = llsf::sim::load_scenario(file).variants.front();
+    llsf::study::Scenario s = llsf::study::load_scenario(file).variants.front();
     s.duration = llsf::core::SimTime::from_sec(60);
-    const llsf::sim::RunResult r = llsf::sim::run_game(s, s.seeds.front());
+    const llsf::study::RunResult r = llsf::study::run_game(s, s.seeds.front());
     std::printf("llsfsim   %s\n", std::string(llsf::core::kVersion).c_str());
     std::printf("data      %s\n", llsf::core::data_dir().c_str());
     std::printf("scenario  %s, seed %llu, %.0f s\n", s.name.c_str(),

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <string>
 #include <unordered_map>
 
@@ -595,9 +596,30 @@ struct World::Impl : public b2ContactListener {
   }
 };
 
+namespace {
+// Box2D 2.4 builds its table of contact types (b2Contact::s_registers) on the first contact of
+// the process, unsynchronised. Two games starting at once on two threads would race on it: make
+// one contact here, once per process under std::call_once, before any World builds its b2World:
+// every World constructor calls it, so games may be built and stepped on any threads. (Its other
+// globals, b2_gjkCalls and friends, are statistics counters nothing reads.)
+void init_box2d_once() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    b2World world(b2Vec2(0.0f, 0.0f));
+    b2CircleShape circle;
+    circle.m_radius = 0.5f;
+    b2BodyDef def;
+    def.type = b2_dynamicBody;
+    for (int i = 0; i < 2; ++i) world.CreateBody(&def)->CreateFixture(&circle, 1.0f);
+    world.Step(0.01f, 1, 1);
+  });
+}
+}  // namespace
+
 // ------------------------------------------------------------------------------------------------
 World::World(const WorldConfig& config, const core::Rng& rng) {
   config.validate();
+  init_box2d_once();
   impl_ = std::make_unique<Impl>(config, rng);
 }
 World::~World() = default;

@@ -16,9 +16,9 @@
 
 #include "app/cli_fixture.h"
 #include "llsf/app/cli.h"
-#include "llsf/sim/batch.h"
-#include "llsf/sim/scenario.h"
-#include "llsf/sim/stats_store.h"
+#include "llsf/study/batch.h"
+#include "llsf/study/scenario.h"
+#include "llsf/study/stats_store.h"
 #include "support/temp_dir.h"
 
 namespace {
@@ -66,7 +66,7 @@ std::string slurp(const std::string& path) {
 using Key = std::tuple<std::string, std::uint64_t, std::uint64_t>;  // variant, seed, hash
 
 std::vector<Key> stored_runs(const std::string& db) {
-  llsf::sim::StatsStore store(db);
+  llsf::study::StatsStore store(db);
   std::vector<Key> out;
   for (std::int64_t batch = 1; batch <= 10; ++batch) {
     for (const auto& r : store.runs(batch)) out.emplace_back(r.variant, r.seed, r.result_hash);
@@ -97,11 +97,11 @@ TEST_CASE("llsfsim batch plays variants x seeds once, stores them, and resumes")
   CHECK(std::get<1>(two[0]) == 3);
   CHECK(std::get<1>(two[1]) == 4);
   {
-    llsf::sim::StatsStore store(db2);
+    llsf::study::StatsStore store(db2);
     CHECK(store.count_rows("batches") == 1);
     CHECK(!store.batch(1)->finished.empty());
     CHECK(store.count_rows("statistics") ==
-          4 * static_cast<std::int64_t>(llsf::sim::numeric_statistics({}).size()));
+          4 * static_cast<std::int64_t>(llsf::study::numeric_statistics({}).size()));
     CHECK(store.count_rows("tests") == 4);
     CHECK(store.count_rows("awards") > 0);  // machines completed, products delivered
     CHECK(store.count_rows("events") == store.count_rows("awards") + 4);
@@ -119,7 +119,7 @@ TEST_CASE("llsfsim batch plays variants x seeds once, stores them, and resumes")
   CHECK(stored_runs(db1) == two);
   CHECK(has(r.out, "recordings " + dir.file("one-recordings") + "/batch1/"));
   {
-    const llsf::sim::StatsStore s1(db1), s2(db2);
+    const llsf::study::StatsStore s1(db1), s2(db2);
     const auto runs1 = s1.runs(1), runs2 = s2.runs(1);
     REQUIRE(runs1.size() == 4);
     REQUIRE(runs2.size() == 4);
@@ -145,19 +145,19 @@ TEST_CASE("llsfsim batch plays variants x seeds once, stores them, and resumes")
 TEST_CASE("llsfsim batch: an interrupted batch keeps its runs and the next call plays the rest") {
   const TempDir dir;
   const std::string scenario = write_tiny(dir);
-  const llsf::sim::ScenarioFile file = llsf::sim::load_scenario(scenario);
-  const std::string hash = llsf::sim::file_content_hash(scenario);
-  llsf::sim::StatsStore store(dir.file("stats.db"));
+  const llsf::study::ScenarioFile file = llsf::study::load_scenario(scenario);
+  const std::string hash = llsf::study::file_content_hash(scenario);
+  llsf::study::StatsStore store(dir.file("stats.db"));
 
   std::atomic<bool> stop{false};
-  llsf::sim::BatchHooks hooks;
+  llsf::study::BatchHooks hooks;
   hooks.stop = &stop;
-  hooks.stored = [&](const llsf::sim::RunResult&, const llsf::sim::BatchProgress&) {
+  hooks.stored = [&](const llsf::study::RunResult&, const llsf::study::BatchProgress&) {
     stop = true;  // as a Ctrl-C after the first stored run
   };
-  llsf::sim::BatchOptions options;
+  llsf::study::BatchOptions options;
   options.jobs = 1;
-  llsf::sim::BatchResult b = llsf::sim::run_batch(file, hash, store, options, hooks);
+  llsf::study::BatchResult b = llsf::study::run_batch(file, hash, store, options, hooks);
   CHECK(b.interrupted);
   // The one worker may have started the next game before the first was stored; it finishes.
   const int first = b.played;
@@ -167,7 +167,7 @@ TEST_CASE("llsfsim batch: an interrupted batch keeps its runs and the next call 
   CHECK(store.count_rows("runs") == first);
   CHECK(store.batch(b.batch_id)->finished.empty());
 
-  b = llsf::sim::run_batch(file, hash, store, options);
+  b = llsf::study::run_batch(file, hash, store, options);
   CHECK(!b.interrupted);
   CHECK(b.skipped == first);
   CHECK(b.played == 4 - first);
@@ -221,10 +221,10 @@ TEST_CASE("llsfsim run stores its game with --db, not with --no-db") {
   r = llsfsim({"run", scenario, "--db", db, "--no-record"});
   CHECK(has(r.out, "database   " + db + " (batch 1, run "));
   CHECK(!has(r.out, "recording  "));
-  CHECK(llsf::sim::StatsStore(db).runs(1).back().recording.empty());
+  CHECK(llsf::study::StatsStore(db).runs(1).back().recording.empty());
   r = llsfsim({"run", scenario, "--db", db});
   CHECK(has(r.out, "recording  " + dir.file("run-recordings/tiny-config_P3-P3-seed3.jsonl.gz")));
-  CHECK(llsf::sim::StatsStore(db).runs(1).back().recording ==
+  CHECK(llsf::study::StatsStore(db).runs(1).back().recording ==
         dir.file("run-recordings/tiny-config_P3-P3-seed3.jsonl.gz"));
 
   // The same game again replaces the stored one; another seed adds one.
@@ -234,7 +234,7 @@ TEST_CASE("llsfsim run stores its game with --db, not with --no-db") {
         llsf::app::kExitOk);
   CHECK(stored_runs(db).size() == 2);
   {
-    llsf::sim::StatsStore store(db);
+    llsf::study::StatsStore store(db);
     CHECK(store.batch(1)->kind == "run");
   }
 

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Exit codes: the user's errors give 2, a bug in llsfsim gives 3 with a request to report it (the
-// bug is made by the test hook LLSF_TEST_INTERNAL_ERROR of sim::load_scenario).
+// bug is made by the test hook LLSF_TEST_INTERNAL_ERROR of study::load_scenario).
 #include <doctest/doctest.h>
 
 #include <cstdlib>

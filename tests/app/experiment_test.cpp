@@ -17,7 +17,7 @@
 #include "app/cli_fixture.h"
 #include "batch_progress.h"
 #include "llsf/app/cli.h"
-#include "llsf/sim/stats_store.h"
+#include "llsf/study/stats_store.h"
 #include "support/temp_dir.h"
 
 namespace {
@@ -116,7 +116,7 @@ TEST_CASE("llsfsim experiment plays its batches, evaluates, resumes and reports 
             "60.0, 95 % CI [60.0, 60.0]; n 6 | **met** |"));
   CHECK(has(md, "| F2 | P3 plays longer than P1P2 | not reproduced (check 1 failed) |"));
   {
-    const llsf::sim::StatsStore store(db);
+    const llsf::study::StatsStore store(db);
     CHECK(store.count_rows("runs") == 6);
     CHECK(!store.batch(1)->finished.empty());
   }
@@ -145,7 +145,7 @@ TEST_CASE("llsfsim experiment plays its batches, evaluates, resumes and reports 
   CHECK(has(r.out, "all: no data"));
   CHECK(has(r.err, "batch tiny holds 0 of 4 runs; `llsfsim experiment " + exp +
                        " --runs 2` plays the missing ones"));
-  CHECK(llsf::sim::StatsStore(db).count_rows("runs") == 6);
+  CHECK(llsf::study::StatsStore(db).count_rows("runs") == 6);
 }
 
 TEST_CASE("llsfsim experiment: bad input exits 2 before anything is played") {
@@ -208,7 +208,7 @@ TEST_CASE("llsfsim experiment: Ctrl-C keeps the stored runs and exits 130") {
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
       if (!fs::exists(db)) continue;
       try {
-        if (llsf::sim::StatsStore(db).count_rows("runs") < 1) continue;
+        if (llsf::study::StatsStore(db).count_rows("runs") < 1) continue;
       } catch (const std::exception&) {
         continue;  // the command is still creating the store
       }
@@ -226,7 +226,7 @@ TEST_CASE("llsfsim experiment: Ctrl-C keeps the stored runs and exits 130") {
   CHECK(has(r.err, "llsfsim experiment: interrupted"));
   CHECK(has(r.out, "result     interrupted"));
   CHECK(!has(r.out, "findings"));
-  const std::int64_t stored = llsf::sim::StatsStore(db).count_rows("runs");
+  const std::int64_t stored = llsf::study::StatsStore(db).count_rows("runs");
   CHECK(stored >= 1);
   CHECK(stored < 60);
 }

@@ -10,7 +10,7 @@
 #include <string>
 
 #include "app/cli_fixture.h"
-#include "llsf/sim/stats_store.h"
+#include "llsf/study/stats_store.h"
 #include "support/temp_dir.h"
 
 namespace {
@@ -26,8 +26,8 @@ using llsf::test::TempDir;
 /// A store with one batch of 2 variants x 2 runs (written directly: no game is played).
 std::string make_store(const TempDir& dir) {
   const std::string db = dir.file("r.db");
-  llsf::sim::StatsStore store(db);
-  llsf::sim::BatchKey key;
+  llsf::study::StatsStore store(db);
+  llsf::study::BatchKey key;
   key.scenario_file = "tiny.yaml";
   key.scenario_name = "tiny";
   key.scenario_hash = "00000000000000aa";
@@ -37,7 +37,7 @@ std::string make_store(const TempDir& dir) {
   const std::int64_t b = store.open_batch(key);
   for (const std::uint64_t seed : {1, 2}) {
     for (const char* v : {"config=P3-P3", "config=P1P2-P3"}) {
-      llsf::sim::RunResult r;
+      llsf::study::RunResult r;
       r.scenario = "tiny";
       r.variant = v;
       r.seed = seed;

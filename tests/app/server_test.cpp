@@ -23,9 +23,9 @@
 #include <vector>
 
 #include "app/cli_fixture.h"
-#include "llsf/sim/batch.h"
-#include "llsf/sim/scenario.h"
-#include "llsf/sim/stats_store.h"
+#include "llsf/study/batch.h"
+#include "llsf/study/scenario.h"
+#include "llsf/study/stats_store.h"
 #include "support/temp_dir.h"
 
 namespace {
@@ -51,7 +51,7 @@ struct Fixture {
   std::string db = dir.file("stats.db");
   std::string recordings = dir.file("stats-recordings");
   std::string viewer = dir.file("dist");
-  std::vector<llsf::sim::StoredRun> runs;
+  std::vector<llsf::study::StoredRun> runs;
 
   Fixture() {
     const std::string agents = std::string(LLSF_SOURCE_DIR) + "/clips/agents";
@@ -60,12 +60,12 @@ struct Fixture {
           "name: tiny\nseeds: [3, 4]\nstart: production\nduration_s: 20\nrobots:\n"
           "  count: 1\n  agent: [" +
               agents + "/common, " + agents + "/llsf2013]\n  config:\n    roles: [P3]\n");
-    llsf::sim::StatsStore store(db);
-    llsf::sim::BatchOptions options;
+    llsf::study::StatsStore store(db);
+    llsf::study::BatchOptions options;
     options.jobs = 1;
     options.recordings_dir = recordings;
-    llsf::sim::run_batch(llsf::sim::load_scenario(scenario), llsf::sim::file_content_hash(scenario),
-                         store, options);
+    llsf::study::run_batch(llsf::study::load_scenario(scenario),
+                           llsf::study::file_content_hash(scenario), store, options);
     runs = store.runs(1);
     write(viewer + "/index.html", "<!doctype html><title>viewer</title>");
     write(viewer + "/viewer.js", "console.log(1);");
@@ -255,7 +255,7 @@ TEST_CASE("server: bad requests get JSON errors and the server keeps serving") {
   CHECK(!error_of(post).empty());
 
   // A corrupt recording: 422 naming the file; a missing one: 404.
-  const llsf::sim::StoredRun& run = f.runs[1];
+  const llsf::study::StoredRun& run = f.runs[1];
   write(run.recording, "this is not gzip\n");
   Reply r = request(port, "/api/runs/" + std::to_string(run.id) + "/recording");
   CHECK(r.status == 422);

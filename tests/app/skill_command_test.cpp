@@ -11,7 +11,7 @@
 
 #include "app/cli_fixture.h"
 #include "llsf/app/cli.h"
-#include "llsf/sim/recording.h"
+#include "llsf/study/recording.h"
 
 namespace {
 
@@ -104,7 +104,7 @@ TEST_CASE("llsfsim run --record writes a readable recording; an unwritable path 
   Run r = llsfsim({"run", scenario, "--no-db", "--record", rec, "-q"});
   INFO(r.err);
   CHECK(r.code == 0);
-  CHECK(llsf::sim::read_recording(rec).size() > 300);
+  CHECK(llsf::study::read_recording(rec).size() > 300);
   r = llsfsim({"run", scenario, "--no-db", "--record", "/no/such/dir/x.jsonl.gz", "-q"});
   CHECK(r.code == llsf::app::kExitBadInput);
   CHECK(has(r.err, "cannot create the recording"));

@@ -17,7 +17,7 @@ mv "$tmp/first" "$tmp/prefix"
 prefix=$tmp/prefix
 bin=$prefix/bin/llsfsim
 data=$prefix/share/llsfsim
-for f in include/llsf/sim/runner.h include/llsf/core/version.h include/llsf_msgs/GameState.pb.h \
+for f in include/llsf/study/runner.h include/llsf/core/version.h include/llsf_msgs/GameState.pb.h \
     lib/cmake/llsfsim/llsfsimConfig.cmake share/llsfsim/clips/agents share/llsfsim/lua/skills \
     share/llsfsim/scenarios/default.yaml share/doc/llsfsim/LICENSE; do
   [ -e "$prefix/$f" ] || fail "not installed: $f"

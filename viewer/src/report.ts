@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // The report page of `llsfsim report --html`: reads the batch's data (to_json in
-// sim/src/report.cpp) from <script id="llsf-report-data" type="application/json"> and draws it
+// study/src/report.cpp) from <script id="llsf-report-data" type="application/json"> and draws it
 // with report_view.ts: box plots of the points per configuration (one box per variant, a dot per
 // run) and per phase, then the tables.
 import {el, renderReport, type ReportData} from "./report_view";

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // The report's view, shared by the report page of `llsfsim report --html` (report.ts) and the
-// viewer's batch page (viewer.ts): given the batch's data (to_json in sim/src/report.cpp) it
+// viewer's batch page (viewer.ts): given the batch's data (to_json in study/src/report.cpp) it
 // draws, like the thesis' Figures 6.3 and 6.5, box plots of the points per configuration (one
 // box per variant, a dot per run) and per phase, then the tables: points per variant, the
 // differences against the baseline with their bootstrap 95 % intervals, and every statistic's

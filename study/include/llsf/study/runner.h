@@ -13,10 +13,10 @@
 #include <vector>
 
 #include "llsf/sim/game.h"
-#include "llsf/sim/scenario.h"
 #include "llsf/sim/skill_brain.h"
+#include "llsf/study/scenario.h"
 
-namespace llsf::sim {
+namespace llsf::study {
 
 /// The verdict of one test case.
 struct TestVerdict {
@@ -109,18 +109,18 @@ struct RunResult {
   std::vector<RunAward> awards;  ///< every points award, in order
   std::string recording;         ///< RunHooks::record_path if the game was recorded
   /// The hackathon score at the end (scenarios with `hackathon:` only).
-  std::optional<HackathonScore> hackathon;
+  std::optional<sim::HackathonScore> hackathon;
   bool passed() const;
 };
 
 /// Called every `progress_every` of game time with the game (for a progress line).
 struct RunHooks {
-  std::function<void(const Game&)> progress;
-  SimTime progress_every = SimTime::from_sec(30);
+  std::function<void(const sim::Game&)> progress;
+  core::SimTime progress_every = core::SimTime::from_sec(30);
   /// Called at every tick after step 9 (recorders, live viewers).
-  std::function<void(const Game&)> tick;
+  std::function<void(const sim::Game&)> tick;
   /// Called with every skill status change of every robot.
-  std::function<void(const SkillStatusChange&)> skill;
+  std::function<void(const sim::SkillStatusChange&)> skill;
   /// If set, the game is recorded to this file (docs/recording.md).
   std::string record_path;
   /// If set, every recording line also goes here as it is written (a live viewer), whether or
@@ -137,4 +137,4 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
 /// The summary as one JSON object (fixed key order).
 std::string to_json(const RunResult& r);
 
-}  // namespace llsf::sim
+}  // namespace llsf::study

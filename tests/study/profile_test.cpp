@@ -8,21 +8,21 @@
 #include <fstream>
 #include <string>
 
-#include "fixture.h"
 #include "llsf/core/error.h"
 #include "llsf/lua/skill_engine.h"
-#include "llsf/sim/profile.h"
-#include "llsf/sim/runner.h"
-#include "llsf/sim/scenario.h"
+#include "llsf/study/profile.h"
+#include "llsf/study/runner.h"
+#include "llsf/study/scenario.h"
+#include "sim/fixture.h"
 #include "support/temp_dir.h"
 
 namespace llsf {
 namespace {
 
-sim::ScenarioFile load_text(const test::TempDir& dir, const std::string& text) {
+study::ScenarioFile load_text(const test::TempDir& dir, const std::string& text) {
   const std::string path = dir.file("s.yaml");
   std::ofstream(path) << text;
-  return sim::load_scenario(path);
+  return study::load_scenario(path);
 }
 
 std::string error_of(const test::TempDir& dir, const std::string& text) {
@@ -40,7 +40,7 @@ TEST_CASE("profiles: ideal is the game loop's defaults, robotino-2013 sets its f
   const sim::GameConfig defaults;
   sim::GameConfig g;
   lua::SkillEngineConfig skills;
-  sim::RobotProfile::named("ideal").apply(g, skills);
+  study::RobotProfile::named("ideal").apply(g, skills);
   CHECK(g.world.robot.max_speed_mps == defaults.world.robot.max_speed_mps);
   CHECK(g.controller.max_speed_mps == defaults.controller.max_speed_mps);
   CHECK(g.controller.blocked_timeout_s == defaults.controller.blocked_timeout_s);
@@ -54,7 +54,7 @@ TEST_CASE("profiles: ideal is the game loop's defaults, robotino-2013 sets its f
   CHECK(skills.stuck_detection);
 
   sim::GameConfig t;
-  sim::RobotProfile::named("robotino-2013").apply(t, skills);
+  study::RobotProfile::named("robotino-2013").apply(t, skills);
   CHECK(t.profile == "robotino-2013");
   CHECK(skills.profile == "robotino-2013");
   CHECK_FALSE(skills.stuck_detection);
@@ -69,13 +69,13 @@ TEST_CASE("profiles: ideal is the game loop's defaults, robotino-2013 sets its f
   CHECK(t.handling.align_s > 0.0);
   CHECK(t.handling.jam_probability > 0.0);
   CHECK_NOTHROW(t.validate());
-  CHECK_THROWS_AS(sim::RobotProfile::named("robotino-2099"), std::invalid_argument);
+  CHECK_THROWS_AS(study::RobotProfile::named("robotino-2099"), std::invalid_argument);
 }
 
 TEST_CASE("profiles: the scenario key, overrides, and keys that win over the profile") {
   const test::TempDir dir("llsf-profile");
   const std::string head = "name: p\nduration_s: 10\nrobots: {count: 1}\n";
-  sim::ScenarioFile f = load_text(dir, head + "profile: robotino-2013\n");
+  study::ScenarioFile f = load_text(dir, head + "profile: robotino-2013\n");
   CHECK(f.variants.front().game.profile == "robotino-2013");
   CHECK(f.variants.front().game.controller.max_speed_mps == 0.5);
   CHECK_FALSE(f.variants.front().skills.stuck_detection);
@@ -126,14 +126,14 @@ TEST_CASE("profiles: the ideal profile leaves the game as it was") {
       "skill_hz: 15}\nworld: {sensors: {laser: {enabled: false}}}\nrobots:\n  count: 2\n"
       "  agent: [" LLSF_SOURCE_DIR "/clips/agents/common, " LLSF_SOURCE_DIR
       "/clips/agents/llsf2013]\n  config: {roles: [P1P2, P3]}\n";
-  const sim::RunResult plain = sim::run_game(load_text(dir, body).variants.front(), 3);
-  const sim::RunResult ideal =
-      sim::run_game(load_text(dir, body + "profile: ideal\n").variants.front(), 3);
+  const study::RunResult plain = study::run_game(load_text(dir, body).variants.front(), 3);
+  const study::RunResult ideal =
+      study::run_game(load_text(dir, body + "profile: ideal\n").variants.front(), 3);
   CHECK(plain.result_hash == ideal.result_hash);
   CHECK(ideal.profile == "ideal");
   CHECK(ideal.jams == 0);
-  const sim::RunResult slow =
-      sim::run_game(load_text(dir, body + "profile: robotino-2013\n").variants.front(), 3);
+  const study::RunResult slow =
+      study::run_game(load_text(dir, body + "profile: robotino-2013\n").variants.front(), 3);
   CHECK(slow.result_hash != ideal.result_hash);
   CHECK(slow.profile == "robotino-2013");
 }

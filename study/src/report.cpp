@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "llsf/sim/report.h"
+#include "llsf/study/report.h"
 
 #include <algorithm>
 #include <cctype>
@@ -16,7 +16,7 @@
 #include "llsf/core/data_dir.h"
 #include "llsf/core/rng.h"
 
-namespace llsf::sim {
+namespace llsf::study {
 
 namespace {
 
@@ -387,4 +387,4 @@ std::string to_html(const BatchReport& r, const std::string& json, const std::st
   return page;
 }
 
-}  // namespace llsf::sim
+}  // namespace llsf::study

@@ -18,7 +18,7 @@
 #include "llsf/sim/game.h"
 #include "llsf/sim/skill_brain.h"
 
-namespace llsf::sim {
+namespace llsf::study {
 
 /// Version of the recording format written by Recorder.
 inline constexpr int kRecordingVersion = 1;
@@ -42,22 +42,22 @@ class Recorder {
  public:
   /// `pose_rate_hz`: pose frames per simulated second (default 10). `path` empty: no file,
   /// the lines go to `sink` only; with both, to both.
-  Recorder(const std::string& path, const Game& game, const RecordingInfo& info,
+  Recorder(const std::string& path, const sim::Game& game, const RecordingInfo& info,
            double pose_rate_hz = 10.0, LineSink sink = {});
   ~Recorder();
   Recorder(const Recorder&) = delete;
   Recorder& operator=(const Recorder&) = delete;
 
   /// Takes the events of the last tick, and a pose frame when one is due.
-  void frame(const Game& game);
+  void frame(const sim::Game& game);
   /// A skill status change of a robot.
-  void skill(const SkillStatusChange& change);
+  void skill(const sim::SkillStatusChange& change);
   /// A line of agent output (its decisions: (log-info ...), warnings, errors).
   void agent(const clips::LogRecord& record);
   /// A change of a robot's lock state (grants, refusals, releases).
   void lock(const std::string& robot, const clips::LockEvent& event);
   /// A free-form event from an agent or tool ({"t":..,"e":"note","robot":..,"text":..}).
-  void note(SimTime t, const std::string& robot, const std::string& text);
+  void note(core::SimTime t, const std::string& robot, const std::string& text);
   /// Flushes and closes the file (idempotent).
   void close();
   /// Lines written so far.
@@ -86,4 +86,4 @@ struct RecordingLine {
 /// missing file, a corrupt stream, a line that is not a JSON object, or an unknown version.
 std::vector<RecordingLine> read_recording(const std::string& path);
 
-}  // namespace llsf::sim
+}  // namespace llsf::study

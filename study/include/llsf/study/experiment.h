@@ -11,10 +11,10 @@
 #include <utility>
 #include <vector>
 
-#include "llsf/sim/scenario.h"
-#include "llsf/sim/stats_store.h"
+#include "llsf/study/scenario.h"
+#include "llsf/study/stats_store.h"
 
-namespace llsf::sim {
+namespace llsf::study {
 
 /// One scenario file of an experiment, played as one batch.
 struct ExperimentBatch {
@@ -271,4 +271,4 @@ std::string to_markdown(const ExperimentResult& r);
 std::string replace_between_markers(const std::string& text, const std::string& name,
                                     const std::string& replacement);
 
-}  // namespace llsf::sim
+}  // namespace llsf::study

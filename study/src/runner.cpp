@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "llsf/sim/runner.h"
+#include "llsf/study/runner.h"
 
 #include <llsf_msgs/GameState.pb.h>
 
@@ -18,9 +18,9 @@
 #include "llsf/core/version.h"
 #include "llsf/refbox/protocol.h"
 #include "llsf/sim/agent_brain.h"
-#include "llsf/sim/recording.h"
+#include "llsf/study/recording.h"
 
-namespace llsf::sim {
+namespace llsf::study {
 
 namespace {
 
@@ -40,7 +40,7 @@ double cpu_seconds() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
-void start_game(Game& g, StartMode start) {
+void start_game(sim::Game& g, StartMode start) {
   if (start == StartMode::kNone) return;  // the refbox stays in PRE_GAME
   g.start(start == StartMode::kExploration  ? refbox::GamePhase::kExploration
           : start == StartMode::kProduction ? refbox::GamePhase::kProduction
@@ -59,7 +59,7 @@ int deliveries_of(const refbox::Refbox& rb) {
 // refusal. Waits still open at the end of the game count until the end.
 class LockWaits {
  public:
-  static constexpr SimTime kRetryGap = SimTime::from_sec(5);
+  static constexpr core::SimTime kRetryGap = core::SimTime::from_sec(5);
 
   void on(const std::string& robot, const clips::LockEvent& e) {
     using clips::LockState;
@@ -98,7 +98,7 @@ class LockWaits {
         return;
     }
   }
-  void finish(SimTime end, RunResult& r) {
+  void finish(core::SimTime end, RunResult& r) {
     for (const auto& [key, w] : open_) close(w, w.refused_at.value_or(end));
     open_.clear();
     r.lock_grants = grants_;
@@ -110,12 +110,12 @@ class LockWaits {
 
  private:
   struct Wait {
-    SimTime since;
-    std::optional<SimTime> refused_at;  ///< refused and not asked again yet
+    core::SimTime since;
+    std::optional<core::SimTime> refused_at;  ///< refused and not asked again yet
   };
-  void close(const Wait& w, SimTime until) {
-    const SimTime waited = until - w.since;
-    if (waited <= SimTime{}) return;  // granted in the cycle that asked
+  void close(const Wait& w, core::SimTime until) {
+    const core::SimTime waited = until - w.since;
+    if (waited <= core::SimTime{}) return;  // granted in the cycle that asked
     ++waits_;
     total_s_ += waited.seconds();
     max_s_ = std::max(max_s_, waited.seconds());
@@ -144,7 +144,7 @@ class LockHolds {
   }
   /// `jammed(robot)` says whether a robot is jammed at the end.
   template <class F>
-  double finish(SimTime end, F&& jammed) {
+  double finish(core::SimTime end, F&& jammed) {
     for (const auto& [key, since] : open_) {
       if (!jammed(key.first)) max_s_ = std::max(max_s_, (end - since).seconds());
     }
@@ -153,14 +153,14 @@ class LockHolds {
   }
 
  private:
-  std::map<std::pair<std::string, std::string>, SimTime> open_;
+  std::map<std::pair<std::string, std::string>, core::SimTime> open_;
   double max_s_ = 0.0;
 };
 
 // Runs of failures of one skill by one robot (a FINAL of that skill ends the run).
 class FailureStreaks {
  public:
-  void on(const SkillStatusChange& ch) {
+  void on(const sim::SkillStatusChange& ch) {
     const std::string skill = ch.skill_string.substr(0, ch.skill_string.find('{'));
     int& n = runs_[{ch.robot, skill}];
     if (ch.status == lua::SkillStatus::kFailed) {
@@ -182,7 +182,7 @@ class FailureStreaks {
 };
 
 /// Pucks in `area` that no robot holds.
-int pucks_in(const Game& g, const kinematic::Rect& area) {
+int pucks_in(const sim::Game& g, const kinematic::Rect& area) {
   const kinematic::World& w = g.world();
   int n = 0;
   for (const core::PuckId p : w.pucks()) {
@@ -207,15 +207,15 @@ bool RunResult::passed() const {
 }
 
 RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks& hooks) {
-  GameConfig config = scenario.game;
+  sim::GameConfig config = scenario.game;
   config.seed = seed;
-  Game game(config);
+  sim::Game game(config);
   LockWaits lock_waits;  // before the brains, which call it
   LockHolds lock_holds;
   FailureStreaks streaks;
   int role_changes = 0;
   double first_role_change_s = -1.0;
-  std::vector<std::unique_ptr<AgentBrain>> brains;
+  std::vector<std::unique_ptr<sim::AgentBrain>> brains;
   int skill_failures = 0;
   std::unique_ptr<Recorder> recorder;
   if (!hooks.record_path.empty() || hooks.record_sink) {
@@ -227,7 +227,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   for (int i = 0; i < game.robot_count(); ++i) {
     const RobotSpec& spec = scenario.robots.at(static_cast<std::size_t>(i));
     if (spec.agent.empty()) continue;
-    AgentBrainConfig c;
+    sim::AgentBrainConfig c;
     c.agent_files = spec.agent;
     c.config = spec.config;
     c.skills = scenario.skills;
@@ -248,9 +248,10 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
       lock_holds.on(name, e, game.robot(i).jammed());
       if (recorder) recorder->lock(name, e);
     };
-    brains.push_back(std::make_unique<AgentBrain>(game, i, c, std::move(log), std::move(locks)));
+    brains.push_back(
+        std::make_unique<sim::AgentBrain>(game, i, c, std::move(log), std::move(locks)));
     brains.back()->skills().set_listener(
-        [&skill_failures, &hooks, &recorder, &streaks, &game, i](const SkillStatusChange& ch) {
+        [&skill_failures, &hooks, &recorder, &streaks, &game, i](const sim::SkillStatusChange& ch) {
           if (recorder) recorder->skill(ch);
           if (hooks.skill) hooks.skill(ch);
           if (ch.status == lua::SkillStatus::kFailed) ++skill_failures;
@@ -266,7 +267,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
     const TestCase& t = scenario.tests[i];
     TestVerdict& v = verdicts[i];
     v.name = t.name;
-    const GameSummary s = game.summary();
+    const sim::GameSummary s = game.summary();
     std::ostringstream d;
     double value = 0.0;
     switch (t.kind) {
@@ -320,8 +321,8 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
 
   game.enable_profile(hooks.profile);
   start_game(game, scenario.start);
-  const SimTime end = scenario.duration;
-  SimTime next_progress = hooks.progress_every;
+  const core::SimTime end = scenario.duration;
+  core::SimTime next_progress = hooks.progress_every;
   const double t0 = cpu_seconds();
   double recording_ns =
       0.0;  // with hooks.profile: the recorder's frames (wall clock, profile only)
@@ -333,11 +334,11 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   storage.hi += core::Vec2(0.1, 0.1);
   int storage_min = pucks_in(game, storage);
   double storage_empty_s = storage_min == 0 ? 0.0 : -1.0;
-  SimTime next_storage_sample = SimTime::from_sec(1);
+  core::SimTime next_storage_sample = core::SimTime::from_sec(1);
   while (game.time() < end) {
     game.step();
     if (game.time() >= next_storage_sample) {
-      next_storage_sample += SimTime::from_sec(1);
+      next_storage_sample += core::SimTime::from_sec(1);
       const int n = pucks_in(game, storage);
       storage_min = std::min(storage_min, n);
       if (n == 0 && storage_empty_s < 0.0) storage_empty_s = game.time().seconds();
@@ -358,7 +359,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
     }
     for (std::size_t i = 0; i < scenario.tests.size(); ++i) {
       const auto& by = scenario.tests[i].by_s;
-      if (!judged[i] && by && game.time() >= SimTime::from_seconds(*by)) {
+      if (!judged[i] && by && game.time() >= core::SimTime::from_seconds(*by)) {
         judge(i, game.refbox().points(), deliveries_of(game.refbox()));
       }
     }
@@ -375,7 +376,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   r.seed = seed;
   r.profile = scenario.game.profile;
   r.game_time_s = game.time().seconds();
-  const GameSummary s = game.summary();
+  const sim::GameSummary s = game.summary();
   r.points = s.points;
   r.exploration_points = s.exploration_points;
   r.production_points = s.production_points;
@@ -463,9 +464,9 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   r.tests = std::move(verdicts);
   r.hackathon = game.hackathon_score();
   if (hooks.profile) {
-    for (int i = 0; i < Game::TickProfile::kSteps; ++i) {
+    for (int i = 0; i < sim::Game::TickProfile::kSteps; ++i) {
       r.time_split.emplace_back(
-          Game::TickProfile::step_name(i),
+          sim::Game::TickProfile::step_name(i),
           1e-9 * static_cast<double>(game.profile().ns[static_cast<std::size_t>(i)]));
     }
     if (recorder) r.time_split.emplace_back("recording", 1e-9 * recording_ns);
@@ -537,7 +538,7 @@ std::string to_json(const RunResult& r) {
             {"passed", r.passed()},
             {"tests", std::move(tests)}};
   if (r.hackathon) {
-    const HackathonScore& h = *r.hackathon;
+    const sim::HackathonScore& h = *r.hackathon;
     j["hackathon"] = {{"points", h.points},
                       {"rescued", h.rescued},
                       {"decoys", h.decoys},
@@ -548,4 +549,4 @@ std::string to_json(const RunResult& r) {
   return j.dump(-1, ' ', false, Json::error_handler_t::replace);
 }
 
-}  // namespace llsf::sim
+}  // namespace llsf::study

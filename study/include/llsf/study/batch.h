@@ -11,11 +11,11 @@
 #include <string>
 #include <vector>
 
-#include "llsf/sim/runner.h"
-#include "llsf/sim/scenario.h"
-#include "llsf/sim/stats_store.h"
+#include "llsf/study/runner.h"
+#include "llsf/study/scenario.h"
+#include "llsf/study/stats_store.h"
 
-namespace llsf::sim {
+namespace llsf::study {
 
 /// How a batch is played.
 struct BatchOptions {
@@ -86,4 +86,4 @@ BatchResult run_batch(const ScenarioFile& file, const std::string& scenario_hash
 std::vector<VariantSummary> summarize(const std::vector<StoredRun>& runs,
                                       const std::vector<std::string>& variant_order);
 
-}  // namespace llsf::sim
+}  // namespace llsf::study

@@ -17,7 +17,7 @@ namespace llsf::lua {
 struct SkillEngineConfig;
 }
 
-namespace llsf::sim {
+namespace llsf::study {
 
 /// A robot profile. Every field has the `ideal` value by default; named() gives the others.
 struct RobotProfile {
@@ -35,13 +35,13 @@ struct RobotProfile {
   double align_s = 0.0;
 
   // Perception.
-  DetectionLevel light = DetectionLevel::kGroundTruth;
+  sim::DetectionLevel light = sim::DetectionLevel::kGroundTruth;
   double light_frame_rate_hz = 10.0;
   double light_delay_s = 1.0;
   double light_error_rate = 0.05;
   bool light_reads_states = false;  ///< LightDetectionConfig::reads_states
   double laser_rate_hz = 5.0;
-  LocalizationLevel localization = LocalizationLevel::kGroundTruth;
+  sim::LocalizationLevel localization = sim::LocalizationLevel::kGroundTruth;
   double position_noise_m = 0.01;
   double heading_noise_rad = 0.01;
 
@@ -63,11 +63,11 @@ struct RobotProfile {
   /// Throws core::ConfigError "profile.<field>: reason" for the first bad field.
   void validate() const;
   /// Sets the game's and the skills' fields that the profile covers.
-  void apply(GameConfig& game, lua::SkillEngineConfig& skills) const;
+  void apply(sim::GameConfig& game, lua::SkillEngineConfig& skills) const;
 };
 
 /// Reads a scenario's `profile:` -- a name (`robotino-2013`) or a map with `name` and any field
 /// to override (`{name: robotino-2013, max_speed_mps: 0.4}`). Errors name the file:line and key.
 RobotProfile load_profile(const core::ConfigNode& node);
 
-}  // namespace llsf::sim
+}  // namespace llsf::study

@@ -12,12 +12,13 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "llsf/sim/report.h"
-#include "llsf/sim/stats_store.h"
+#include "llsf/study/report.h"
+#include "llsf/study/stats_store.h"
 #include "support/temp_dir.h"
 
 using namespace llsf;
 using namespace llsf::sim;
+using namespace llsf::study;
 using nlohmann::json;
 
 namespace {

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // StatsStore: schema, a run written and read back, one transaction per run, batch identity.
-#include "llsf/sim/stats_store.h"
+#include "llsf/study/stats_store.h"
 #include "support/temp_dir.h"
 
 #include <doctest/doctest.h>
@@ -14,10 +14,10 @@
 namespace {
 
 namespace fs = std::filesystem;
-using llsf::sim::BatchKey;
-using llsf::sim::RunResult;
-using llsf::sim::StatsError;
-using llsf::sim::StatsStore;
+using llsf::study::BatchKey;
+using llsf::study::RunResult;
+using llsf::study::StatsError;
+using llsf::study::StatsStore;
 
 using llsf::test::TempDir;
 
@@ -152,7 +152,7 @@ TEST_CASE("StatsStore writes a run and reads it back") {
   CHECK(runs[0].passed);
   CHECK(runs[0].points == 28);
   CHECK(runs[0].game_time_s == 60.0);
-  CHECK(runs[0].llsfsim_version == llsf::sim::llsfsim_version());
+  CHECK(runs[0].llsfsim_version == llsf::study::llsfsim_version());
   // The same run by its id; an unknown id: none.
   const auto one = store.run(id);
   REQUIRE(one);
@@ -163,7 +163,7 @@ TEST_CASE("StatsStore writes a run and reads it back") {
 
   // Every numeric statistic, by name.
   const auto stats = store.statistics(id);
-  CHECK(stats.size() == llsf::sim::numeric_statistics(r).size());
+  CHECK(stats.size() == llsf::study::numeric_statistics(r).size());
   auto stat = [&](const std::string& name) {
     for (const auto& [n, v] : stats) {
       if (n == name) return v;
@@ -246,9 +246,9 @@ TEST_CASE("file_content_hash identifies a file's bytes") {
   std::ofstream(dir.file("a.yaml")) << "name: a\n";
   std::ofstream(dir.file("b.yaml")) << "name: a\n";
   std::ofstream(dir.file("c.yaml")) << "name: c\n";
-  const std::string a = llsf::sim::file_content_hash(dir.file("a.yaml"));
+  const std::string a = llsf::study::file_content_hash(dir.file("a.yaml"));
   CHECK(a.size() == 16);
-  CHECK(a == llsf::sim::file_content_hash(dir.file("b.yaml")));
-  CHECK(a != llsf::sim::file_content_hash(dir.file("c.yaml")));
-  CHECK_THROWS_AS(llsf::sim::file_content_hash(dir.file("missing.yaml")), StatsError);
+  CHECK(a == llsf::study::file_content_hash(dir.file("b.yaml")));
+  CHECK(a != llsf::study::file_content_hash(dir.file("c.yaml")));
+  CHECK_THROWS_AS(llsf::study::file_content_hash(dir.file("missing.yaml")), StatsError);
 }

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "llsf/sim/experiment.h"
+#include "llsf/study/experiment.h"
 
 #include <algorithm>
 #include <cctype>
@@ -16,10 +16,10 @@
 #include "llsf/core/config.h"
 #include "llsf/core/error.h"
 #include "llsf/core/rng.h"
-#include "llsf/sim/batch.h"
-#include "llsf/sim/report.h"
+#include "llsf/study/batch.h"
+#include "llsf/study/report.h"
 
-namespace llsf::sim {
+namespace llsf::study {
 
 namespace {
 
@@ -1305,4 +1305,4 @@ std::string replace_between_markers(const std::string& text, const std::string& 
   return out + text.substr(en);
 }
 
-}  // namespace llsf::sim
+}  // namespace llsf::study

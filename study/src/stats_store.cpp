@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "llsf/sim/stats_store.h"
+#include "llsf/study/stats_store.h"
 
 #include <sqlite3.h>
 
@@ -15,7 +15,7 @@
 #include "llsf/core/rng.h"
 #include "llsf/core/version.h"
 
-namespace llsf::sim {
+namespace llsf::study {
 
 namespace {
 
@@ -702,4 +702,4 @@ std::vector<std::pair<std::string, double>> numeric_statistics(const RunResult& 
   };
 }
 
-}  // namespace llsf::sim
+}  // namespace llsf::study

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "llsf/sim/recording.h"
+#include "llsf/study/recording.h"
 
 #include <zlib.h>
 
@@ -15,7 +15,7 @@
 #include "llsf/core/error.h"
 #include "llsf/refbox/refbox.h"
 
-namespace llsf::sim {
+namespace llsf::study {
 
 namespace {
 
@@ -55,8 +55,8 @@ struct Recorder::Impl {
   gzFile file = nullptr;
   std::string path;
   std::int64_t lines = 0;
-  SimTime period;
-  SimTime next_frame;
+  core::SimTime period;
+  core::SimTime next_frame;
   std::string line;  // reused
   // What the last frame / tick showed, to write only changes.
   std::unordered_map<std::uint32_t, std::pair<double, double>> puck_pos;
@@ -74,7 +74,7 @@ struct Recorder::Impl {
   std::vector<std::vector<core::Vec2>> paths;  // per robot, as last written
   std::vector<int> jam_device;                 // per robot, as last written (-1: not jammed)
   std::vector<std::int64_t> robot_dropped;     // per robot: its copies dropped so far
-  HackathonScore score;                        // hackathon: as last written
+  sim::HackathonScore score;                   // hackathon: as last written
   bool score_known = false;
   LineSink sink;
 
@@ -91,12 +91,12 @@ struct Recorder::Impl {
     ++lines;
   }
   /// An event line's start: {"t": .., "e": event}.
-  static Json event(SimTime t, const char* name) {
+  static Json event(core::SimTime t, const char* name) {
     return Json{{"t", fixed(t.seconds(), 2)}, {"e", name}};
   }
 };
 
-Recorder::Recorder(const std::string& path, const Game& game, const RecordingInfo& info,
+Recorder::Recorder(const std::string& path, const sim::Game& game, const RecordingInfo& info,
                    double pose_rate_hz, LineSink sink)
     : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
@@ -109,7 +109,7 @@ Recorder::Recorder(const std::string& path, const Game& game, const RecordingInf
   m.paths.resize(static_cast<std::size_t>(game.robot_count()));
   m.jam_device.assign(static_cast<std::size_t>(game.robot_count()), -1);
   m.robot_dropped.assign(static_cast<std::size_t>(game.robot_count()), 0);
-  m.period = SimTime::period_of_hz(pose_rate_hz);
+  m.period = core::SimTime::period_of_hz(pose_rate_hz);
   m.next_frame = game.time();
   const kinematic::WorldConfig& w = game.config().world;
   Json h = {
@@ -157,13 +157,13 @@ Recorder::Recorder(const std::string& path, const Game& game, const RecordingInf
     }
     h["obstacles"] = std::move(obstacles);
   }
-  if (const HackathonLayout* layout = game.hackathon_layout()) {
-    const HackathonConfig& hc = *game.config().hackathon;
+  if (const sim::HackathonLayout* layout = game.hackathon_layout()) {
+    const sim::HackathonConfig& hc = *game.config().hackathon;
     const kinematic::Rect& a = hc.safe_area;
     Json colours = Json::array();
     for (const auto& c : hc.colours) colours.push_back({{"name", c.name}, {"decoy", c.decoy}});
     Json pucks = Json::object();
-    for (const HackathonPuck& p : layout->pucks) {
+    for (const sim::HackathonPuck& p : layout->pucks) {
       pucks[std::to_string(p.id.value())] = hc.colours[static_cast<std::size_t>(p.colour)].name;
     }
     h["hackathon"] = {{"safe_area", Json::array({fixed(a.lo.x(), 3), fixed(a.lo.y(), 3),
@@ -193,7 +193,7 @@ void Recorder::close() {
 
 std::int64_t Recorder::lines() const { return impl_->lines; }
 
-void Recorder::skill(const SkillStatusChange& c) {
+void Recorder::skill(const sim::SkillStatusChange& c) {
   Json j = Impl::event(c.time, "skill");
   j["robot"] = c.robot;
   j["status"] = lua::to_string(c.status);
@@ -232,16 +232,16 @@ void Recorder::lock(const std::string& robot, const clips::LockEvent& e) {
   impl_->write(j);
 }
 
-void Recorder::note(SimTime t, const std::string& robot, const std::string& text) {
+void Recorder::note(core::SimTime t, const std::string& robot, const std::string& text) {
   Json j = Impl::event(t, "note");
   j["robot"] = robot;
   j["text"] = text;
   impl_->write(j);
 }
 
-void Recorder::frame(const Game& game) {
+void Recorder::frame(const sim::Game& game) {
   Impl& m = *impl_;
-  const SimTime t = game.time();
+  const core::SimTime t = game.time();
   const refbox::Refbox& rb = game.refbox();
   const kinematic::World& world = game.world();
 
@@ -406,7 +406,7 @@ void Recorder::frame(const Game& game) {
   m.write(f);
 
   // The hackathon score, at the frame rate, when it changed.
-  if (const std::optional<HackathonScore> score = game.hackathon_score()) {
+  if (const std::optional<sim::HackathonScore> score = game.hackathon_score()) {
     if (!m.score_known || score->points != m.score.points || score->rescued != m.score.rescued ||
         score->decoys != m.score.decoys || score->in_safe_area != m.score.in_safe_area) {
       if (m.score_known || score->rescued != 0 || score->decoys != 0) {
@@ -514,4 +514,4 @@ std::vector<RecordingLine> read_recording(const std::string& path) {
   return out;
 }
 
-}  // namespace llsf::sim
+}  // namespace llsf::study

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "llsf/sim/scenario.h"
+#include "llsf/study/scenario.h"
 
 #include <cstdlib>
 #include <filesystem>
@@ -13,16 +13,16 @@
 #include "llsf/kinematic/world_config.h"
 #include "llsf/planner/config.h"
 #include "llsf/refbox/config.h"
-#include "llsf/sim/profile.h"
+#include "llsf/study/profile.h"
 
-namespace llsf::sim {
+namespace llsf::study {
 
 namespace {
 
 namespace fs = std::filesystem;
 
 /// A hackathon run's length unless `duration_s` says otherwise.
-constexpr SimTime kHackathonDefaultDuration = SimTime::from_sec(300);
+constexpr core::SimTime kHackathonDefaultDuration = core::SimTime::from_sec(300);
 
 std::string read_text(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -68,46 +68,46 @@ double positive(const core::ConfigNode& n) {
   return v;
 }
 
-void read_levels(const core::ConfigNode& n, RobotLevelsConfig& l) {
+void read_levels(const core::ConfigNode& n, sim::RobotLevelsConfig& l) {
   if (!n.defined()) return;
   n.require_map();
   n.check_keys({"localization", "light", "puck", "skill", "position_noise_m", "heading_noise_rad",
                 "light_error_rate", "light_delay_s", "cruise_speed_mps"});
   if (n["localization"].defined()) {
-    l.localization.level = enum_of<LocalizationLevel>(
-        n["localization"],
-        {{"ground_truth", LocalizationLevel::kGroundTruth}, {"noisy", LocalizationLevel::kNoisy}});
+    l.localization.level = enum_of<sim::LocalizationLevel>(
+        n["localization"], {{"ground_truth", sim::LocalizationLevel::kGroundTruth},
+                            {"noisy", sim::LocalizationLevel::kNoisy}});
   }
   auto detection = [](const core::ConfigNode& c) {
-    return enum_of<DetectionLevel>(
-        c, {{"ground_truth", DetectionLevel::kGroundTruth}, {"vision", DetectionLevel::kVision}});
+    return enum_of<sim::DetectionLevel>(c, {{"ground_truth", sim::DetectionLevel::kGroundTruth},
+                                            {"vision", sim::DetectionLevel::kVision}});
   };
   if (n["light"].defined()) l.light.level = detection(n["light"]);
   if (n["puck"].defined()) l.puck.level = detection(n["puck"]);
   if (n["skill"].defined()) {
-    l.skill = enum_of<SkillLevel>(
-        n["skill"], {{"physical", SkillLevel::kPhysical}, {"symbolic", SkillLevel::kSymbolic}});
+    l.skill = enum_of<sim::SkillLevel>(n["skill"], {{"physical", sim::SkillLevel::kPhysical},
+                                                    {"symbolic", sim::SkillLevel::kSymbolic}});
   }
   n.read("position_noise_m", l.localization.position_noise_m);
   n.read("heading_noise_rad", l.localization.heading_noise_rad);
   n.read("light_error_rate", l.light.error_rate);
   if (n["light_delay_s"].defined()) {
-    l.light.delay = SimTime::from_seconds(n["light_delay_s"].as_double());
+    l.light.delay = core::SimTime::from_seconds(n["light_delay_s"].as_double());
   }
   n.read("cruise_speed_mps", l.symbolic.cruise_speed_mps);
 }
 
-void read_rates(const core::ConfigNode& n, GameConfig& g) {
+void read_rates(const core::ConfigNode& n, sim::GameConfig& g) {
   if (!n.defined()) return;
   n.require_map();
   n.check_keys({"physics_hz", "skill_hz", "agent_hz", "beacon_period_s"});
   if (n["physics_hz"].defined()) {
-    g.world.physics.step = SimTime::period_of_hz(positive(n["physics_hz"]));
+    g.world.physics.step = core::SimTime::period_of_hz(positive(n["physics_hz"]));
   }
   if (n["skill_hz"].defined()) g.skill_rate_hz = positive(n["skill_hz"]);
   if (n["agent_hz"].defined()) g.agent_rate_hz = positive(n["agent_hz"]);
   if (n["beacon_period_s"].defined()) {
-    g.beacon_period = SimTime::from_seconds(positive(n["beacon_period_s"]));
+    g.beacon_period = core::SimTime::from_seconds(positive(n["beacon_period_s"]));
   }
 }
 
@@ -290,7 +290,7 @@ Scenario read_scenario(const core::ConfigNode& root, const std::string& file) {
   read_rates(root["rates"], s.game);
   root.read("team", s.game.team);
   if (root["hackathon"].defined()) {
-    s.game.hackathon = load_hackathon_config(root["hackathon"], s.game.world);
+    s.game.hackathon = sim::load_hackathon_config(root["hackathon"], s.game.world);
     s.start = StartMode::kNone;
   }
   if (root["start"].defined()) {
@@ -307,7 +307,7 @@ Scenario read_scenario(const core::ConfigNode& root, const std::string& file) {
   }
   if (s.game.hackathon) duration = kHackathonDefaultDuration.seconds();
   if (root["duration_s"].defined()) duration = positive(root["duration_s"]);
-  s.duration = SimTime::from_seconds(duration);
+  s.duration = core::SimTime::from_seconds(duration);
   read_robots(root["robots"], dir, s);
   if (root["skills"].defined()) {
     s.skills = lua::SkillEngineConfig::from_config(root["skills"]);
@@ -422,4 +422,4 @@ ScenarioFile load_scenario(const std::string& path) {
   }
 }
 
-}  // namespace llsf::sim
+}  // namespace llsf::study

@@ -11,12 +11,13 @@
 #include "llsf/core/error.h"
 #include "llsf/sim/agent_brain.h"
 #include "llsf/sim/game.h"
-#include "llsf/sim/runner.h"
-#include "llsf/sim/scenario.h"
+#include "llsf/study/runner.h"
+#include "llsf/study/scenario.h"
 #include "support/temp_dir.h"
 
 using namespace llsf;
 using namespace llsf::sim;
+using namespace llsf::study;
 
 namespace {
 

@@ -8,8 +8,8 @@
 #include <cstdint>
 #include <string>
 
-#include "llsf/sim/runner.h"
-#include "llsf/sim/scenario.h"
+#include "llsf/study/runner.h"
+#include "llsf/study/scenario.h"
 
 namespace llsf {
 namespace {
@@ -30,9 +30,9 @@ TEST_CASE("pinned whole games: default, thesis-two-robots and hackathon, seed 1"
   };
   for (const Pinned& p : pinned) {
     INFO(p.scenario);
-    const sim::ScenarioFile file =
-        sim::load_scenario(std::string(LLSF_SOURCE_DIR "/") + p.scenario);
-    const sim::RunResult r = sim::run_game(file.variants.front(), 1);
+    const study::ScenarioFile file =
+        study::load_scenario(std::string(LLSF_SOURCE_DIR "/") + p.scenario);
+    const study::RunResult r = study::run_game(file.variants.front(), 1);
     CHECK(r.result_hash == p.hash);
     CHECK(r.points == p.points);
   }

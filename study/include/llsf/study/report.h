@@ -13,9 +13,9 @@
 
 #include "llsf/core/error.h"
 #include "llsf/core/rng.h"
-#include "llsf/sim/stats_store.h"
+#include "llsf/study/stats_store.h"
 
-namespace llsf::sim {
+namespace llsf::study {
 
 /// Distribution of one statistic over a variant's runs.
 struct StatSummary {
@@ -115,4 +115,4 @@ Interval bootstrap_interval(const std::vector<double>& a, const std::vector<doub
 /// (R's type 7); 0 for an empty vector.
 double quantile(const std::vector<double>& sorted, double q);
 
-}  // namespace llsf::sim
+}  // namespace llsf::study

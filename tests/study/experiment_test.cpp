@@ -12,13 +12,14 @@
 
 #include "llsf/core/error.h"
 #include "llsf/core/rng.h"
-#include "llsf/sim/experiment.h"
-#include "llsf/sim/report.h"
-#include "llsf/sim/stats_store.h"
+#include "llsf/study/experiment.h"
+#include "llsf/study/report.h"
+#include "llsf/study/stats_store.h"
 #include "support/temp_dir.h"
 
 using namespace llsf;
 using namespace llsf::sim;
+using namespace llsf::study;
 using llsf::test::TempDir;
 
 namespace {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "llsf/sim/profile.h"
+#include "llsf/study/profile.h"
 
 #include <cmath>
 #include <sstream>
@@ -8,7 +8,7 @@
 #include "llsf/core/error.h"
 #include "llsf/lua/skill_engine.h"
 
-namespace llsf::sim {
+namespace llsf::study {
 
 namespace {
 
@@ -54,7 +54,7 @@ RobotProfile robotino_2013() {
   p.align_s = 12.0;
   // Thesis §6.1.1: webcam at 2 Hz, light detection about 1 s late; §6.1.3: the light
   // detection is very reliable in the simulation.
-  p.light = DetectionLevel::kVision;
+  p.light = sim::DetectionLevel::kVision;
   p.light_frame_rate_hz = 2.0;
   p.light_delay_s = 1.0;
   p.light_error_rate = 0.0;
@@ -63,7 +63,7 @@ RobotProfile robotino_2013() {
   p.light_reads_states = true;
   p.laser_rate_hz = 5.0;  // thesis §6.1.1: half the real sensor's 10 Hz
   // Thesis §6.1.1: amcl, no difference to reality seen; Fig. 6.4c: wrongly localized robots.
-  p.localization = LocalizationLevel::kNoisy;
+  p.localization = sim::LocalizationLevel::kNoisy;
   // Assumption: move_base's recovery behaviour (thesis §6.1.1 "looks nervous and does much
   // recovery behavior when facing obstacles"; §6.2: passing each other "can take much time").
   p.wait_before_replan_s = 3.0;
@@ -118,7 +118,7 @@ void RobotProfile::validate() const {
     fail("jam_probability", "must be in [0, 1] (got " + num(jam_probability) + ")");
 }
 
-void RobotProfile::apply(GameConfig& game, lua::SkillEngineConfig& skills) const {
+void RobotProfile::apply(sim::GameConfig& game, lua::SkillEngineConfig& skills) const {
   game.profile = name;
   kinematic::RobotModelConfig& r = game.world.robot;
   r.max_speed_mps = max_speed_mps;
@@ -135,17 +135,17 @@ void RobotProfile::apply(GameConfig& game, lua::SkillEngineConfig& skills) const
   c.backoff_max_s = backoff_max_s;
   c.blocked_timeout_s = blocked_timeout_s;
   game.world.sensors.laser.rate_hz = laser_rate_hz;
-  LightDetectionConfig& l = game.levels.light;
+  sim::LightDetectionConfig& l = game.levels.light;
   l.level = light;
   l.frame_rate_hz = light_frame_rate_hz;
-  l.delay = SimTime::from_seconds(light_delay_s);
+  l.delay = core::SimTime::from_seconds(light_delay_s);
   l.error_rate = light_error_rate;
   l.reads_states = light_reads_states;
-  LocalizationConfig& loc = game.levels.localization;
+  sim::LocalizationConfig& loc = game.levels.localization;
   loc.level = localization;
   loc.position_noise_m = position_noise_m;
   loc.heading_noise_rad = heading_noise_rad;
-  HandlingConfig& h = game.handling;
+  sim::HandlingConfig& h = game.handling;
   h.align_s = align_s;
   h.motor_max_speed_mps = motor_max_speed_mps;
   h.motor_max_omega_rps = motor_max_omega_rps;
@@ -224,10 +224,10 @@ RobotProfile load_profile(const core::ConfigNode& node) {
   RobotProfile p;
   if (node["name"].defined()) p = named_or_fail(node["name"]);
   for (const NumberKey& k : kNumbers) node.read(k.key, p.*k.field);
-  read_level(node, "light", p.light, "ground_truth", DetectionLevel::kGroundTruth, "vision",
-             DetectionLevel::kVision);
-  read_level(node, "localization", p.localization, "ground_truth", LocalizationLevel::kGroundTruth,
-             "noisy", LocalizationLevel::kNoisy);
+  read_level(node, "light", p.light, "ground_truth", sim::DetectionLevel::kGroundTruth, "vision",
+             sim::DetectionLevel::kVision);
+  read_level(node, "localization", p.localization, "ground_truth",
+             sim::LocalizationLevel::kGroundTruth, "noisy", sim::LocalizationLevel::kNoisy);
   node.read("light_reads_states", p.light_reads_states);
   node.read("stuck_detection", p.stuck_detection);
   try {
@@ -246,4 +246,4 @@ RobotProfile load_profile(const core::ConfigNode& node) {
   return p;
 }
 
-}  // namespace llsf::sim
+}  // namespace llsf::study

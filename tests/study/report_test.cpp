@@ -6,11 +6,12 @@
 #include <filesystem>
 #include <string>
 
-#include "llsf/sim/report.h"
-#include "llsf/sim/stats_store.h"
+#include "llsf/study/report.h"
+#include "llsf/study/stats_store.h"
 
 using namespace llsf;
 using namespace llsf::sim;
+using namespace llsf::study;
 
 TEST_CASE("quantiles interpolate between order statistics (R type 7)") {
   const std::vector<double> v{1, 2, 3, 4};

@@ -1,7 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "llsf/sim/batch.h"
-
-#include <box2d/box2d.h>
+#include "llsf/study/batch.h"
 
 #include <algorithm>
 #include <chrono>
@@ -16,9 +14,9 @@
 #include <utility>
 
 #include "llsf/core/error.h"
-#include "llsf/sim/recording.h"
+#include "llsf/study/recording.h"
 
-namespace llsf::sim {
+namespace llsf::study {
 
 namespace {
 
@@ -51,23 +49,6 @@ class WorkerPool {
   std::atomic<bool>& stop_;
   std::vector<std::thread> threads_;
 };
-
-// Box2D 2.4 builds its table of contact types (b2Contact::s_registers) on the first contact of
-// the process, unsynchronised. Two games starting at once on two threads would race on it: make
-// one contact here, on one thread, before the workers start. (Its other globals, b2_gjkCalls and
-// friends, are statistics counters nothing reads.)
-void init_box2d_once() {
-  static std::once_flag once;
-  std::call_once(once, [] {
-    b2World world(b2Vec2(0.0f, 0.0f));
-    b2CircleShape circle;
-    circle.m_radius = 0.5f;
-    b2BodyDef def;
-    def.type = b2_dynamicBody;
-    for (int i = 0; i < 2; ++i) world.CreateBody(&def)->CreateFixture(&circle, 1.0f);
-    world.Step(0.01f, 1, 1);
-  });
-}
 
 }  // namespace
 
@@ -198,7 +179,6 @@ BatchResult run_batch(const ScenarioFile& file, const std::string& scenario_hash
   const auto t0 = std::chrono::steady_clock::now();  // progress only, never a game input
   BatchProgress progress;
   progress.to_play = static_cast<int>(jobs.size());
-  if (threads > 1) init_box2d_once();
   {
     WorkerPool pool(stop_workers);
     running = threads;
@@ -262,4 +242,4 @@ BatchResult run_batch(const ScenarioFile& file, const std::string& scenario_hash
   return result;
 }
 
-}  // namespace llsf::sim
+}  // namespace llsf::study

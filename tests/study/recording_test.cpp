@@ -11,13 +11,14 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "llsf/sim/recording.h"
-#include "llsf/sim/runner.h"
-#include "llsf/sim/scenario.h"
+#include "llsf/study/recording.h"
+#include "llsf/study/runner.h"
+#include "llsf/study/scenario.h"
 #include "support/temp_dir.h"
 
 using namespace llsf;
 using namespace llsf::sim;
+using namespace llsf::study;
 using Json = nlohmann::json;
 
 namespace {

@@ -15,9 +15,9 @@
 #include <vector>
 
 #include "llsf/core/error.h"
-#include "llsf/sim/runner.h"
+#include "llsf/study/runner.h"
 
-namespace llsf::sim {
+namespace llsf::study {
 
 /// The store could not be opened, read or written (the message names the file and SQLite's
 /// reason).
@@ -145,4 +145,4 @@ std::string stored_recording_path(const std::string& db_path, const std::string&
 /// The inverse: a kept path as a path usable from the working directory.
 std::string resolved_recording_path(const std::string& db_path, const std::string& stored);
 
-}  // namespace llsf::sim
+}  // namespace llsf::study

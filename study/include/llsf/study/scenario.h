@@ -15,7 +15,7 @@
 #include "llsf/lua/skill_engine.h"
 #include "llsf/sim/game_config.h"
 
-namespace llsf::sim {
+namespace llsf::study {
 
 /// One robot's brain: its agent files and configuration (empty agent: no brain, it stands).
 struct RobotSpec {
@@ -57,9 +57,9 @@ struct Scenario {
   std::string file;     ///< the YAML file
   std::string variant;  ///< "" without a matrix, else "axis=value,axis=value"
   std::vector<std::uint64_t> seeds{1};
-  GameConfig game;  ///< world, refbox, radio, navigation, levels, rates (seed: the first)
+  sim::GameConfig game;  ///< world, refbox, radio, navigation, levels, rates (seed: the first)
   StartMode start = StartMode::kGame;
-  SimTime duration;  ///< game time to play
+  core::SimTime duration;  ///< game time to play
   std::vector<RobotSpec> robots;
   lua::SkillEngineConfig skills;  ///< skill_dirs empty: the library of the skill level
   std::vector<TestCase> tests;
@@ -85,4 +85,4 @@ Scenario read_scenario_map(const core::ConfigNode& root, const std::string& file
 /// "points_at_least 30 by 720 s", for reports.
 std::string describe(const TestCase& t);
 
-}  // namespace llsf::sim
+}  // namespace llsf::study
