@@ -85,16 +85,16 @@ Exercise load_exercise(const std::string& dir) {
   ex.file = (fs::path(dir) / "exercise.yaml").string();
   const core::ConfigNode root = core::ConfigNode::load_file(ex.file);
   root.require_map();
-  root.check_keys({"title", "skill", "repeat", "progress_s", "goal", "scenario"});
   ex.title = root.at("title").as_string();
   ex.skill = root.at("skill").as_string();
   if (!is_identifier(ex.skill)) root["skill"].fail("must be a Lua identifier (the skill's name)");
   root.read("repeat", ex.repeat);
-  root.read("progress_s", ex.progress_s);
-  if (ex.progress_s <= 0.0) root["progress_s"].fail("must be > 0");
+  root.read("progress_s", ex.progress_s, core::positive());
+  core::ConfigNode sc = root.at("scenario");
+  const core::ConfigNode g = root.at("goal");
+  root.no_other_keys();
 
   // The world: a scenario map (docs/scenarios.md) that must switch on the hackathon.
-  core::ConfigNode sc = root.at("scenario");
   sc.require_map();
   if (!sc["name"].defined()) sc.set("name", core::ConfigNode::parse("'" + ex.name + "'", ex.file));
   ex.scenario = study::read_scenario_map(sc, ex.file);
@@ -106,46 +106,44 @@ Exercise load_exercise(const std::string& dir) {
   }
 
   // The scoring rule.
-  const core::ConfigNode g = root.at("goal");
   g.require_map();
-  g.check_keys({"reach", "find", "points_at_least"});
+  const core::ConfigNode reach = g["reach"];
+  const core::ConfigNode find = g["find"];
+  static_cast<void>(g["points_at_least"]);  // asked for: the third known key
+  g.no_other_keys();
   if (g.size() != 1) g.fail("give exactly one of reach, find, points_at_least");
   const kinematic::FieldConfig& field = ex.scenario.game.world.field;
-  if (g["reach"].defined()) {
-    const core::ConfigNode r = g["reach"];
+  if (reach.defined()) {
+    const core::ConfigNode& r = reach;
     r.require_map();
-    r.check_keys({"targets", "within_m"});
     ex.goal.kind = Goal::Kind::kReach;
     const core::ConfigNode t = r.at("targets");
     if (!t.is_sequence() || t.size() == 0) t.fail("expected a list of {x, y}");
     for (const core::ConfigNode& p : t.elements()) {
       p.require_map();
-      p.check_keys({"x", "y"});
       const core::Vec2 v(p.at("x").as_double(), p.at("y").as_double());
+      p.no_other_keys();
       if (v.x() < 0.0 || v.y() < 0.0 || v.x() > field.width_m || v.y() > field.height_m) {
         p.fail(fmt::format("({:.2f}, {:.2f}) is not on the field", v.x(), v.y()));
       }
       ex.goal.targets.push_back(v);
     }
-    r.read("within_m", ex.goal.within_m);
-    if (ex.goal.within_m <= 0.0) r["within_m"].fail("must be > 0");
-  } else if (g["find"].defined()) {
-    const core::ConfigNode f = g["find"];
+    r.read("within_m", ex.goal.within_m, core::positive());
+    r.no_other_keys();
+  } else if (find.defined()) {
+    const core::ConfigNode& f = find;
     f.require_map();
-    f.check_keys({"colour", "within_m"});
     ex.goal.kind = Goal::Kind::kFind;
     ex.goal.colour = f.at("colour").as_string();
     if (ex.scenario.game.hackathon->colour_index(ex.goal.colour) < 0) {
       f["colour"].fail("'" + ex.goal.colour + "' is not a colour of scenario.hackathon.colours");
     }
     ex.goal.within_m = 0.3;
-    f.read("within_m", ex.goal.within_m);
-    if (ex.goal.within_m <= 0.0) f["within_m"].fail("must be > 0");
+    f.read("within_m", ex.goal.within_m, core::positive());
+    f.no_other_keys();
   } else {
     ex.goal.kind = Goal::Kind::kPoints;
-    const std::int64_t p = g["points_at_least"].as_int();
-    if (p < 0) g["points_at_least"].fail("must be >= 0");
-    ex.goal.points = static_cast<int>(p);
+    g.read("points_at_least", ex.goal.points, core::non_negative());
   }
   return ex;
 }

@@ -30,18 +30,10 @@ const char* loss_model_name(LossModel m) {
 
 namespace {
 
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
+std::string num(double v) { return core::number_text(v); }
 
 [[noreturn]] void fail(const std::string& path, const std::string& reason) {
   throw ConfigError(path + ": " + reason);
-}
-
-void require_probability(const std::string& path, double p) {
-  if (!(p >= 0.0 && p <= 1.0)) fail(path, "must be in [0, 1] (got " + num(p) + ")");
 }
 
 void require_non_negative(const std::string& path, SimTime t) {
@@ -65,18 +57,14 @@ std::string indexed(const char* list, std::size_t i) {
 }  // namespace
 
 void HubConfig::validate() const {
-  require_probability("loss.probability", loss_probability);
-  if (!(mean_burst_length >= 1.0) || !std::isfinite(mean_burst_length)) {
-    fail("loss.mean_burst_length", "must be >= 1 (got " + num(mean_burst_length) + ")");
-  }
+  core::require("loss.probability", loss_probability, core::probability());
+  core::require("loss.mean_burst_length", mean_burst_length, core::at_least(1.0));
   if (loss_model == LossModel::kBurst) {
     require_burst_feasible("loss.probability", loss_probability, mean_burst_length);
   }
   require_non_negative("delay.fixed_ms", delay.fixed);
   require_non_negative("delay.jitter_ms", delay.jitter);
-  if (max_frame_bytes < kHeaderSize || max_frame_bytes > 65507) {
-    fail("max_frame_bytes", "must be in [8, 65507] (got " + std::to_string(max_frame_bytes) + ")");
-  }
+  core::require("max_frame_bytes", max_frame_bytes, core::in_range(kHeaderSize, 65507));
   for (std::size_t i = 0; i < links.size(); ++i) {
     const LinkConfig& l = links[i];
     const std::string p = indexed("links", i);
@@ -89,7 +77,7 @@ void HubConfig::validate() const {
                                                   "burst (model is ") +
                                           loss_model_name(loss_model) + ")");
       }
-      require_probability(p + ".loss_probability", *l.loss_probability);
+      core::require(p + ".loss_probability", *l.loss_probability, core::probability());
       if (loss_model == LossModel::kBurst) {
         require_burst_feasible(p + ".loss_probability", *l.loss_probability, mean_burst_length);
       }
@@ -151,56 +139,25 @@ LossModel parse_loss_model(const ConfigNode& n) {
   n.fail("unknown loss model '" + s + "' (expected none, global, per_link or burst)");
 }
 
-/// The node at the start of a validate() message "a.b[2].c: reason" (or its deepest present
-/// ancestor).
-ConfigNode locate(const ConfigNode& root, const std::string& message) {
-  const std::string path = message.substr(0, message.find(": "));
-  ConfigNode n = root;
-  std::size_t i = 0;
-  while (i < path.size()) {
-    const std::size_t j = path.find_first_of(".[", i);
-    const std::string key = path.substr(i, j == std::string::npos ? std::string::npos : j - i);
-    if (!key.empty()) {
-      const ConfigNode child = n[key];
-      if (!child.defined()) return n;
-      n = child;
-    }
-    if (j == std::string::npos) break;
-    if (path[j] == '[') {
-      const std::size_t close = path.find(']', j);
-      if (close == std::string::npos || !n.is_sequence()) return n;
-      const int index = std::stoi(path.substr(j + 1, close - j - 1));
-      if (index >= n.size()) return n;
-      n = n.at(index);
-      i = close + 1;
-      if (i < path.size() && path[i] == '.') ++i;
-    } else {
-      i = j + 1;
-    }
-  }
-  return n;
-}
-
 }  // namespace
 
 HubConfig load_hub_config(const ConfigNode& node, HubConfig base) {
   HubConfig c = std::move(base);
   node.require_map();
   if (node.is_null()) return c;
-  node.check_keys({"loss", "delay", "links", "outages", "max_frame_bytes", "forward_unregistered"});
 
   if (const ConfigNode loss = node["loss"]; loss.defined()) {
     loss.require_map();
-    loss.check_keys({"model", "probability", "mean_burst_length"});
     if (loss["model"].defined()) c.loss_model = parse_loss_model(loss["model"]);
     loss.read("probability", c.loss_probability);
     loss.read("mean_burst_length", c.mean_burst_length);
+    loss.no_other_keys();
   }
   if (const ConfigNode delay = node["delay"]; delay.defined()) {
     delay.require_map();
-    delay.check_keys({"fixed_ms", "jitter_ms"});
     read_ms(delay, "fixed_ms", c.delay.fixed);
     read_ms(delay, "jitter_ms", c.delay.jitter);
+    delay.no_other_keys();
   }
   node.read("max_frame_bytes", c.max_frame_bytes);
   node.read("forward_unregistered", c.forward_unregistered);
@@ -209,7 +166,6 @@ HubConfig load_hub_config(const ConfigNode& node, HubConfig base) {
     c.links.clear();
     for (const ConfigNode& l : links.elements()) {
       l.require_map();
-      l.check_keys({"from", "to", "symmetric", "loss_probability", "fixed_ms", "jitter_ms"});
       LinkConfig lc;
       lc.from = l.at("from").as_string();
       lc.to = l.at("to").as_string();
@@ -217,6 +173,7 @@ HubConfig load_hub_config(const ConfigNode& node, HubConfig base) {
       if (l["loss_probability"].defined()) lc.loss_probability = l["loss_probability"].as_double();
       if (l["fixed_ms"].defined()) read_ms(l, "fixed_ms", lc.delay_fixed.emplace());
       if (l["jitter_ms"].defined()) read_ms(l, "jitter_ms", lc.delay_jitter.emplace());
+      l.no_other_keys();
       // Ranges are checked by validate(), whose errors are located below.
       c.links.push_back(lc);
     }
@@ -225,7 +182,6 @@ HubConfig load_hub_config(const ConfigNode& node, HubConfig base) {
     c.outages.clear();
     for (const ConfigNode& o : outages.elements()) {
       o.require_map();
-      o.check_keys({"peer", "other", "from_s", "until_s"});
       OutageConfig oc;
       oc.peer = o.at("peer").as_string();
       o.read("other", oc.other);
@@ -233,15 +189,13 @@ HubConfig load_hub_config(const ConfigNode& node, HubConfig base) {
       o.at("until_s");
       read_s(o, "from_s", oc.from);
       read_s(o, "until_s", oc.until);
+      o.no_other_keys();
       c.outages.push_back(oc);
     }
   }
-  try {
-    c.validate();
-  } catch (const ConfigError& e) {
-    // validate() names fields by their YAML paths; point at the deepest node that exists.
-    throw ConfigError(locate(node, e.what()).location() + ": " + e.what());
-  }
+  node.no_other_keys();
+  // validate() names fields by their YAML paths; point at the deepest node that exists.
+  node.locate_errors([&] { c.validate(); });
   return c;
 }
 

@@ -18,12 +18,6 @@ namespace {
   throw ConfigError(path + ": " + reason);
 }
 
-void require_port(const std::string& path, int port) {
-  if (port < 0 || port > 65535) {
-    fail(path, "must be a port in [0, 65535] (got " + std::to_string(port) + ")");
-  }
-}
-
 std::string peer_path(std::size_t i, const char* field) {
   std::string p = "udp_peers[";
   p += std::to_string(i);
@@ -38,7 +32,7 @@ void SocketConfig::validate() const {
   boost::system::error_code ec;
   boost::asio::ip::make_address(address, ec);
   if (ec) fail("address", "'" + address + "' is not an IP address");
-  require_port("stream.port", stream_port);
+  core::require("stream.port", stream_port, core::port());
   std::set<std::string> names;
   std::set<int> ports;
   for (std::size_t i = 0; i < udp_peers.size(); ++i) {
@@ -46,8 +40,8 @@ void SocketConfig::validate() const {
     if (p.name.empty()) fail(peer_path(i, "name"), "must not be empty");
     if (!names.insert(p.name).second) fail(peer_path(i, "name"), "'" + p.name + "' is taken");
     if (p.channel.empty()) fail(peer_path(i, "channel"), "must not be empty");
-    require_port(peer_path(i, "send_port"), p.send_port);
-    require_port(peer_path(i, "recv_port"), p.recv_port);
+    core::require(peer_path(i, "send_port"), p.send_port, core::port());
+    core::require(peer_path(i, "recv_port"), p.recv_port, core::port());
     if (p.send_port != 0 && !ports.insert(p.send_port).second) {
       fail(peer_path(i, "send_port"), std::to_string(p.send_port) + " is used by another peer");
     }
@@ -58,46 +52,28 @@ SocketConfig load_socket_config(const ConfigNode& node, SocketConfig base) {
   SocketConfig c = std::move(base);
   node.require_map();
   if (node.is_null()) return c;
-  node.check_keys({"address", "stream", "udp_peers"});
   node.read("address", c.address);
   if (const ConfigNode s = node["stream"]; s.defined()) {
     s.require_map();
-    s.check_keys({"enabled", "port"});
     s.read("enabled", c.stream_enabled);
     s.read("port", c.stream_port);
+    s.no_other_keys();
   }
   if (const ConfigNode peers = node["udp_peers"]; peers.defined()) {
     c.udp_peers.clear();
     for (const ConfigNode& p : peers.elements()) {
       p.require_map();
-      p.check_keys({"name", "channel", "send_port", "recv_port"});
       UdpPeerConfig u;
       u.name = p.at("name").as_string();
       p.read("channel", u.channel);
       p.read("send_port", u.send_port);
       p.read("recv_port", u.recv_port);
+      p.no_other_keys();
       c.udp_peers.push_back(u);
     }
   }
-  try {
-    c.validate();
-  } catch (const ConfigError& e) {
-    // Point at the list entry or the key the message names, when it is present.
-    const std::string what = e.what();
-    ConfigNode at = node;
-    if (what.rfind("udp_peers[", 0) == 0) {
-      const int i = std::stoi(what.substr(10));
-      at = node["udp_peers"].at(i);
-      const std::size_t dot = what.find("].") + 2;
-      const std::string key = what.substr(dot, what.find(':') - dot);
-      if (at[key].defined()) at = at[key];
-    } else if (what.rfind("stream.port", 0) == 0 && node["stream"]["port"].defined()) {
-      at = node["stream"]["port"];
-    } else if (what.rfind("address", 0) == 0 && node["address"].defined()) {
-      at = node["address"];
-    }
-    throw ConfigError(at.location() + ": " + what);
-  }
+  node.no_other_keys();
+  node.locate_errors([&] { c.validate(); });
   return c;
 }
 

@@ -3,11 +3,68 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 namespace llsf::core {
+
+// --- Bounds -----------------------------------------------------------------------------------
+
+std::string number_text(double v) {
+  char buf[64];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
+}
+
+std::string Bound::violation(double v) const {
+  const std::string got = " (got " + number_text(v) + ")";
+  const bool fin = std::isfinite(v);
+  switch (kind) {
+    case Kind::kFinite:
+      return fin ? "" : "must be a finite number" + got;
+    case Kind::kGreater:
+      return v > lo && fin ? "" : "must be > " + number_text(lo) + got;
+    case Kind::kAtLeast:
+      return v >= lo && fin ? "" : "must be >= " + number_text(lo) + got;
+    case Kind::kAtMost:
+      return v <= hi ? "" : "must be at most " + number_text(hi) + got;
+    case Kind::kClosed:
+      return v >= lo && v <= hi
+                 ? ""
+                 : "must be in [" + number_text(lo) + ", " + number_text(hi) + "]" + got;
+    case Kind::kOpenClosed:
+      return v > lo && v <= hi
+                 ? ""
+                 : "must be in (" + number_text(lo) + ", " + number_text(hi) + "]" + got;
+    case Kind::kPort:
+      return v >= lo && v <= hi
+                 ? ""
+                 : "must be a port in [" + number_text(lo) + ", " + number_text(hi) + "]" + got;
+  }
+  return "";
+}
+
+void require(std::string_view path, double v, const Bound& bound) {
+  if (std::string why = bound.violation(v); !why.empty()) {
+    throw ConfigError(std::string(path) + ": " + why);
+  }
+}
+
+// --- ConfigNode -------------------------------------------------------------------------------
+
+/// The keys asked for, per map path, for one parsed document (shared by all its nodes). Keys
+/// are kept in the order first asked, for the "did you mean" hint.
+struct AskedKeys {
+  std::map<std::string, std::vector<std::string>, std::less<>> by_map;
+  void ask(const std::string& map_path, std::string_view key) {
+    auto& keys = by_map[map_path];
+    if (std::find(keys.begin(), keys.end(), key) == keys.end()) keys.emplace_back(key);
+  }
+};
 
 struct ConfigNode::Impl {
   YAML::Node node;
@@ -15,12 +72,28 @@ struct ConfigNode::Impl {
   std::string path;
   YAML::Mark mark;  // of the node, or of the parent for undefined keys
   bool defined = false;
+  std::shared_ptr<AskedKeys> asked = std::make_shared<AskedKeys>();
 };
 
 namespace {
 std::string child_path(const std::string& parent, std::string_view key) {
   if (parent.empty()) return std::string(key);
   return parent + "." + std::string(key);
+}
+/// Edit distance (insert, delete, substitute), for "did you mean".
+int edit_distance(std::string_view a, std::string_view b) {
+  std::vector<int> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = static_cast<int>(j);
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    int diag = row[0];
+    row[0] = static_cast<int>(i);
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const int up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diag = up;
+    }
+  }
+  return row[b.size()];
 }
 std::string describe(const YAML::Node& n) {
   if (!n.IsDefined()) return "nothing";
@@ -71,6 +144,8 @@ int ConfigNode::size() const {
 ConfigNode ConfigNode::operator[](std::string_view key) const {
   auto impl = std::make_shared<Impl>();
   impl->source = impl_->source;
+  impl->asked = impl_->asked;
+  if (is_map()) impl_->asked->ask(impl_->path, key);
   impl->path = child_path(impl_->path, key);
   impl->mark = impl_->mark;
   if (is_map()) {
@@ -96,6 +171,7 @@ ConfigNode ConfigNode::at(int index) const {
   if (index < 0 || index >= size()) fail("index " + std::to_string(index) + " out of range");
   auto impl = std::make_shared<Impl>();
   impl->source = impl_->source;
+  impl->asked = impl_->asked;
   impl->path = impl_->path + "[" + std::to_string(index) + "]";
   impl->node = impl_->node[static_cast<std::size_t>(index)];
   impl->mark = impl->node.Mark().line >= 0 ? impl->node.Mark() : impl_->mark;
@@ -124,18 +200,39 @@ void ConfigNode::require_map() const {
   if (defined() && !is_null() && !is_map()) fail("expected a map, got " + describe(impl_->node));
 }
 
-void ConfigNode::check_keys(std::initializer_list<std::string_view> allowed) const {
+void ConfigNode::no_other_keys() const {
   if (!is_map()) return;
+  static const std::vector<std::string> kNone;
+  const auto it = impl_->asked->by_map.find(impl_->path);
+  const std::vector<std::string>& asked = it == impl_->asked->by_map.end() ? kNone : it->second;
   for (const auto& kv : impl_->node) {
     const std::string k = kv.first.Scalar();
-    bool ok = false;
-    for (auto a : allowed) ok = ok || (a == k);
-    if (!ok) {
-      std::string list;
-      for (auto a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
-      (*this)[k].fail("unknown key '" + k + "' (allowed: " + list + ")");
+    if (std::find(asked.begin(), asked.end(), k) != asked.end()) continue;
+    // The closest asked-for key within a third of the name's length is a likely typo.
+    const std::string* best = nullptr;
+    int best_d = std::max(1, static_cast<int>(k.size()) / 3) + 1;
+    for (const std::string& a : asked) {
+      if (const int d = edit_distance(k, a); d < best_d) {
+        best = &a;
+        best_d = d;
+      }
     }
+    std::string hint;
+    if (best != nullptr) {
+      hint = " (did you mean '" + *best + "'?)";
+    } else if (!asked.empty()) {
+      std::string list;
+      for (const std::string& a : asked) list += (list.empty() ? "" : ", ") + a;
+      hint = " (allowed: " + list + ")";
+    }
+    (*this)[k].fail("unknown key '" + k + "'" + hint);
   }
+}
+
+void ConfigNode::check_keys(std::initializer_list<std::string_view> allowed) const {
+  if (!is_map()) return;
+  for (auto a : allowed) impl_->asked->ask(impl_->path, a);
+  no_other_keys();
 }
 
 double ConfigNode::as_double() const {
@@ -201,6 +298,21 @@ void ConfigNode::read(std::string_view key, bool& out) const {
 void ConfigNode::read(std::string_view key, std::string& out) const {
   if (auto c = (*this)[key]; c.defined()) out = c.as_string();
 }
+void ConfigNode::read(std::string_view key, double& out, const Bound& bound) const {
+  if (auto c = (*this)[key]; c.defined()) {
+    const double v = c.as_double();
+    if (std::string why = bound.violation(v); !why.empty()) c.fail(why);
+    out = v;
+  }
+}
+void ConfigNode::read(std::string_view key, int& out, const Bound& bound) const {
+  if (auto c = (*this)[key]; c.defined()) {
+    int v = 0;
+    read(key, v);
+    if (std::string why = bound.violation(v); !why.empty()) c.fail(why);
+    out = v;
+  }
+}
 
 const std::string& ConfigNode::path() const { return impl_->path; }
 
@@ -241,6 +353,89 @@ ConfigNode& ConfigNode::set(std::string_view dotted_path, const ConfigNode& valu
 void ConfigNode::fail(const std::string& message) const {
   const std::string p = impl_->path.empty() ? std::string("(top level)") : impl_->path;
   throw ConfigError(location() + ": " + p + ": " + message);
+}
+
+// --- Putting a location on validate() errors --------------------------------------------------
+
+namespace {
+bool is_path_char(char ch) {
+  return (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') ||
+         ch == '_' || ch == '.' || ch == '[' || ch == ']';
+}
+}  // namespace
+
+ConfigNode ConfigNode::resolve(std::string_view rel) const {
+  ConfigNode n = *this;
+  std::size_t i = 0;
+  while (i < rel.size()) {
+    if (rel[i] == '[') {
+      const std::size_t close = rel.find(']', i);
+      if (close == std::string_view::npos || !n.is_sequence()) return n;
+      int index = -1;
+      std::from_chars(rel.data() + i + 1, rel.data() + close, index);
+      if (index < 0 || index >= n.size()) return n;
+      n = n.at(index);
+      i = close + 1;
+    } else {
+      if (rel[i] == '.') ++i;
+      const std::size_t end = std::min(rel.find_first_of(".[", i), rel.size());
+      if (end == i || !n.is_map()) return n;
+      const ConfigNode child = n[rel.substr(i, end - i)];
+      if (!child.defined()) return n;
+      n = child;
+      i = end;
+    }
+  }
+  return n;
+}
+
+void ConfigNode::fail_at(std::string_view rel, const std::string& reason) const {
+  std::string full = impl_->path;
+  if (!full.empty() && !rel.empty() && rel.front() != '[') full += ".";
+  full += rel;
+  const ConfigNode at = resolve(rel);
+  if (at.path() == full) at.fail(reason);
+  // Only an ancestor exists: a deeper path named in the reason may be closer to the cause.
+  // Only path-like words (with a '.' or '[') count, so that "the field" does not match `field`.
+  const ConfigNode* best = &at;
+  ConfigNode named;
+  for (std::size_t i = 0; i < reason.size();) {
+    if (!is_path_char(reason[i]) || (i > 0 && is_path_char(reason[i - 1]))) {
+      ++i;
+      continue;
+    }
+    std::size_t end = i;
+    while (end < reason.size() && is_path_char(reason[end])) ++end;
+    std::string_view word(reason.data() + i, end - i);
+    while (!word.empty() && (word.back() == '.' || word.back() == ']')) {
+      if (word.back() == ']' && word.find('[') != std::string_view::npos) break;
+      word.remove_suffix(1);
+    }
+    if (word.find_first_of(".[") != std::string_view::npos) {
+      ConfigNode c = resolve(word);
+      std::string want = impl_->path;
+      if (!want.empty() && word.front() != '[') want += ".";
+      want += word;
+      if (c.path() == want && c.path().size() > best->path().size()) {
+        named = c;
+        best = &named;
+      }
+    }
+    i = end;
+  }
+  throw ConfigError(best->location() + ": " + (full.empty() ? "(top level)" : full) + ": " +
+                    reason);
+}
+
+void ConfigNode::relocate(const ConfigError& e) const {
+  const std::string what = e.what();
+  const std::size_t colon = what.find(": ");
+  const std::string_view head = std::string_view(what).substr(0, colon);
+  const bool is_path =
+      colon != std::string::npos && !head.empty() &&
+      std::all_of(head.begin(), head.end(), [](char ch) { return is_path_char(ch); });
+  if (!is_path) throw ConfigError(location() + ": " + what);
+  fail_at(head, what.substr(colon + 2));
 }
 
 }  // namespace llsf::core

@@ -132,12 +132,7 @@ constexpr double kRfidMaxRange = 0.115;  // RB: ISO 15693 reader, read range <= 
 constexpr double kEps = 1e-9;            // touching is not overlapping
 constexpr int kMaxBeams = 10000;
 
-/// Shortest round-trip form of a number ("-0.2", "1e-05").
-std::string num(double v) {
-  char buf[64];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, r.ptr);
-}
+std::string num(double v) { return core::number_text(v); }
 
 /// "(x.xx, y.yy)" for positions in messages.
 std::string at_xy(const Vec2& p) {
@@ -148,21 +143,6 @@ std::string at_xy(const Vec2& p) {
 
 [[noreturn]] void fail(const std::string& path, const std::string& reason) {
   throw ConfigError(path + ": " + reason);
-}
-
-void require_finite(const std::string& path, double v) {
-  if (!std::isfinite(v)) fail(path, "must be a finite number (got " + num(v) + ")");
-}
-void require_positive(const std::string& path, double v) {
-  if (!(v > 0.0) || !std::isfinite(v)) fail(path, "must be > 0 (got " + num(v) + ")");
-}
-void require_non_negative(const std::string& path, double v) {
-  if (!(v >= 0.0) || !std::isfinite(v)) fail(path, "must be >= 0 (got " + num(v) + ")");
-}
-void require_in(const std::string& path, double v, double lo, double hi) {
-  if (!(v >= lo && v <= hi)) {
-    fail(path, "must be in [" + num(lo) + ", " + num(hi) + "] (got " + num(v) + ")");
-  }
 }
 
 /// True if the whole circle lies inside [0, width] x [0, height].
@@ -194,9 +174,9 @@ std::string field_size(const FieldConfig& f) {
 }
 
 void validate_field(const FieldConfig& f) {
-  require_positive("field.width_m", f.width_m);
-  require_positive("field.height_m", f.height_m);
-  require_positive("field.wall_thickness_m", f.wall_thickness_m);
+  core::require("field.width_m", f.width_m, core::positive());
+  core::require("field.height_m", f.height_m, core::positive());
+  core::require("field.wall_thickness_m", f.wall_thickness_m, core::positive());
 }
 
 void validate_devices(const WorldConfig& c) {
@@ -204,13 +184,13 @@ void validate_devices(const WorldConfig& c) {
   for (int i = 0; i < kDeviceCount; ++i) {
     const DeviceConfig& d = c.devices[i];
     const std::string p = device_path(i);
-    require_finite(p + ".x", d.pose.x);
-    require_finite(p + ".y", d.pose.y);
-    require_finite(p + ".ori", d.pose.theta);
-    require_positive(p + ".body_depth_m", d.body_depth_m);
-    require_positive(p + ".body_width_m", d.body_width_m);
-    require_finite(p + ".body_offset_m", d.body_offset_m);
-    require_finite(p + ".rfid_offset_m", d.rfid_offset_m);
+    core::require(p + ".x", d.pose.x, core::finite());
+    core::require(p + ".y", d.pose.y, core::finite());
+    core::require(p + ".ori", d.pose.theta, core::finite());
+    core::require(p + ".body_depth_m", d.body_depth_m, core::positive());
+    core::require(p + ".body_width_m", d.body_width_m, core::positive());
+    core::require(p + ".body_offset_m", d.body_offset_m, core::finite());
+    core::require(p + ".rfid_offset_m", d.rfid_offset_m, core::finite());
     if (!(d.rfid_radius_m > 0.0 && d.rfid_radius_m <= kRfidMaxRange)) {
       fail(p + ".rfid_radius_m", "must be > 0 and <= " + num(kRfidMaxRange) +
                                      " (the RFID reader range) (got " + num(d.rfid_radius_m) + ")");
@@ -261,11 +241,11 @@ void validate_obstacles(const WorldConfig& c) {
                               indexed("obstacles", j) + ")");
       }
     }
-    require_finite(p + ".x", o.pose.x);
-    require_finite(p + ".y", o.pose.y);
-    require_finite(p + ".ori", o.pose.theta);
-    require_positive(p + ".size_x_m", o.size_x_m);
-    require_positive(p + ".size_y_m", o.size_y_m);
+    core::require(p + ".x", o.pose.x, core::finite());
+    core::require(p + ".y", o.pose.y, core::finite());
+    core::require(p + ".ori", o.pose.theta, core::finite());
+    core::require(p + ".size_x_m", o.size_x_m, core::positive());
+    core::require(p + ".size_y_m", o.size_y_m, core::positive());
     if (!core::inside_rect(o.footprint(), Vec2(0.0, 0.0), Vec2(f.width_m, f.height_m))) {
       fail(p, "obstacle '" + o.name + "' at " + at_xy(o.pose.position()) +
                   " is not entirely inside the field (" + field_size(f) + ")");
@@ -275,11 +255,11 @@ void validate_obstacles(const WorldConfig& c) {
 
 void validate_pucks(const WorldConfig& c) {
   const PuckModelConfig& m = c.puck;
-  require_positive("puck.radius_m", m.radius_m);
-  require_positive("puck.mass_kg", m.mass_kg);
-  require_non_negative("puck.floor_friction", m.floor_friction);
-  require_non_negative("puck.contact_friction", m.contact_friction);
-  require_in("puck.restitution", m.restitution, 0.0, 1.0);
+  core::require("puck.radius_m", m.radius_m, core::positive());
+  core::require("puck.mass_kg", m.mass_kg, core::positive());
+  core::require("puck.floor_friction", m.floor_friction, core::non_negative());
+  core::require("puck.contact_friction", m.contact_friction, core::non_negative());
+  core::require("puck.restitution", m.restitution, core::in_range(0.0, 1.0));
 
   const double r = m.radius_m;
   std::map<int, std::size_t> seen_ids;
@@ -291,8 +271,8 @@ void validate_pucks(const WorldConfig& c) {
       fail(p + ".id", "duplicate puck id " + std::to_string(pk.id) + " (also used by " +
                           indexed("pucks", it->second) + ")");
     }
-    require_finite(p + ".x", pk.position.x());
-    require_finite(p + ".y", pk.position.y());
+    core::require(p + ".x", pk.position.x(), core::finite());
+    core::require(p + ".y", pk.position.y(), core::finite());
     const std::string what = "puck " + std::to_string(pk.id) + " at " + at_xy(pk.position);
     if (!circle_inside_field(pk.position, r, c.field)) {
       fail(p, what + " is outside the field (the whole circle of puck.radius_m = " + num(r) +
@@ -315,13 +295,13 @@ void validate_pucks(const WorldConfig& c) {
 
 void validate_robots(const WorldConfig& c) {
   const RobotModelConfig& m = c.robot;
-  require_positive("robot.radius_m", m.radius_m);
-  require_positive("robot.mass_kg", m.mass_kg);
-  require_positive("robot.max_speed_mps", m.max_speed_mps);
-  require_positive("robot.max_omega_rps", m.max_omega_rps);
-  require_positive("robot.max_accel_mps2", m.max_accel_mps2);
-  require_positive("robot.max_alpha_rps2", m.max_alpha_rps2);
-  require_non_negative("robot.contact_friction", m.contact_friction);
+  core::require("robot.radius_m", m.radius_m, core::positive());
+  core::require("robot.mass_kg", m.mass_kg, core::positive());
+  core::require("robot.max_speed_mps", m.max_speed_mps, core::positive());
+  core::require("robot.max_omega_rps", m.max_omega_rps, core::positive());
+  core::require("robot.max_accel_mps2", m.max_accel_mps2, core::positive());
+  core::require("robot.max_alpha_rps2", m.max_alpha_rps2, core::positive());
+  core::require("robot.contact_friction", m.contact_friction, core::non_negative());
 
   const HolderConfig& h = m.holder;
   if (!(h.inner_width_m > 2.0 * c.puck.radius_m) || !std::isfinite(h.inner_width_m)) {
@@ -329,10 +309,11 @@ void validate_robots(const WorldConfig& c) {
          "must be wider than the puck diameter 2 * puck.radius_m = " + num(2.0 * c.puck.radius_m) +
              " (got " + num(h.inner_width_m) + ")");
   }
-  require_positive("robot.holder.arm_length_m", h.arm_length_m);
-  require_positive("robot.holder.arm_thickness_m", h.arm_thickness_m);
-  require_non_negative("robot.holder.arm_friction", h.arm_friction);
-  require_non_negative("robot.holder.release_backing_speed_mps", h.release_backing_speed_mps);
+  core::require("robot.holder.arm_length_m", h.arm_length_m, core::positive());
+  core::require("robot.holder.arm_thickness_m", h.arm_thickness_m, core::positive());
+  core::require("robot.holder.arm_friction", h.arm_friction, core::non_negative());
+  core::require("robot.holder.release_backing_speed_mps", h.release_backing_speed_mps,
+                core::non_negative());
 
   const double r = m.radius_m;
   std::map<std::string, std::size_t> seen_names;
@@ -353,9 +334,9 @@ void validate_robots(const WorldConfig& c) {
       fail(p + ".name", "duplicate robot name '" + rs.name + "' (also used by " +
                             indexed("robots", it->second) + ")");
     }
-    require_finite(p + ".x", rs.pose.x);
-    require_finite(p + ".y", rs.pose.y);
-    require_finite(p + ".ori", rs.pose.theta);
+    core::require(p + ".x", rs.pose.x, core::finite());
+    core::require(p + ".y", rs.pose.y, core::finite());
+    core::require(p + ".ori", rs.pose.theta, core::finite());
     const Vec2 pos = rs.pose.position();
     const std::string what = "robot '" + rs.name + "' at " + at_xy(pos);
     if (!circle_inside_field(pos, r, c.field)) {
@@ -384,47 +365,51 @@ void validate_robots(const WorldConfig& c) {
 }
 
 void validate_sensors(const SensorsConfig& s) {
-  require_positive("sensors.odometry.rate_hz", s.odometry.rate_hz);
-  require_non_negative("sensors.odometry.trans_noise_per_m", s.odometry.trans_noise_per_m);
-  require_non_negative("sensors.odometry.rot_noise_per_rad", s.odometry.rot_noise_per_rad);
-  require_non_negative("sensors.odometry.accel_noise_per_mps", s.odometry.accel_noise_per_mps);
-  require_non_negative("sensors.odometry.accel_rot_noise_per_rps",
-                       s.odometry.accel_rot_noise_per_rps);
+  core::require("sensors.odometry.rate_hz", s.odometry.rate_hz, core::positive());
+  core::require("sensors.odometry.trans_noise_per_m", s.odometry.trans_noise_per_m,
+                core::non_negative());
+  core::require("sensors.odometry.rot_noise_per_rad", s.odometry.rot_noise_per_rad,
+                core::non_negative());
+  core::require("sensors.odometry.accel_noise_per_mps", s.odometry.accel_noise_per_mps,
+                core::non_negative());
+  core::require("sensors.odometry.accel_rot_noise_per_rps", s.odometry.accel_rot_noise_per_rps,
+                core::non_negative());
 
-  require_positive("sensors.gyro.rate_hz", s.gyro.rate_hz);
-  require_non_negative("sensors.gyro.noise_std_rps", s.gyro.noise_std_rps);
-  require_finite("sensors.gyro.bias_rps", s.gyro.bias_rps);
+  core::require("sensors.gyro.rate_hz", s.gyro.rate_hz, core::positive());
+  core::require("sensors.gyro.noise_std_rps", s.gyro.noise_std_rps, core::non_negative());
+  core::require("sensors.gyro.bias_rps", s.gyro.bias_rps, core::finite());
 
-  require_positive("sensors.ir.rate_hz", s.ir.rate_hz);
-  require_positive("sensors.ir.range_m", s.ir.range_m);
-  require_non_negative("sensors.ir.noise_std_m", s.ir.noise_std_m);
-  require_positive("sensors.ir.threshold_m", s.ir.threshold_m);
+  core::require("sensors.ir.rate_hz", s.ir.rate_hz, core::positive());
+  core::require("sensors.ir.range_m", s.ir.range_m, core::positive());
+  core::require("sensors.ir.noise_std_m", s.ir.noise_std_m, core::non_negative());
+  core::require("sensors.ir.threshold_m", s.ir.threshold_m, core::positive());
   if (s.ir.threshold_m > s.ir.range_m) {
     fail("sensors.ir.threshold_m", "must be <= sensors.ir.range_m " + num(s.ir.range_m) + " (got " +
                                        num(s.ir.threshold_m) + ")");
   }
 
-  require_positive("sensors.optical.rate_hz", s.optical.rate_hz);
-  require_positive("sensors.optical.range_m", s.optical.range_m);
-  require_in("sensors.optical.miss_probability", s.optical.miss_probability, 0.0, 1.0);
+  core::require("sensors.optical.rate_hz", s.optical.rate_hz, core::positive());
+  core::require("sensors.optical.range_m", s.optical.range_m, core::positive());
+  core::require("sensors.optical.miss_probability", s.optical.miss_probability,
+                core::probability());
 
-  require_positive("sensors.ground_truth.rate_hz", s.ground_truth.rate_hz);
+  core::require("sensors.ground_truth.rate_hz", s.ground_truth.rate_hz, core::positive());
 
   const LaserConfig& l = s.laser;
   if (l.beams < 1 || l.beams > kMaxBeams) {
     fail("sensors.laser.beams",
          "must be in 1.." + std::to_string(kMaxBeams) + " (got " + std::to_string(l.beams) + ")");
   }
-  require_positive("sensors.laser.rate_hz", l.rate_hz);
-  require_non_negative("sensors.laser.min_range_m", l.min_range_m);
-  require_positive("sensors.laser.max_range_m", l.max_range_m);
+  core::require("sensors.laser.rate_hz", l.rate_hz, core::positive());
+  core::require("sensors.laser.min_range_m", l.min_range_m, core::non_negative());
+  core::require("sensors.laser.max_range_m", l.max_range_m, core::positive());
   if (!(l.min_range_m < l.max_range_m)) {
     fail("sensors.laser.min_range_m", "must be < sensors.laser.max_range_m " + num(l.max_range_m) +
                                           " (got " + num(l.min_range_m) + ")");
   }
-  require_non_negative("sensors.laser.noise_std_m", l.noise_std_m);
-  require_finite("sensors.laser.mount_x_m", l.mount_x_m);
-  require_finite("sensors.laser.mount_y_m", l.mount_y_m);
+  core::require("sensors.laser.noise_std_m", l.noise_std_m, core::non_negative());
+  core::require("sensors.laser.mount_x_m", l.mount_x_m, core::finite());
+  core::require("sensors.laser.mount_y_m", l.mount_y_m, core::finite());
 }
 
 void validate_physics(const PhysicsConfig& p) {
@@ -460,27 +445,14 @@ void WorldConfig::validate() const {
 
 namespace {
 
-/// Parent of a dotted path: "a.b[2].c" -> "a.b[2]" -> "a.b" -> "a" -> "".
-std::string parent_path(const std::string& path) {
-  const auto pos = path.find_last_of(".[");
-  return pos == std::string::npos ? std::string() : path.substr(0, pos);
-}
-
-bool is_name_char(char ch) {
-  return (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') ||
-         ch == '_';
-}
-
-/// Reads a document into a WorldConfig and remembers the node of every path it read, so that a
-/// validate() error ("devices.M4: ...") can be reported at the line the value came from.
+/// Reads a document into a WorldConfig; core::ConfigNode checks for unknown keys and puts the
+/// file:line on validate() errors.
 class Loader {
  public:
   explicit Loader(const ConfigNode& root) : root_(root) {}
 
   WorldConfig load(WorldConfig c) {
     root_.require_map();
-    root_.check_keys(
-        {"field", "devices", "puck", "pucks", "robot", "robots", "sensors", "physics"});
     read_field(c.field);
     read_devices(c);
     read_puck_model(c.puck);
@@ -489,56 +461,25 @@ class Loader {
     read_robots(c);
     read_sensors(c.sensors);
     read_physics(c.physics);
-    try {
-      c.validate();
-    } catch (const ConfigError& e) {
-      throw ConfigError(locate(e.what()).location() + ": " + e.what());
-    }
+    root_.no_other_keys();
+    root_.locate_errors([&] { c.validate(); });
     return c;
   }
 
  private:
-  void remember(const ConfigNode& n) { seen_.insert_or_assign(n.path(), n); }
-
-  /// The map under `key` (possibly undefined or null), with its keys checked.
-  ConfigNode section(const ConfigNode& parent, std::string_view key,
-                     std::initializer_list<std::string_view> allowed) {
+  /// The map under `key` (possibly undefined or null).
+  static ConfigNode section(const ConfigNode& parent, std::string_view key) {
     ConfigNode n = parent[key];
-    if (!n.defined()) return n;
     n.require_map();
-    n.check_keys(allowed);
-    remember(n);
     return n;
   }
-  /// An element of a list that must be a map with the given keys.
-  ConfigNode element(const ConfigNode& e, std::initializer_list<std::string_view> allowed,
-                     const char* what) {
+  /// An element of a list that must be a map.
+  static void element(const ConfigNode& e, const char* what) {
     if (!e.is_map()) e.fail(std::string("expected a map ") + what);
-    e.check_keys(allowed);
-    remember(e);
-    return e;
   }
 
-  void read(const ConfigNode& m, std::string_view key, double& out) {
-    if (ConfigNode n = m[key]; n.defined()) {
-      out = n.as_double();
-      remember(n);
-    }
-  }
-  void read(const ConfigNode& m, std::string_view key, int& out) {
-    if (ConfigNode n = m[key]; n.defined()) {
-      m.read(key, out);
-      remember(n);
-    }
-  }
-  void read(const ConfigNode& m, std::string_view key, bool& out) {
-    if (ConfigNode n = m[key]; n.defined()) {
-      out = n.as_bool();
-      remember(n);
-    }
-  }
   /// `ori` (radians) or `ori_deg` (degrees), normalised to (-pi, pi].
-  void read_orientation(const ConfigNode& m, double& theta) {
+  static void read_orientation(const ConfigNode& m, double& theta) {
     const ConfigNode rad = m["ori"];
     const ConfigNode deg = m["ori_deg"];
     if (rad.defined() && deg.defined()) {
@@ -546,26 +487,22 @@ class Loader {
     }
     if (rad.defined()) {
       theta = core::normalize_angle(rad.as_double());
-      remember(rad);
     } else if (deg.defined()) {
       theta = core::normalize_angle(core::deg_to_rad(deg.as_double()));
-      remember(deg);
     }
   }
 
   void read_field(FieldConfig& f) {
-    const ConfigNode n = section(root_, "field", {"width_m", "height_m", "wall_thickness_m"});
-    read(n, "width_m", f.width_m);
-    read(n, "height_m", f.height_m);
-    read(n, "wall_thickness_m", f.wall_thickness_m);
+    const ConfigNode n = section(root_, "field");
+    n.read("width_m", f.width_m);
+    n.read("height_m", f.height_m);
+    n.read("wall_thickness_m", f.wall_thickness_m);
+    n.no_other_keys();
   }
 
   void read_devices(WorldConfig& c) {
-    const ConfigNode devs = root_["devices"];
-    if (!devs.defined()) return;
-    devs.require_map();
-    remember(devs);
-    if (devs.is_null()) return;
+    const ConfigNode devs = section(root_, "devices");
+    if (!devs.is_map()) return;
     for (const std::string& name : devs.keys()) {
       const ConfigNode d = devs[name];
       const auto id = device_by_name(name);
@@ -573,205 +510,151 @@ class Loader {
         d.fail("unknown device '" + name + "' (expected one of M1..M10, R1, R2, TST, D1, D2, D3)");
       }
       d.require_map();
-      d.check_keys({"x", "y", "ori", "ori_deg", "body_depth_m", "body_width_m", "body_offset_m",
-                    "rfid_offset_m", "rfid_radius_m"});
-      remember(d);
       DeviceConfig& dev = c.devices[id->value()];
-      read(d, "x", dev.pose.x);
-      read(d, "y", dev.pose.y);
+      d.read("x", dev.pose.x);
+      d.read("y", dev.pose.y);
       read_orientation(d, dev.pose.theta);
-      read(d, "body_depth_m", dev.body_depth_m);
-      read(d, "body_width_m", dev.body_width_m);
-      read(d, "body_offset_m", dev.body_offset_m);
-      read(d, "rfid_offset_m", dev.rfid_offset_m);
-      read(d, "rfid_radius_m", dev.rfid_radius_m);
+      d.read("body_depth_m", dev.body_depth_m);
+      d.read("body_width_m", dev.body_width_m);
+      d.read("body_offset_m", dev.body_offset_m);
+      d.read("rfid_offset_m", dev.rfid_offset_m);
+      d.read("rfid_radius_m", dev.rfid_radius_m);
+      d.no_other_keys();
     }
   }
 
   void read_puck_model(PuckModelConfig& m) {
-    const ConfigNode n =
-        section(root_, "puck",
-                {"radius_m", "mass_kg", "floor_friction", "contact_friction", "restitution"});
-    read(n, "radius_m", m.radius_m);
-    read(n, "mass_kg", m.mass_kg);
-    read(n, "floor_friction", m.floor_friction);
-    read(n, "contact_friction", m.contact_friction);
-    read(n, "restitution", m.restitution);
+    const ConfigNode n = section(root_, "puck");
+    n.read("radius_m", m.radius_m);
+    n.read("mass_kg", m.mass_kg);
+    n.read("floor_friction", m.floor_friction);
+    n.read("contact_friction", m.contact_friction);
+    n.read("restitution", m.restitution);
+    n.no_other_keys();
   }
 
   void read_pucks(WorldConfig& c) {
     const ConfigNode list = root_["pucks"];
     if (!list.defined()) return;
-    remember(list);
     c.pucks.clear();  // the list replaces the base's; null or [] means no pucks
     if (list.is_null()) return;
     for (const ConfigNode& e : list.elements()) {
-      element(e, {"id", "x", "y"}, "{id, x, y}");
+      element(e, "{id, x, y}");
       PuckPlacement p;
       e.at("id");  // required keys: fail early with "missing required key"
       e.at("x");
       e.at("y");
-      read(e, "id", p.id);
-      read(e, "x", p.position.x());
-      read(e, "y", p.position.y());
+      e.read("id", p.id);
+      e.read("x", p.position.x());
+      e.read("y", p.position.y());
+      e.no_other_keys();
       c.pucks.push_back(p);
     }
   }
 
   void read_robot_model(RobotModelConfig& m) {
-    const ConfigNode n =
-        section(root_, "robot",
-                {"radius_m", "mass_kg", "max_speed_mps", "max_omega_rps", "max_accel_mps2",
-                 "max_alpha_rps2", "contact_friction", "holder"});
-    read(n, "radius_m", m.radius_m);
-    read(n, "mass_kg", m.mass_kg);
-    read(n, "max_speed_mps", m.max_speed_mps);
-    read(n, "max_omega_rps", m.max_omega_rps);
-    read(n, "max_accel_mps2", m.max_accel_mps2);
-    read(n, "max_alpha_rps2", m.max_alpha_rps2);
-    read(n, "contact_friction", m.contact_friction);
+    const ConfigNode n = section(root_, "robot");
+    n.read("radius_m", m.radius_m);
+    n.read("mass_kg", m.mass_kg);
+    n.read("max_speed_mps", m.max_speed_mps);
+    n.read("max_omega_rps", m.max_omega_rps);
+    n.read("max_accel_mps2", m.max_accel_mps2);
+    n.read("max_alpha_rps2", m.max_alpha_rps2);
+    n.read("contact_friction", m.contact_friction);
 
     HolderConfig& h = m.holder;
-    const ConfigNode hn = section(n, "holder",
-                                  {"mode", "inner_width_m", "arm_length_m", "arm_thickness_m",
-                                   "arm_friction", "release_backing_speed_mps"});
-    if (const ConfigNode mode = hn["mode"]; mode.defined()) {
-      const std::string s = mode.as_string();
-      if (s == "physical") {
-        h.mode = HolderMode::kPhysical;
-      } else if (s == "assisted") {
-        h.mode = HolderMode::kAssisted;
-      } else {
-        mode.fail("unknown holder mode '" + s + "' (expected one of: physical, assisted)");
-      }
-      remember(mode);
-    }
-    read(hn, "inner_width_m", h.inner_width_m);
-    read(hn, "arm_length_m", h.arm_length_m);
-    read(hn, "arm_thickness_m", h.arm_thickness_m);
-    read(hn, "arm_friction", h.arm_friction);
-    read(hn, "release_backing_speed_mps", h.release_backing_speed_mps);
+    const ConfigNode hn = section(n, "holder");
+    hn.read_enum("mode", h.mode,
+                 {{"physical", HolderMode::kPhysical}, {"assisted", HolderMode::kAssisted}},
+                 "holder mode");
+    hn.read("inner_width_m", h.inner_width_m);
+    hn.read("arm_length_m", h.arm_length_m);
+    hn.read("arm_thickness_m", h.arm_thickness_m);
+    hn.read("arm_friction", h.arm_friction);
+    hn.read("release_backing_speed_mps", h.release_backing_speed_mps);
+    hn.no_other_keys();
+    n.no_other_keys();
   }
 
   void read_robots(WorldConfig& c) {
     const ConfigNode list = root_["robots"];
     if (!list.defined()) return;
-    remember(list);
     c.robots.clear();  // the list replaces the base's; null or [] means no robots
     if (list.is_null()) return;
     for (const ConfigNode& e : list.elements()) {
-      element(e, {"name", "x", "y", "ori", "ori_deg", "jersey"}, "{name, x, y, ori_deg, jersey}");
+      element(e, "{name, x, y, ori_deg, jersey}");
       RobotStart r;
       r.name = e.at("name").as_string();
-      remember(e.at("name"));
-      e.at("x");
-      e.at("y");
-      read(e, "x", r.pose.x);
-      read(e, "y", r.pose.y);
+      r.pose.x = e.at("x").as_double();
+      r.pose.y = e.at("y").as_double();
       read_orientation(e, r.pose.theta);
-      if (e["jersey"].defined()) read(e, "jersey", r.jersey);
+      e.read("jersey", r.jersey);
+      e.no_other_keys();
       c.robots.push_back(std::move(r));
     }
   }
 
   void read_sensors(SensorsConfig& s) {
-    const ConfigNode n =
-        section(root_, "sensors", {"odometry", "gyro", "ir", "optical", "ground_truth", "laser"});
+    const ConfigNode n = section(root_, "sensors");
 
-    const ConfigNode odo = section(n, "odometry",
-                                   {"rate_hz", "trans_noise_per_m", "rot_noise_per_rad",
-                                    "accel_noise_per_mps", "accel_rot_noise_per_rps"});
-    read(odo, "rate_hz", s.odometry.rate_hz);
-    read(odo, "trans_noise_per_m", s.odometry.trans_noise_per_m);
-    read(odo, "rot_noise_per_rad", s.odometry.rot_noise_per_rad);
-    read(odo, "accel_noise_per_mps", s.odometry.accel_noise_per_mps);
-    read(odo, "accel_rot_noise_per_rps", s.odometry.accel_rot_noise_per_rps);
+    const ConfigNode odo = section(n, "odometry");
+    odo.read("rate_hz", s.odometry.rate_hz);
+    odo.read("trans_noise_per_m", s.odometry.trans_noise_per_m);
+    odo.read("rot_noise_per_rad", s.odometry.rot_noise_per_rad);
+    odo.read("accel_noise_per_mps", s.odometry.accel_noise_per_mps);
+    odo.read("accel_rot_noise_per_rps", s.odometry.accel_rot_noise_per_rps);
+    odo.no_other_keys();
 
-    const ConfigNode gyro = section(n, "gyro", {"rate_hz", "noise_std_rps", "bias_rps"});
-    read(gyro, "rate_hz", s.gyro.rate_hz);
-    read(gyro, "noise_std_rps", s.gyro.noise_std_rps);
-    read(gyro, "bias_rps", s.gyro.bias_rps);
+    const ConfigNode gyro = section(n, "gyro");
+    gyro.read("rate_hz", s.gyro.rate_hz);
+    gyro.read("noise_std_rps", s.gyro.noise_std_rps);
+    gyro.read("bias_rps", s.gyro.bias_rps);
+    gyro.no_other_keys();
 
-    const ConfigNode ir = section(n, "ir", {"rate_hz", "range_m", "noise_std_m", "threshold_m"});
-    read(ir, "rate_hz", s.ir.rate_hz);
-    read(ir, "range_m", s.ir.range_m);
-    read(ir, "noise_std_m", s.ir.noise_std_m);
-    read(ir, "threshold_m", s.ir.threshold_m);
+    const ConfigNode ir = section(n, "ir");
+    ir.read("rate_hz", s.ir.rate_hz);
+    ir.read("range_m", s.ir.range_m);
+    ir.read("noise_std_m", s.ir.noise_std_m);
+    ir.read("threshold_m", s.ir.threshold_m);
+    ir.no_other_keys();
 
-    const ConfigNode opt = section(n, "optical", {"rate_hz", "range_m", "miss_probability"});
-    read(opt, "rate_hz", s.optical.rate_hz);
-    read(opt, "range_m", s.optical.range_m);
-    read(opt, "miss_probability", s.optical.miss_probability);
+    const ConfigNode opt = section(n, "optical");
+    opt.read("rate_hz", s.optical.rate_hz);
+    opt.read("range_m", s.optical.range_m);
+    opt.read("miss_probability", s.optical.miss_probability);
+    opt.no_other_keys();
 
-    const ConfigNode gt = section(n, "ground_truth", {"rate_hz"});
-    read(gt, "rate_hz", s.ground_truth.rate_hz);
+    const ConfigNode gt = section(n, "ground_truth");
+    gt.read("rate_hz", s.ground_truth.rate_hz);
+    gt.no_other_keys();
 
-    const ConfigNode las = section(n, "laser",
-                                   {"enabled", "beams", "rate_hz", "min_range_m", "max_range_m",
-                                    "noise_std_m", "mount_x_m", "mount_y_m"});
-    read(las, "enabled", s.laser.enabled);
-    read(las, "beams", s.laser.beams);
-    read(las, "rate_hz", s.laser.rate_hz);
-    read(las, "min_range_m", s.laser.min_range_m);
-    read(las, "max_range_m", s.laser.max_range_m);
-    read(las, "noise_std_m", s.laser.noise_std_m);
-    read(las, "mount_x_m", s.laser.mount_x_m);
-    read(las, "mount_y_m", s.laser.mount_y_m);
+    const ConfigNode las = section(n, "laser");
+    las.read("enabled", s.laser.enabled);
+    las.read("beams", s.laser.beams);
+    las.read("rate_hz", s.laser.rate_hz);
+    las.read("min_range_m", s.laser.min_range_m);
+    las.read("max_range_m", s.laser.max_range_m);
+    las.read("noise_std_m", s.laser.noise_std_m);
+    las.read("mount_x_m", s.laser.mount_x_m);
+    las.read("mount_y_m", s.laser.mount_y_m);
+    las.no_other_keys();
+    n.no_other_keys();
   }
 
   void read_physics(PhysicsConfig& p) {
-    const ConfigNode n =
-        section(root_, "physics", {"step_ms", "velocity_iterations", "position_iterations"});
+    const ConfigNode n = section(root_, "physics");
     if (const ConfigNode step = n["step_ms"]; step.defined()) {
       const double ms = step.as_double();
       // Checked here too: a huge value would overflow the nanosecond conversion.
       if (!(ms > 0.0 && ms <= 100.0)) step.fail("must be > 0 and <= 100 (got " + num(ms) + ")");
       p.step = SimTime::from_seconds(ms / 1000.0);
-      remember(step);
     }
-    read(n, "velocity_iterations", p.velocity_iterations);
-    read(n, "position_iterations", p.position_iterations);
-  }
-
-  /// The node to report a validate() message at. The message starts with the field path; the
-  /// deepest node read at that path or an ancestor wins. If only an ancestor was read (e.g.
-  /// "devices.M4: footprint overlaps devices.M8" after moving M8), a path named later in the
-  /// message that was read exactly may be closer to the cause and wins if it is deeper. Only
-  /// path-like words (with a '.' or '[') count, so that "the field" does not match `field`.
-  /// Falls back to the document root.
-  const ConfigNode& locate(const std::string& message) const {
-    const std::string prefix = message.substr(0, message.find(": "));
-    const ConfigNode* best = nullptr;
-    std::size_t best_len = 0;
-    for (std::string p = prefix; !p.empty(); p = parent_path(p)) {
-      if (auto it = seen_.find(p); it != seen_.end()) {
-        if (p == prefix) return it->second;
-        best = &it->second;
-        best_len = p.size();
-        break;
-      }
-    }
-    const std::size_t rest = prefix.size();
-    for (const auto& [path, node] : seen_) {
-      if (path.size() <= best_len || path.find_first_of(".[") == std::string::npos) continue;
-      for (auto pos = message.find(path, rest); pos != std::string::npos;
-           pos = message.find(path, pos + 1)) {
-        const bool starts = pos == 0 || (!is_name_char(message[pos - 1]) &&
-                                         message[pos - 1] != '.' && message[pos - 1] != ']');
-        const std::size_t end = pos + path.size();
-        const bool ends = end == message.size() || !is_name_char(message[end]);
-        if (starts && ends) {
-          best = &node;
-          best_len = path.size();
-          break;
-        }
-      }
-    }
-    return best ? *best : root_;
+    n.read("velocity_iterations", p.velocity_iterations);
+    n.read("position_iterations", p.position_iterations);
+    n.no_other_keys();
   }
 
   ConfigNode root_;
-  std::map<std::string, ConfigNode> seen_;
 };
 
 }  // namespace
@@ -779,11 +662,7 @@ class Loader {
 WorldConfig load_world_config(const core::ConfigNode& node, WorldConfig base) {
   if (!node.defined() || node.is_null()) {
     // An empty document: the base unchanged (still checked, it may come from elsewhere).
-    try {
-      base.validate();
-    } catch (const ConfigError& e) {
-      throw ConfigError(node.location() + ": " + e.what());
-    }
+    node.locate_errors([&] { base.validate(); });
     return base;
   }
   return Loader(node).load(std::move(base));

@@ -61,8 +61,6 @@ void SkillEngineConfig::validate() const {
 
 SkillEngineConfig SkillEngineConfig::from_config(const core::ConfigNode& node) {
   node.require_map();
-  node.check_keys({"skill_dirs", "rate_hz", "instruction_budget", "memory_limit_bytes",
-                   "hot_reload", "random_seed"});
   SkillEngineConfig cfg;
   const core::ConfigNode dirs = node["skill_dirs"];
   if (dirs.defined()) {
@@ -76,6 +74,7 @@ SkillEngineConfig SkillEngineConfig::from_config(const core::ConfigNode& node) {
   std::int64_t seed = 0;
   node.read("random_seed", seed);
   cfg.random_seed = static_cast<std::uint64_t>(seed);
+  node.no_other_keys();
   try {
     cfg.validate();
   } catch (const core::ConfigError& e) {

@@ -108,8 +108,6 @@ Lights read_light_code(const ConfigNode& v) {
 
 GameParams read_params(const ConfigNode& n) {
   n.require_map();
-  n.check_keys({"machine_types", "proc_time_s", "light_codes", "order_quantities",
-                "late_order_start_s", "down_times", "gate_schedule"});
   GameParams p;
   const ConfigNode types = n.at("machine_types");
   types.require_map();
@@ -124,14 +122,14 @@ GameParams read_params(const ConfigNode& n) {
     p.machine_types[i] = *t;
   }
   const ConfigNode proc = n.at("proc_time_s");
-  proc.check_keys({"T1", "T2", "T3", "T4", "T5"});
   const ConfigNode codes = n.at("light_codes");
-  codes.check_keys({"T1", "T2", "T3", "T4", "T5"});
   for (int t = 0; t < 5; ++t) {
     const std::string key{'T', static_cast<char>('1' + t)};
     p.proc_time_s[t] = read_int(proc.at(key));
     p.light_codes[t] = read_light_code(codes.at(key));
   }
+  proc.no_other_keys();
+  codes.no_other_keys();
   const ConfigNode q = n.at("order_quantities");
   if (!q.is_sequence() || q.size() != kRegularOrderCount) q.fail("expected a list of 9 integers");
   for (int i = 0; i < kRegularOrderCount; ++i) p.order_quantities[i] = read_int(q.at(i));
@@ -142,44 +140,18 @@ GameParams read_params(const ConfigNode& n) {
   for (int i = 0; i < kLateOrderCount; ++i) p.late_order_start_s[i] = read_int(late.at(i));
   for (const ConfigNode& e : n.at("down_times").elements()) {
     e.require_map();
-    e.check_keys({"machine", "start_s", "end_s"});
     p.down_times.push_back(
         DownTime{read_device(e.at("machine")), read_int(e.at("start_s")), read_int(e.at("end_s"))});
+    e.no_other_keys();
   }
   for (const ConfigNode& e : n.at("gate_schedule").elements()) {
     e.require_map();
-    e.check_keys({"gate", "start_s", "end_s"});
     p.gate_schedule.push_back(
         GatePeriod{read_device(e.at("gate")), read_int(e.at("start_s")), read_int(e.at("end_s"))});
+    e.no_other_keys();
   }
+  n.no_other_keys();
   return p;
-}
-
-/// The node a relative field path ("params.down_times[2].end_s") points at, as deep as it exists.
-ConfigNode resolve(const ConfigNode& root, const std::string& field) {
-  ConfigNode n = root;
-  std::size_t pos = 0;
-  while (pos < field.size()) {
-    std::size_t end = field.find_first_of(".[", pos);
-    if (end == std::string::npos) end = field.size();
-    ConfigNode next;
-    if (end > pos) {
-      if (!n.is_map()) break;
-      next = n[field.substr(pos, end - pos)];
-    } else if (field[pos] == '[') {
-      const std::size_t close = field.find(']', pos);
-      if (close == std::string::npos || !n.is_sequence()) break;
-      const int idx = std::stoi(field.substr(pos + 1, close - pos - 1));
-      if (idx >= n.size()) break;
-      next = n.at(idx);
-      end = close + 1;
-    }
-    if (!next.defined()) break;
-    n = next;
-    pos = end;
-    if (pos < field.size() && field[pos] == '.') ++pos;
-  }
-  return n;
 }
 
 }  // namespace
@@ -217,9 +189,6 @@ RefboxConfig load_refbox_config(const ConfigNode& node) {
     c.validate();
     return c;
   }
-  node.check_keys({"rules", "team", "skip_setup", "setup_s", "exploration_s", "production_s",
-                   "pucks", "learn_unknown_pucks", "params", "mode", "overtime_s",
-                   "recycle_points"});
   node.read("rules", c.rules);
   if (node["recycle_points"].defined()) {
     const std::int64_t v = node["recycle_points"].as_int();
@@ -246,12 +215,9 @@ RefboxConfig load_refbox_config(const ConfigNode& node) {
   }
   c.overtime_duration = read_seconds(node, "overtime_s", c.overtime_duration);
   if (node["params"].defined() && !node["params"].is_null()) c.params = read_params(node["params"]);
-  check_config(c, [&](const std::string& field, const std::string& reason) {
-    const ConfigNode n = resolve(node, field);
-    const bool exact = n.path().size() >= field.size() &&
-                       n.path().compare(n.path().size() - field.size(), field.size(), field) == 0;
-    n.fail(exact ? reason : field + ": " + reason);
-  });
+  node.no_other_keys();
+  check_config(
+      c, [&](const std::string& field, const std::string& reason) { node.fail_at(field, reason); });
   return c;
 }
 

@@ -2,7 +2,6 @@
 #include "llsf/sim/game_config.h"
 
 #include <cmath>
-#include <sstream>
 
 #include "llsf/core/error.h"
 #include "llsf/core/geometry.h"
@@ -15,22 +14,11 @@ namespace {
   throw core::ConfigError("game." + field + ": " + reason);
 }
 
-std::string num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
+std::string num(double v) { return core::number_text(v); }
 
-void positive(const std::string& field, double v) {
-  if (!(v > 0.0) || !std::isfinite(v)) fail(field, "must be > 0 (got " + num(v) + ")");
-}
-
-void non_negative(const std::string& field, double v) {
-  if (!(v >= 0.0) || !std::isfinite(v)) fail(field, "must be >= 0 (got " + num(v) + ")");
-}
-
-void probability(const std::string& field, double v) {
-  if (!(v >= 0.0 && v <= 1.0)) fail(field, "must be in [0, 1] (got " + num(v) + ")");
+/// `value` of the game field `field` (named without the "game." prefix) within `bound`.
+void require_game(const std::string& field, double value, const core::Bound& bound) {
+  core::require("game." + field, value, bound);
 }
 
 void angle(const std::string& field, double v) {
@@ -56,12 +44,9 @@ void GameConfig::validate() const {
   const LocalizationConfig& l = levels.localization;
   if (l.correction_period <= SimTime())
     fail("levels.localization.correction_period", "must be > 0");
-  if (!(l.correction_gain > 0.0 && l.correction_gain <= 1.0)) {
-    fail("levels.localization.correction_gain",
-         "must be in (0, 1] (got " + num(l.correction_gain) + ")");
-  }
-  non_negative("levels.localization.position_noise_m", l.position_noise_m);
-  non_negative("levels.localization.heading_noise_rad", l.heading_noise_rad);
+  require_game("levels.localization.correction_gain", l.correction_gain, core::fraction());
+  require_game("levels.localization.position_noise_m", l.position_noise_m, core::non_negative());
+  require_game("levels.localization.heading_noise_rad", l.heading_noise_rad, core::non_negative());
   // Symbolic skill level.
   if (!(levels.symbolic.cruise_speed_mps > 0.0)) {
     fail("levels.symbolic.cruise_speed_mps", "must be > 0");
@@ -69,23 +54,23 @@ void GameConfig::validate() const {
   if (!(levels.symbolic.turn_rate_rps > 0.0)) fail("levels.symbolic.turn_rate_rps", "must be > 0");
   // Light detection.
   const LightDetectionConfig& li = levels.light;
-  positive("levels.light.range_m", li.range_m);
+  require_game("levels.light.range_m", li.range_m, core::positive());
   angle("levels.light.half_angle_rad", li.half_angle_rad);
   angle("levels.light.facing_half_angle_rad", li.facing_half_angle_rad);
-  positive("levels.light.frame_rate_hz", li.frame_rate_hz);
+  require_game("levels.light.frame_rate_hz", li.frame_rate_hz, core::positive());
   if (li.delay < SimTime()) fail("levels.light.delay", "must be >= 0");
   if (li.delay > SimTime::from_sec(60)) fail("levels.light.delay", "must be at most 60 s");
-  probability("levels.light.error_rate", li.error_rate);
+  require_game("levels.light.error_rate", li.error_rate, core::probability());
   // Puck detection.
   const PuckDetectionConfig& p = levels.puck;
-  positive("levels.puck.range_m", p.range_m);
-  positive("levels.puck.vision_range_m", p.vision_range_m);
+  require_game("levels.puck.range_m", p.range_m, core::positive());
+  require_game("levels.puck.vision_range_m", p.vision_range_m, core::positive());
   angle("levels.puck.half_angle_rad", p.half_angle_rad);
-  non_negative("levels.puck.merge_distance_m", p.merge_distance_m);
-  positive("levels.puck.frame_rate_hz", p.frame_rate_hz);
+  require_game("levels.puck.merge_distance_m", p.merge_distance_m, core::non_negative());
+  require_game("levels.puck.frame_rate_hz", p.frame_rate_hz, core::positive());
   // Rates.
-  positive("skill_rate_hz", skill_rate_hz);
-  positive("agent_rate_hz", agent_rate_hz);
+  require_game("skill_rate_hz", skill_rate_hz, core::positive());
+  require_game("agent_rate_hz", agent_rate_hz, core::positive());
   if (beacon_period <= SimTime()) fail("beacon_period", "must be > 0");
   const double physics_hz = 1e9 / static_cast<double>(world.physics.step.ns());
   if (world.physics.step > SimTime() && skill_rate_hz > physics_hz) {
@@ -97,14 +82,14 @@ void GameConfig::validate() const {
                               num(agent_rate_hz) + ")");
   }
   // Handling (robot profiles).
-  non_negative("handling.align_s", handling.align_s);
+  require_game("handling.align_s", handling.align_s, core::non_negative());
   if (handling.align_s > 60.0) fail("handling.align_s", "must be at most 60 s");
-  non_negative("handling.motor_max_speed_mps", handling.motor_max_speed_mps);
-  non_negative("handling.motor_max_omega_rps", handling.motor_max_omega_rps);
-  probability("handling.jam_probability", handling.jam_probability);
-  non_negative("handling.jam_zone_m", handling.jam_zone_m);
-  non_negative("handling.jam_recovery_s", handling.jam_recovery_s);
-  non_negative("handling.align_min_drive_m", handling.align_min_drive_m);
+  require_game("handling.motor_max_speed_mps", handling.motor_max_speed_mps, core::non_negative());
+  require_game("handling.motor_max_omega_rps", handling.motor_max_omega_rps, core::non_negative());
+  require_game("handling.jam_probability", handling.jam_probability, core::probability());
+  require_game("handling.jam_zone_m", handling.jam_zone_m, core::non_negative());
+  require_game("handling.jam_recovery_s", handling.jam_recovery_s, core::non_negative());
+  require_game("handling.align_min_drive_m", handling.align_min_drive_m, core::non_negative());
   // The modules' own configs.
   world.validate();
   refbox.validate();

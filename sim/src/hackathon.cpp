@@ -17,14 +17,15 @@ using core::Vec2;
 using kinematic::ObstacleConfig;
 using kinematic::Rect;
 
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%g", v);
-  return buf;
-}
+std::string num(double v) { return core::number_text(v); }
 
 [[noreturn]] void fail(const std::string& path, const std::string& why) {
   throw core::ConfigError("hackathon." + path + ": " + why);
+}
+
+/// `value` of the hackathon field `path` (without the "hackathon." prefix) within `bound`.
+void require_hackathon(const std::string& path, double value, const core::Bound& bound) {
+  core::require("hackathon." + path, value, bound);
 }
 
 /// Distance from point `p` to the box (0 inside).
@@ -83,7 +84,7 @@ void HackathonConfig::validate(const kinematic::WorldConfig& world) const {
                                std::pair{"safe_area.y_min", safe_area.lo.y()},
                                std::pair{"safe_area.x_max", safe_area.hi.x()},
                                std::pair{"safe_area.y_max", safe_area.hi.y()}}) {
-    if (!std::isfinite(v)) fail(key, "must be a finite number (got " + num(v) + ")");
+    require_hackathon(key, v, core::finite());
   }
   if (!(safe_area.hi.x() - safe_area.lo.x() >= 0.1))
     fail("safe_area.x_max", "must be at least 0.1 m greater than x_min");
@@ -151,32 +152,24 @@ void HackathonConfig::validate(const kinematic::WorldConfig& world) const {
   if (pucks == 0) fail("colours", "no pucks: every count is 0");
 
   // Numbers.
-  if (!(puck_clearance_m >= 0.0) || !std::isfinite(puck_clearance_m))
-    fail("puck_clearance_m", "must be >= 0 (got " + num(puck_clearance_m) + ")");
+  require_hackathon("puck_clearance_m", puck_clearance_m, core::non_negative());
   if (!(puck_spacing_m >= 2.0 * world.puck.radius_m) || !std::isfinite(puck_spacing_m)) {
     fail("puck_spacing_m", "must be >= the puck diameter " + num(2.0 * world.puck.radius_m) +
                                " (got " + num(puck_spacing_m) + ")");
   }
-  if (points_per_puck < 0)
-    fail("points_per_puck", "must be >= 0 (got " + std::to_string(points_per_puck) + ")");
-  if (decoy_penalty < 0)
-    fail("decoy_penalty", "must be >= 0 (got " + std::to_string(decoy_penalty) + ")");
+  require_hackathon("points_per_puck", points_per_puck, core::non_negative());
+  require_hackathon("decoy_penalty", decoy_penalty, core::non_negative());
 
   // Camera.
   const ColourCameraConfig& cam = camera;
-  if (!(cam.range_m > 0.0) || !std::isfinite(cam.range_m))
-    fail("camera.range_m", "must be > 0 (got " + num(cam.range_m) + ")");
+  require_hackathon("camera.range_m", cam.range_m, core::positive());
   if (!(cam.fov_rad > 0.0 && cam.fov_rad <= 2.0 * core::kPi))
     fail("camera.fov_deg",
          "must be in (0, 360] (got " + num(cam.fov_rad * 180.0 / core::kPi) + ")");
-  if (!(cam.frame_rate_hz > 0.0) || !std::isfinite(cam.frame_rate_hz))
-    fail("camera.frame_rate_hz", "must be > 0 (got " + num(cam.frame_rate_hz) + ")");
-  if (!(cam.miss_rate >= 0.0 && cam.miss_rate <= 1.0))
-    fail("camera.miss_rate", "must be in [0, 1] (got " + num(cam.miss_rate) + ")");
-  if (!(cam.false_colour_rate >= 0.0 && cam.false_colour_rate <= 1.0))
-    fail("camera.false_colour_rate", "must be in [0, 1] (got " + num(cam.false_colour_rate) + ")");
-  if (!(cam.position_noise_m >= 0.0) || !std::isfinite(cam.position_noise_m))
-    fail("camera.position_noise_m", "must be >= 0 (got " + num(cam.position_noise_m) + ")");
+  require_hackathon("camera.frame_rate_hz", cam.frame_rate_hz, core::positive());
+  require_hackathon("camera.miss_rate", cam.miss_rate, core::probability());
+  require_hackathon("camera.false_colour_rate", cam.false_colour_rate, core::probability());
+  require_hackathon("camera.position_noise_m", cam.position_noise_m, core::non_negative());
 }
 
 // --- layout ------------------------------------------------------------------------------------
@@ -285,164 +278,105 @@ HackathonScore score_hackathon(const HackathonConfig& config, const HackathonLay
 
 namespace {
 
-/// Reads the map and remembers the node of every path, so that a validate() error can be
-/// reported at the line of the value it names.
-class HackathonLoader {
- public:
-  HackathonConfig load(const core::ConfigNode& n, const kinematic::WorldConfig& world) {
-    HackathonConfig c;
-    remember("", n);
-    if (n.defined() && !n.is_null()) {
-      n.require_map();
-      n.check_keys({"safe_area", "safe_place", "obstacles", "colours", "puck_clearance_m",
-                    "puck_spacing_m", "points_per_puck", "decoy_penalty", "camera"});
-      read_safe_area(n["safe_area"], c.safe_area);
-      if (n["safe_place"].defined()) c.safe_place = value(n, "safe_place").as_string();
-      read_obstacles(n["obstacles"], c.obstacles);
-      read_colours(n["colours"], c.colours);
-      number(n, "puck_clearance_m", "puck_clearance_m", c.puck_clearance_m);
-      number(n, "puck_spacing_m", "puck_spacing_m", c.puck_spacing_m);
-      integer(n, "points_per_puck", "points_per_puck", c.points_per_puck);
-      integer(n, "decoy_penalty", "decoy_penalty", c.decoy_penalty);
-      read_camera(n["camera"], c.camera);
-    }
-    try {
-      c.validate(world);
-    } catch (const core::ConfigError& e) {
-      fail_at(e.what());
-    }
-    return c;
+void read_int(const core::ConfigNode& m, const std::string& key, int& out) {
+  if (const core::ConfigNode v = m[key]; v.defined()) {
+    const std::int64_t x = v.as_int();
+    if (x < -1000000 || x > 1000000) v.fail("out of range");
+    out = static_cast<int>(x);
   }
+}
 
- private:
-  void remember(const std::string& path, const core::ConfigNode& n) {
-    if (n.defined()) seen_.insert_or_assign(path, n);
-  }
-  core::ConfigNode value(const core::ConfigNode& m, const std::string& key,
-                         const std::string& path = "") {
-    const core::ConfigNode v = m[key];
-    remember(path.empty() ? key : path, v);
-    return v;
-  }
-  void number(const core::ConfigNode& m, const std::string& key, const std::string& path,
-              double& out) {
-    if (m[key].defined()) out = value(m, key, path).as_double();
-  }
-  void integer(const core::ConfigNode& m, const std::string& key, const std::string& path,
-               int& out) {
-    if (!m[key].defined()) return;
-    const std::int64_t v = value(m, key, path).as_int();
-    if (v < -1000000 || v > 1000000) m[key].fail("out of range");
-    out = static_cast<int>(v);
-  }
+void read_safe_area(const core::ConfigNode& n, Rect& r) {
+  if (!n.defined()) return;
+  n.require_map();
+  double x0 = r.lo.x(), y0 = r.lo.y(), x1 = r.hi.x(), y1 = r.hi.y();
+  n.read("x_min", x0);
+  n.read("y_min", y0);
+  n.read("x_max", x1);
+  n.read("y_max", y1);
+  n.no_other_keys();
+  r = Rect{{x0, y0}, {x1, y1}};
+}
 
-  void read_safe_area(const core::ConfigNode& n, Rect& r) {
-    if (!n.defined()) return;
-    n.require_map();
-    n.check_keys({"x_min", "y_min", "x_max", "y_max"});
-    remember("safe_area", n);
-    double x0 = r.lo.x(), y0 = r.lo.y(), x1 = r.hi.x(), y1 = r.hi.y();
-    number(n, "x_min", "safe_area.x_min", x0);
-    number(n, "y_min", "safe_area.y_min", y0);
-    number(n, "x_max", "safe_area.x_max", x1);
-    number(n, "y_max", "safe_area.y_max", y1);
-    r = Rect{{x0, y0}, {x1, y1}};
+void read_obstacles(const core::ConfigNode& n, std::vector<ObstacleConfig>& out) {
+  if (!n.defined()) return;
+  out.clear();  // a given list replaces the default
+  if (n.is_null()) return;
+  if (!n.is_sequence()) n.fail("expected a list of {name, x, y, size_x_m, size_y_m, ori_deg}");
+  for (int i = 0; i < n.size(); ++i) {
+    const core::ConfigNode e = n.at(i);
+    if (!e.is_map()) e.fail("expected a map {name, x, y, size_x_m, size_y_m, ori_deg}");
+    ObstacleConfig o;
+    o.name = "box" + std::to_string(i + 1);
+    e.read("name", o.name);
+    o.pose.x = e.at("x").as_double();  // at(): required, "missing key" at the element
+    o.pose.y = e.at("y").as_double();
+    o.size_x_m = e.at("size_x_m").as_double();
+    o.size_y_m = e.at("size_y_m").as_double();
+    double deg = 0.0;
+    e.read("ori_deg", deg);
+    o.pose.theta = core::normalize_angle(deg * core::kPi / 180.0);
+    e.no_other_keys();
+    out.push_back(std::move(o));
   }
+}
 
-  void read_obstacles(const core::ConfigNode& n, std::vector<ObstacleConfig>& out) {
-    if (!n.defined()) return;
-    out.clear();  // a given list replaces the default
-    if (n.is_null()) return;
-    if (!n.is_sequence()) n.fail("expected a list of {name, x, y, size_x_m, size_y_m, ori_deg}");
-    remember("obstacles", n);
-    for (int i = 0; i < n.size(); ++i) {
-      const core::ConfigNode e = n.at(i);
-      if (!e.is_map()) e.fail("expected a map {name, x, y, size_x_m, size_y_m, ori_deg}");
-      e.check_keys({"name", "x", "y", "size_x_m", "size_y_m", "ori_deg"});
-      const std::string p = indexed("obstacles", static_cast<std::size_t>(i));
-      remember(p, e);
-      ObstacleConfig o;
-      o.name = e["name"].defined() ? value(e, "name", p + ".name").as_string()
-                                   : "box" + std::to_string(i + 1);
-      auto required = [&](const char* key) {
-        static_cast<void>(e.at(key));  // throws "missing key" at the element
-        return value(e, key, p + "." + key).as_double();
-      };
-      o.pose.x = required("x");
-      o.pose.y = required("y");
-      o.size_x_m = required("size_x_m");
-      o.size_y_m = required("size_y_m");
-      double deg = 0.0;
-      number(e, "ori_deg", p + ".ori", deg);
-      o.pose.theta = core::normalize_angle(deg * core::kPi / 180.0);
-      out.push_back(std::move(o));
-    }
+void read_colours(const core::ConfigNode& n, std::vector<HackathonColour>& out) {
+  if (!n.defined()) return;
+  if (!n.is_sequence()) n.fail("expected a list of {name, count, decoy}");
+  out.clear();
+  for (int i = 0; i < n.size(); ++i) {
+    const core::ConfigNode e = n.at(i);
+    if (!e.is_map()) e.fail("expected a map {name, count, decoy}");
+    HackathonColour c;
+    c.name = e.at("name").as_string();
+    read_int(e, "count", c.count);
+    e.read("decoy", c.decoy);
+    e.no_other_keys();
+    out.push_back(std::move(c));
   }
+}
 
-  void read_colours(const core::ConfigNode& n, std::vector<HackathonColour>& out) {
-    if (!n.defined()) return;
-    if (!n.is_sequence()) n.fail("expected a list of {name, count, decoy}");
-    remember("colours", n);
-    out.clear();
-    for (int i = 0; i < n.size(); ++i) {
-      const core::ConfigNode e = n.at(i);
-      if (!e.is_map()) e.fail("expected a map {name, count, decoy}");
-      e.check_keys({"name", "count", "decoy"});
-      const std::string p = indexed("colours", static_cast<std::size_t>(i));
-      remember(p, e);
-      HackathonColour c;
-      static_cast<void>(e.at("name"));  // required
-      c.name = value(e, "name", p + ".name").as_string();
-      integer(e, "count", p + ".count", c.count);
-      if (e["decoy"].defined()) c.decoy = value(e, "decoy", p + ".decoy").as_bool();
-      out.push_back(std::move(c));
-    }
-  }
-
-  void read_camera(const core::ConfigNode& n, ColourCameraConfig& c) {
-    if (!n.defined()) return;
-    n.require_map();
-    n.check_keys({"range_m", "fov_deg", "frame_rate_hz", "miss_rate", "false_colour_rate",
-                  "position_noise_m"});
-    remember("camera", n);
-    number(n, "range_m", "camera.range_m", c.range_m);
-    if (n["fov_deg"].defined()) {
-      c.fov_rad = value(n, "fov_deg", "camera.fov_deg").as_double() * core::kPi / 180.0;
-    }
-    number(n, "frame_rate_hz", "camera.frame_rate_hz", c.frame_rate_hz);
-    number(n, "miss_rate", "camera.miss_rate", c.miss_rate);
-    number(n, "false_colour_rate", "camera.false_colour_rate", c.false_colour_rate);
-    number(n, "position_noise_m", "camera.position_noise_m", c.position_noise_m);
-  }
-
-  /// Re-throws a validate() error ("hackathon.obstacles[1].x: reason") at the line of the node
-  /// of its path, or of its nearest parent (then the full path stays in the reason).
-  [[noreturn]] void fail_at(const std::string& message) const {
-    const auto colon = message.find(": ");
-    std::string path = message.substr(0, colon);
-    const std::string reason = colon == std::string::npos ? message : message.substr(colon + 2);
-    if (path.rfind("hackathon.", 0) == 0) path = path.substr(10);
-    bool exact = true;
-    while (true) {
-      if (const auto it = seen_.find(path); it != seen_.end()) {
-        it->second.fail(exact ? reason : message);
-      }
-      if (path.empty()) break;
-      const auto pos = path.find_last_of(".[");
-      path = pos == std::string::npos ? std::string() : path.substr(0, pos);
-      exact = false;
-    }
-    seen_.at("").fail(message);
-  }
-
-  std::map<std::string, core::ConfigNode> seen_;
-};
+void read_camera(const core::ConfigNode& n, ColourCameraConfig& c) {
+  if (!n.defined()) return;
+  n.require_map();
+  n.read("range_m", c.range_m);
+  if (n["fov_deg"].defined()) c.fov_rad = n["fov_deg"].as_double() * core::kPi / 180.0;
+  n.read("frame_rate_hz", c.frame_rate_hz);
+  n.read("miss_rate", c.miss_rate);
+  n.read("false_colour_rate", c.false_colour_rate);
+  n.read("position_noise_m", c.position_noise_m);
+  n.no_other_keys();
+}
 
 }  // namespace
 
 HackathonConfig load_hackathon_config(const core::ConfigNode& node,
                                       const kinematic::WorldConfig& world) {
-  return HackathonLoader().load(node, world);
+  HackathonConfig c;
+  const core::ConfigNode& n = node;
+  if (n.defined() && !n.is_null()) {
+    n.require_map();
+    read_safe_area(n["safe_area"], c.safe_area);
+    n.read("safe_place", c.safe_place);
+    read_obstacles(n["obstacles"], c.obstacles);
+    read_colours(n["colours"], c.colours);
+    n.read("puck_clearance_m", c.puck_clearance_m);
+    n.read("puck_spacing_m", c.puck_spacing_m);
+    read_int(n, "points_per_puck", c.points_per_puck);
+    read_int(n, "decoy_penalty", c.decoy_penalty);
+    read_camera(n["camera"], c.camera);
+    n.no_other_keys();
+  }
+  try {
+    c.validate(world);
+  } catch (const core::ConfigError& e) {
+    // validate() names fields "hackathon.<path>"; the path is relative to this map.
+    const std::string what = e.what();
+    const std::string prefix = "hackathon.";
+    n.relocate(core::ConfigError(what.rfind(prefix, 0) == 0 ? what.substr(prefix.size()) : what));
+  }
+  return c;
 }
 
 }  // namespace llsf::sim

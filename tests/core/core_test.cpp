@@ -188,8 +188,11 @@ TEST_CASE("config nodes report file, line and path") {
     CHECK(std::string(e.what()).find("test.yaml:7:") == 0);
     CHECK(std::string(e.what()).find("list[1].x") != std::string::npos);
   }
-  CHECK_THROWS_WITH_AS(root["robot"].check_keys({"radius_m", "name"}),
-                       doctest::Contains("unknown key 'speed'"), ConfigError);
+  const ConfigNode fresh = ConfigNode::parse(text, "test.yaml")["robot"];
+  static_cast<void>(fresh["radius_m"]);
+  static_cast<void>(fresh["name"]);
+  CHECK_THROWS_WITH_AS(fresh.no_other_keys(), doctest::Contains("unknown key 'speed'"),
+                       ConfigError);
   CHECK_THROWS_WITH_AS(root.at("nothing"), doctest::Contains("missing required key 'nothing'"),
                        ConfigError);
   CHECK_THROWS_WITH_AS(ConfigNode::parse("a: [1, 2\n", "bad.yaml"), doctest::Contains("bad.yaml:"),
@@ -226,4 +229,81 @@ TEST_CASE("ConfigNode::set replaces a value by a node that keeps its own locatio
     CHECK(std::string(e.what()).find("radio.loss") != std::string::npos);
   }
   CHECK_THROWS_AS(root.set("a..b", two), ConfigError);
+}
+
+TEST_CASE("ConfigNode::no_other_keys reports the first key no loader asked for, with a hint") {
+  using llsf::core::ConfigError;
+  using llsf::core::ConfigNode;
+  const ConfigNode root = ConfigNode::parse(
+      "robot:\n"
+      "  radius_m: 0.2\n"
+      "  max_sped_mps: 1\n"
+      "  colour: red\n",
+      "w.yaml");
+  const ConfigNode robot = root["robot"];
+  double r = 0.0;
+  double v = 0.0;
+  robot.read("radius_m", r);
+  robot.read("max_speed_mps", v);  // asked for, absent: a known key all the same
+  CHECK_THROWS_WITH_AS(robot.no_other_keys(),
+                       "w.yaml:3:17: robot.max_sped_mps: unknown key 'max_sped_mps' (did you mean "
+                       "'max_speed_mps'?)",
+                       ConfigError);
+  robot.read("max_sped_mps", v);
+  CHECK_THROWS_WITH_AS(robot.no_other_keys(),
+                       "w.yaml:4:11: robot.colour: unknown key 'colour' (allowed: radius_m, "
+                       "max_speed_mps, max_sped_mps)",
+                       ConfigError);
+  std::string colour;
+  robot.read("colour", colour);
+  CHECK_NOTHROW(robot.no_other_keys());  // every key read once: nothing to report
+  CHECK_NOTHROW(root.no_other_keys());   // `robot` was asked for
+  CHECK_NOTHROW(root["absent"].no_other_keys());
+  CHECK(r == 0.2);
+}
+
+TEST_CASE("validated reads and require() share one wording; loaders add file:line") {
+  using llsf::core::ConfigError;
+  using llsf::core::ConfigNode;
+  namespace core = llsf::core;
+  const ConfigNode root = ConfigNode::parse(
+      "puck:\n"
+      "  radius_m: -1\n"
+      "  restitution: 1.5\n"
+      "  beams: 0\n"
+      "  mode: wobbly\n",
+      "p.yaml");
+  const ConfigNode puck = root["puck"];
+  double r = 0.0;
+  int beams = 1;
+  CHECK_THROWS_WITH_AS(puck.read("radius_m", r, core::positive()),
+                       "p.yaml:2:13: puck.radius_m: must be > 0 (got -1)", ConfigError);
+  CHECK_THROWS_WITH_AS(puck.read("restitution", r, core::probability()),
+                       "p.yaml:3:16: puck.restitution: must be in [0, 1] (got 1.5)", ConfigError);
+  CHECK_THROWS_WITH_AS(puck.read("beams", beams, core::in_range(1, 100)),
+                       "p.yaml:4:10: puck.beams: must be in [1, 100] (got 0)", ConfigError);
+  CHECK(beams == 1);
+  enum class Mode { kA, kB };
+  Mode m = Mode::kA;
+  CHECK_THROWS_WITH_AS(
+      puck.read_enum("mode", m, {{"physical", Mode::kA}, {"assisted", Mode::kB}}, "holder mode"),
+      "p.yaml:5:9: puck.mode: unknown holder mode 'wobbly' (expected one of: "
+      "physical, assisted)",
+      ConfigError);
+  CHECK_THROWS_WITH_AS(core::require("puck.radius_m", -1.0, core::positive()),
+                       "puck.radius_m: must be > 0 (got -1)", ConfigError);
+  CHECK_THROWS_WITH_AS(core::require("x", 0.0, core::fraction()), "x: must be in (0, 1] (got 0)",
+                       ConfigError);
+  CHECK_NOTHROW(core::require("x", 0.5, core::fraction()));
+  CHECK_THROWS_WITH_AS(core::require("p", 70000, core::port()),
+                       "p: must be a port in [0, 65535] (got 70000)", ConfigError);
+  // A validate() error on a struct gets the location of the value it names.
+  CHECK_THROWS_WITH_AS(
+      root.locate_errors([] { core::require("puck.restitution", 1.5, core::probability()); }),
+      "p.yaml:3:16: puck.restitution: must be in [0, 1] (got 1.5)", ConfigError);
+  // Not in the file: the nearest ancestor that is, or a deeper path the message names.
+  CHECK_THROWS_WITH_AS(root.fail_at("puck.mass_kg", "must be > 0"),
+                       "p.yaml:2:3: puck.mass_kg: must be > 0", ConfigError);
+  CHECK_THROWS_WITH_AS(root.fail_at("robot", "overlaps puck.beams"),
+                       "p.yaml:4:10: robot: overlaps puck.beams", ConfigError);
 }
