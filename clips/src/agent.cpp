@@ -3,10 +3,14 @@
 // loading with file:line errors, output routing to the log sink, runtime-error containment.
 #include "llsf/clips/agent.h"
 
+#include <algorithm>
+#include <cctype>
 #include <fstream>
 #include <sstream>
+#include <unordered_map>
 
 #include "feature.h"
+#include "llsf/core/config.h"
 
 namespace llsf::clips {
 
@@ -45,6 +49,10 @@ void AgentConfig::validate() const {
   if (robot_number < 0) throw std::invalid_argument("AgentConfig.robot_number must be >= 0");
   if (max_rules_per_cycle <= 0)
     throw std::invalid_argument("AgentConfig.max_rules_per_cycle must be > 0");
+  if (max_steps_per_cycle <= 0)
+    throw std::invalid_argument("AgentConfig.max_steps_per_cycle must be > 0");
+  if (!(max_cycle_wall_s > 0.0))
+    throw std::invalid_argument("AgentConfig.max_cycle_wall_s must be > 0");
   if (locks) lock_config.validate();
 }
 
@@ -91,8 +99,11 @@ struct AgentHost::Impl {
   int runtime_errors = 0;
   int limit_hits = 0;
   std::int64_t rules_fired = 0;
-  std::string werror;    // CLIPS error output not yet reported
-  std::string lines[4];  // partial output lines per level
+  std::string werror;         // CLIPS error output not yet reported
+  std::string lines[4];       // partial output lines per level
+  std::string budget_reason;  // set when the work budget stopped the cycle
+  std::unordered_map<std::string, std::string> rule_places;  // defrule name -> "file:line"
+  std::int64_t max_steps_seen = 0;
 
   Impl(AgentConfig config, AgentIo io) {
     config.validate();
@@ -165,15 +176,51 @@ struct AgentHost::Impl {
       // Keep the cause; the "execution halted" line only names the rule.
       if (auto first = text.find("[PRCCODE4]"); first > 0) text = text.substr(0, first);
     }
-    const std::string msg = one_line(text);
-    emit(LogLevel::kError,
-         rule.empty() ? "runtime error: " + msg : "runtime error in rule " + rule + ": " + msg);
+    std::string msg = one_line(text);
+    if (!budget_reason.empty()) {
+      msg = budget_reason;
+      budget_reason.clear();
+    }
+    if (rule.empty()) {
+      emit(LogLevel::kError, "runtime error: " + msg);
+    } else {
+      const auto place = rule_places.find(rule);
+      emit(LogLevel::kError, "runtime error in rule " + rule +
+                                 (place != rule_places.end() ? " (" + place->second + ")" : "") +
+                                 ": " + msg);
+    }
     werror.clear();
     ++runtime_errors;
     return 1;
   }
 
+  // Where each defrule of `text` starts ("file:line"), for messages that name a rule.
+  void note_rule_places(const std::string& text, std::string_view source) {
+    int line = 1;
+    bool comment = false;
+    for (std::size_t i = 0; i < text.size(); ++i) {
+      const char c = text[i];
+      if (c == '\n') {
+        ++line;
+        comment = false;
+      } else if (c == ';') {
+        comment = true;
+      } else if (!comment && c == '(' && text.compare(i + 1, 7, "defrule") == 0) {
+        std::size_t b = i + 8;
+        while (b < text.size() && std::isspace(static_cast<unsigned char>(text[b])) != 0) ++b;
+        std::size_t e = b;
+        while (e < text.size() && std::isspace(static_cast<unsigned char>(text[e])) == 0 &&
+               text[e] != '(' && text[e] != ')' && text[e] != ';')
+          ++e;
+        if (e > b) {
+          rule_places[text.substr(b, e - b)] = std::string(source) + ":" + std::to_string(line);
+        }
+      }
+    }
+  }
+
   void load(const std::string& text, std::string_view source) {
+    note_rule_places(text, source);
     const auto errors = env.load(text);
     flush_output();
     if (errors.empty()) return;
@@ -194,6 +241,7 @@ struct AgentHost::Impl {
   }
 
   CycleResult cycle(core::SimTime now) {
+    env.start_budget(state.config.max_steps_per_cycle, state.config.max_cycle_wall_s);
     if (!started) start(now);
     state.now = now;
     CycleResult result;
@@ -209,17 +257,41 @@ struct AgentHost::Impl {
       remaining -= fired;
       const bool error = env.halted() || !werror.empty();
       if (!error) break;
+      if (env.budget_hit() != detail::Environment::BudgetHit::kNone) {
+        // The rule's actions were stopped by the work budget: the cycle ends here.
+        result.budget_exceeded = true;
+        budget_reason =
+            env.budget_hit() == detail::Environment::BudgetHit::kSteps
+                ? "stopped after " + std::to_string(state.config.max_steps_per_cycle) +
+                      " steps of work in one agent cycle (an endless loop in its actions?); the "
+                      "game goes on"
+                : "stopped after " + core::number_text(state.config.max_cycle_wall_s) +
+                      " s of wall time in one agent cycle (an endless loop in its actions?); the "
+                      "game goes on";
+        if (werror.find("[PRCCODE4]") == std::string::npos) {
+          werror +=
+              "[PRCCODE4] Execution halted during the actions of defrule " + env.next_rule() + ".";
+        }
+        report_errors();
+        env.clear_halt();
+        break;
+      }
       report_errors();
       env.clear_halt();
       if (env.agenda_empty()) break;
     }
-    if (remaining <= 0 && !env.agenda_empty()) {
+    if (remaining <= 0 && !env.agenda_empty() && !result.budget_exceeded) {
       result.limit_reached = true;
       ++limit_hits;
-      emit(LogLevel::kWarn, "rule firing limit of " +
-                                std::to_string(state.config.max_rules_per_cycle) +
-                                " reached with rules still on the agenda (endless rule loop?)");
+      const std::string rule = env.next_rule();
+      const auto place = rule_places.find(rule);
+      emit(LogLevel::kWarn,
+           "rule firing limit of " + std::to_string(state.config.max_rules_per_cycle) +
+               " reached with rules still on the agenda (endless rule loop?); next: rule " + rule +
+               (place != rule_places.end() ? " (" + place->second + ")" : ""));
     }
+    result.steps = env.budget_steps();
+    max_steps_seen = std::max(max_steps_seen, result.steps);
     for (auto& f : features) f->after_run(env);
     flush_output();
     rules_fired += result.rules_fired;
@@ -306,6 +378,7 @@ Value AgentHost::eval(std::string_view expression) {
 }
 
 int AgentHost::runtime_errors() const { return impl_->runtime_errors; }
+std::int64_t AgentHost::max_cycle_steps() const { return impl_->max_steps_seen; }
 int AgentHost::limit_hits() const { return impl_->limit_hits; }
 std::int64_t AgentHost::rules_fired() const { return impl_->rules_fired; }
 int AgentHost::live_messages() const { return impl_->state.live_messages; }

@@ -283,6 +283,40 @@ Environment::Environment() {
   if (env_ == nullptr) throw std::runtime_error("CLIPS: cannot create an environment");
   EnvAddRouterWithContext(env_, kRouterName, 40, &RouterAccess::query, &RouterAccess::print,
                           &RouterAccess::getc, &RouterAccess::ungetc, &RouterAccess::exit, this);
+  SetEnvironmentContext(env_, this);
+  EnvAddPeriodicFunction(env_, "llsf-budget", &Environment::periodic, 0);
+}
+
+void Environment::periodic(void* clips_env) {
+  auto* self = static_cast<Environment*>(GetEnvironmentContext(clips_env));
+  if (self == nullptr || self->max_steps_ <= 0) return;
+  ++self->steps_;
+  if (self->budget_hit_ == BudgetHit::kNone) {
+    if (self->steps_ > self->max_steps_) {
+      self->budget_hit_ = BudgetHit::kSteps;
+    } else if ((self->steps_ & 1023) == 0) {
+      // The wall clock only cuts runaway work (it never changes a game that stays in budget).
+      const std::chrono::duration<double> spent =
+          std::chrono::steady_clock::now() - self->budget_start_;
+      if (spent.count() > self->max_wall_s_) self->budget_hit_ = BudgetHit::kWall;
+    }
+  }
+  if (self->budget_hit_ != BudgetHit::kNone) SetHaltExecution(clips_env, TRUE);
+}
+
+void Environment::start_budget(std::int64_t max_steps, double max_wall_s) {
+  steps_ = 0;
+  max_steps_ = max_steps;
+  max_wall_s_ = max_wall_s;
+  budget_hit_ = BudgetHit::kNone;
+  budget_start_ = std::chrono::steady_clock::now();
+}
+
+std::string Environment::next_rule() const {
+  void* act = EnvGetNextActivation(env_, nullptr);
+  if (act == nullptr) return {};
+  const char* name = EnvGetActivationName(env_, act);
+  return name != nullptr ? std::string(name) : std::string();
 }
 
 Environment::~Environment() { DestroyEnvironment(env_); }

@@ -4,6 +4,7 @@
 // (GetType, SetValue, ...) and a global `struct field`. Features talk to CLIPS through this.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <deque>
 #include <functional>
@@ -127,6 +128,19 @@ class Environment {
 
   /// Runs at most `limit` rule firings; returns the number fired.
   std::int64_t run(std::int64_t limit);
+
+  /// Why a budget stopped execution.
+  enum class BudgetHit : std::uint8_t { kNone, kSteps, kWall };
+  /// Starts a work budget for the following run()s: a step is one of CLIPS' periodic callbacks
+  /// (about two per rule firing, one per iteration of while, loop-for-count, progn$, ...).
+  /// Past `max_steps` steps, or (checked every 1,024 steps) past `max_wall_s` seconds of wall
+  /// time, execution halts as on an error: the running rule's actions stop. Until the next
+  /// start_budget() every further step halts again.
+  void start_budget(std::int64_t max_steps, double max_wall_s);
+  BudgetHit budget_hit() const { return budget_hit_; }
+  std::int64_t budget_steps() const { return steps_; }
+  /// The rule of the first activation on the agenda, or "" if it is empty.
+  std::string next_rule() const;
   /// True if the current focus has activations left.
   bool agenda_empty() const;
   /// True after an error stopped execution (CLIPS' halt flag); clear_halt() resets it.
@@ -151,6 +165,7 @@ class Environment {
   };
   friend struct RouterAccess;
   void on_print(std::string_view logical_name, std::string_view text);
+  static void periodic(void* clips_env);
 
   void* env_ = nullptr;
   OutputHandler output_;
@@ -159,6 +174,12 @@ class Environment {
   bool loading_ = false;
   std::string load_errors_;
   std::vector<std::pair<std::size_t, int>> error_starts_;  // (offset in load_errors_, line)
+  // The work budget (start_budget).
+  std::int64_t steps_ = 0;
+  std::int64_t max_steps_ = 0;  // 0: no budget
+  double max_wall_s_ = 0.0;
+  std::chrono::steady_clock::time_point budget_start_;
+  BudgetHit budget_hit_ = BudgetHit::kNone;
 };
 
 }  // namespace llsf::clips::detail

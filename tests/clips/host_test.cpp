@@ -123,8 +123,67 @@ TEST_CASE("a runtime error is logged with the rule name and the agent keeps goin
   f.load("(defrule bad-call (call-it) => (skill-call drive_to place))");
   f.assert_fact("(call-it)");
   CHECK(f.step().runtime_errors == 1);
-  CHECK(f.logged("runtime error in rule bad-call: [LLSF1] skill-call: arguments must come in key"));
+  CHECK(
+      f.logged("runtime error in rule bad-call (test.clp:1): [LLSF1] skill-call: arguments must "
+               "come in key"));
   CHECK(f.agent().runtime_errors() == 2);
+}
+
+TEST_CASE("rules are named with their file:line in runtime errors and the firing limit") {
+  AgentConfig cfg;
+  cfg.max_rules_per_cycle = 50;
+  AgentFixture f(cfg);
+  f.load(
+      "; (defrule commented-out => )\n"
+      "(defrule ok => (assert (ok)))\n"
+      "\n"
+      "(defrule\n  spin ?f <- (spin ?n) => (retract ?f) (assert (spin (+ ?n 1))))\n"
+      "(defrule bad (value ?v) => (assert (sum (+ 1 ?v))))\n",
+      "agent/spin.clp");
+  f.step();
+  f.assert_fact("(value abc)");
+  CycleResult r = f.step();
+  CHECK(r.runtime_errors == 1);
+  CHECK(f.logged("runtime error in rule bad (agent/spin.clp:6): "));
+  f.assert_fact("(spin 0)");
+  r = f.step();
+  CHECK(r.limit_reached);
+  CHECK(f.logged("(endless rule loop?); next: rule spin (agent/spin.clp:4)"));
+}
+
+TEST_CASE("the work budget stops a runaway rule's actions, names it, and the game goes on") {
+  AgentConfig cfg;
+  cfg.max_steps_per_cycle = 100'000;
+  AgentFixture f(cfg);
+  f.load(
+      "(defrule forever (go) => (bind ?i 0) (while TRUE (bind ?i (+ ?i 1))))\n"
+      "(defrule flood (flood) => (loop-for-count (?i 20000000) (assert (x ?i))))\n"
+      "(defrule alive (time $?) => (assert (alive)))\n",
+      "runaway.clp");
+  f.step();
+  const std::int64_t normal_steps = f.agent().max_cycle_steps();
+  CHECK(normal_steps > 0);
+  CHECK(normal_steps < 1'000);
+  f.assert_fact("(go)");
+  CycleResult r = f.step();
+  CHECK(r.budget_exceeded);
+  CHECK(r.runtime_errors == 1);
+  CHECK(r.steps > 100'000);
+  CHECK(
+      f.logged("runtime error in rule forever (runaway.clp:1): stopped after 100000 steps of "
+               "work in one agent cycle (an endless loop in its actions?); the game goes on"));
+  // The next cycle has a fresh budget: the agent goes on.
+  r = f.step();
+  CHECK_FALSE(r.budget_exceeded);
+  CHECK(r.runtime_errors == 0);
+  CHECK(f.has("(alive)"));
+  // 20 million asserts in one rule's actions: stopped the same way.
+  f.assert_fact("(flood)");
+  r = f.step();
+  CHECK(r.budget_exceeded);
+  CHECK(f.logged("runtime error in rule flood (runaway.clp:2): stopped after 100000 steps"));
+  CHECK(f.agent().runtime_errors() == 2);
+  CHECK_FALSE(f.step().budget_exceeded);
 }
 
 TEST_CASE("printout and log functions reach the sink with the simulated time") {

@@ -2,6 +2,7 @@
 // The LLSF 2013 team agent (clips/agents/llsf2013) playing whole games in the game loop.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
@@ -82,6 +83,11 @@ TEST_CASE("the LLSF 2013 agent produces and delivers with three robots") {
   MESSAGE("production points: ", s.production_points);
   CHECK(g.runtime_errors() == 0);
   CHECK(s.production_points >= 20);
+  // The shipped agent stays far below the work budget of a cycle (docs/clips.md, "Budgets").
+  std::int64_t steps = 0;
+  for (const AgentBrain* b : g.brains) steps = std::max(steps, b->agent().max_cycle_steps());
+  MESSAGE("most CLIPS steps in one agent cycle: ", steps);
+  CHECK(steps * 100 < clips::AgentConfig{}.max_steps_per_cycle);
 }
 
 TEST_CASE("the thesis' configurations are configuration: P3-P3, P1P2-P3-R, P1-P2-P3-RD") {

@@ -74,7 +74,14 @@ struct AgentConfig {
   std::string team_name = "Carologistics";    ///< ?*TEAM-NAME* (a string)
   std::uint64_t seed = 1;                     ///< seeds CLIPS' (random)
   std::int64_t max_rules_per_cycle = 10'000;  ///< rule firings per cycle before the run is cut
-  ConfigEntries config;                       ///< asserted as confval facts after (reset)
+  /// The work budget of one cycle (docs/clips.md, "Budgets"): CLIPS steps (periodic callbacks:
+  /// about two per rule firing, one per iteration of while, loop-for-count, ...) and wall time.
+  /// Past either, the running rule's actions stop, the host logs a runtime error naming the rule
+  /// and its file:line, and the cycle ends; the next cycle goes on. The shipped agents stay far
+  /// below both (measured: docs/clips.md); the wall time only cuts runaway work.
+  std::int64_t max_steps_per_cycle = 1'000'000;
+  double max_cycle_wall_s = 10.0;
+  ConfigEntries config;  ///< asserted as confval facts after (reset)
   /// Runs the resource-lock protocol (docs/locks.md): lock facts, lock messages consumed, the
   /// master's announcements. Off by default, so that agents without locks stay silent.
   bool locks = false;
@@ -98,8 +105,10 @@ struct AgentIo {
 /// What one cycle did.
 struct CycleResult {
   std::int64_t rules_fired = 0;
-  bool limit_reached = false;  ///< max_rules_per_cycle fired and the agenda was not empty
-  int runtime_errors = 0;      ///< runtime errors in this cycle (also logged)
+  bool limit_reached = false;    ///< max_rules_per_cycle fired and the agenda was not empty
+  bool budget_exceeded = false;  ///< the cycle was stopped by its work budget (a runtime error)
+  std::int64_t steps = 0;        ///< CLIPS steps the cycle took (its work budget's measure)
+  int runtime_errors = 0;        ///< runtime errors in this cycle (also logged)
 };
 
 /// A fact copied out of the agent (tests, tools).
@@ -162,6 +171,8 @@ class AgentHost {
   /// Evaluates an expression, e.g. "(now)" or "(+ 1 2)" (void on error).
   Value eval(std::string_view expression);
 
+  /// The most CLIPS steps one cycle took so far (the measure of max_steps_per_cycle).
+  std::int64_t max_cycle_steps() const;
   /// Runtime errors since construction.
   int runtime_errors() const;
   /// Cycles whose run was cut by max_rules_per_cycle.
