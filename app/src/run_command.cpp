@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
 #include <ostream>
@@ -42,7 +43,8 @@ struct RunOptions {
   bool no_db = false;
   std::string record;  ///< "" = default_recordings_dir(db)/recording_file_name(...)
   bool no_record = false;
-  LiveOptions live;  ///< --speed, --realtime, --serve, --port, --serve-exit
+  bool strict = false;  ///< an agent mistake (RunIssue::is_mistake) fails the run
+  LiveOptions live;     ///< --speed, --realtime, --serve, --port, --serve-exit
 };
 
 const study::Scenario* pick_variant(const study::ScenarioFile& f, const std::string& name,
@@ -62,6 +64,45 @@ const study::Scenario* pick_variant(const study::ScenarioFile& f, const std::str
   err << "llsfsim run: " << f.file << " has no variant '" << name << "'; its variants:\n";
   for (const study::Scenario& s : f.variants) err << "  " << s.variant << "\n";
   return nullptr;
+}
+
+/// The run's issues: the mistakes (runtime errors, rule loops, long lock holds) each on a line
+/// with time, robot, rule and file:line (at most 10), then the skill failures grouped by robot,
+/// skill and error (docs/llsfsim.md, "Issues").
+void print_issues(const study::RunResult& r, std::ostream& out) {
+  int mistakes = 0;
+  std::map<std::string, std::pair<int, double>> failures;  // "robot skill: error" -> (n, first)
+  for (const study::RunIssue& i : r.issues) {
+    if (!i.is_mistake()) {
+      const std::string skill = i.text.substr(0, i.text.find('{'));
+      const std::size_t colon = i.text.find("}: ");
+      const std::string error = colon == std::string::npos ? i.text : i.text.substr(colon + 3);
+      auto& f = failures[i.robot + " " + skill + ": " + error];
+      if (f.first++ == 0) f.second = i.time_s;
+      continue;
+    }
+    if (mistakes++ >= 10) continue;
+    std::string where;
+    if (!i.rule.empty()) where = " rule " + i.rule;
+    if (!i.place.empty()) where += " (" + i.place + ")";
+    out << fmt::format("issue      {:7.1f} s {} {}{}: {}\n", i.time_s, i.robot, i.kind, where,
+                       i.text);
+  }
+  if (mistakes > 10)
+    out << fmt::format("issue      ... and {} more (--json lists them)\n", mistakes - 10);
+  int shown = 0;
+  for (const auto& [what, f] : failures) {
+    if (shown++ >= 10) {
+      out << fmt::format("skills     ... and {} more kinds of failure (--json)\n",
+                         failures.size() - 10);
+      break;
+    }
+    out << fmt::format("skills     {}x {} (first at {:.1f} s)\n", f.first, what, f.second);
+  }
+  if (r.issues_dropped > 0) {
+    out << fmt::format("issue      {} more issues not kept (the first {} are)\n", r.issues_dropped,
+                       study::RunResult::kMaxIssues);
+  }
 }
 
 void print_summary(const study::RunResult& r, std::ostream& out) {
@@ -84,6 +125,7 @@ void print_summary(const study::RunResult& r, std::ostream& out) {
   }
   out << fmt::format("robots     {} collisions, {} skill failures, {} agent runtime errors\n",
                      r.collisions, r.skill_failures, r.agent_runtime_errors);
+  print_issues(r, out);
   if (r.lock_grants + r.lock_refusals > 0) {
     out << fmt::format(
         "locks      {} grants, {} refusals; {} waits, {:.1f} s waited in all, longest {:.1f} s\n",
@@ -222,6 +264,16 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
     if (!stored_as.empty()) out << fmt::format("database   {}\n", stored_as);
   }
   serve_until_stopped(o.live, server, note);
+  if (o.strict && !r.passed()) return kExitFailed;
+  if (o.strict) {
+    for (const study::RunIssue& i : r.issues) {
+      if (!i.is_mistake()) continue;
+      if (!o.quiet && !o.json) {
+        err << "llsfsim run: --strict: the agents made mistakes (issue lines above)\n";
+      }
+      return kExitFailed;
+    }
+  }
   return r.passed() ? kExitOk : kExitFailed;
 }
 
@@ -270,6 +322,9 @@ Action add_run_command(CLI::App& app) {
                  "Matrix variant, e.g. 'config=P3-P3' or just 'P3-P3' (default: the first)");
   app.add_flag("--json", o->json, "Print the summary as one JSON object");
   app.add_flag("-q,--quiet", o->quiet, "No summary, only the exit code");
+  app.add_flag("--strict", o->strict,
+               "Fail the run (exit 1) on any agent mistake: a runtime error (also a rule stopped "
+               "by the work budget), a rule loop cut by the firing limit, a lock held over 300 s");
   auto* db = app.add_option("--db", o->db,
                             "Statistics store (SQLite) the run is written to (docs/statistics.md)")
                  ->capture_default_str();

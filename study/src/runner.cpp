@@ -148,20 +148,32 @@ class LockHolds {
     if (e.to == LockState::kRequested) return;  // taking a pending release back: still held
     auto it = open_.find(key);
     if (it == open_.end()) return;
-    if (!jammed) max_s_ = std::max(max_s_, (e.time - it->second).seconds());
+    if (!jammed) held(key, it->second, e.time);
     open_.erase(it);
   }
+  /// Holds longer than RunIssue::kLongLockHold_s: (robot, resource, from, to).
+  struct LongHold {
+    std::string robot, resource;
+    core::SimTime from, to;
+  };
+  const std::vector<LongHold>& long_holds() const { return long_; }
   /// `jammed(robot)` says whether a robot is jammed at the end.
   template <class F>
   double finish(core::SimTime end, F&& jammed) {
     for (const auto& [key, since] : open_) {
-      if (!jammed(key.first)) max_s_ = std::max(max_s_, (end - since).seconds());
+      if (!jammed(key.first)) held(key, since, end);
     }
     open_.clear();
     return max_s_;
   }
 
  private:
+  void held(const std::pair<std::string, std::string>& key, core::SimTime from, core::SimTime to) {
+    const double s = (to - from).seconds();
+    max_s_ = std::max(max_s_, s);
+    if (s > RunIssue::kLongLockHold_s) long_.push_back({key.first, key.second, from, to});
+  }
+  std::vector<LongHold> long_;
   std::map<std::pair<std::string, std::string>, core::SimTime> open_;
   double max_s_ = 0.0;
 };
@@ -206,6 +218,46 @@ int pucks_in(const sim::Game& g, const kinematic::Rect& area) {
   return n;
 }
 
+/// The issue an agent's log line reports (docs/llsfsim.md, "Issues"), if any: the host's
+/// "runtime error in rule NAME (FILE:LINE): text" / "runtime error: text" and its firing-limit
+/// warning "... (endless rule loop?); next: rule NAME (FILE:LINE)".
+std::optional<RunIssue> issue_of(const clips::LogRecord& rec) {
+  const std::string_view text = rec.text;
+  RunIssue issue;
+  issue.time_s = rec.time.seconds();
+  issue.robot = std::string(rec.agent);
+  // "NAME (PLACE)" or "NAME" at the start of `s`; returns the rest after it.
+  auto rule_at = [&issue](std::string_view s) {
+    const std::size_t end = s.find_first_of(" :");
+    issue.rule = std::string(s.substr(0, end));
+    s = end == std::string_view::npos ? std::string_view() : s.substr(end);
+    if (s.starts_with(" (")) {
+      const std::size_t close = s.find(')');
+      if (close != std::string_view::npos) {
+        issue.place = std::string(s.substr(2, close - 2));
+        s = s.substr(close + 1);
+      }
+    }
+    return s;
+  };
+  if (rec.level == clips::LogLevel::kError && text.starts_with("runtime error")) {
+    issue.kind = "runtime-error";
+    std::string_view rest = text.substr(std::string_view("runtime error").size());
+    if (rest.starts_with(" in rule ")) rest = rule_at(rest.substr(9));
+    if (rest.starts_with(": ")) rest.remove_prefix(2);
+    issue.text = std::string(rest);
+    return issue;
+  }
+  if (rec.level == clips::LogLevel::kWarn && text.starts_with("rule firing limit")) {
+    issue.kind = "rule-loop";
+    const std::size_t next = text.find("; next: rule ");
+    issue.text = std::string(text.substr(0, next));
+    if (next != std::string_view::npos) rule_at(text.substr(next + 13));
+    return issue;
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 bool RunResult::passed() const {
@@ -225,6 +277,15 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   int role_changes = 0;
   double first_role_change_s = -1.0;
   int skill_failures = 0;
+  std::vector<RunIssue> issues;
+  int issues_dropped = 0;
+  auto add_issue = [&issues, &issues_dropped](RunIssue i) {
+    if (issues.size() < RunResult::kMaxIssues) {
+      issues.push_back(std::move(i));
+    } else {
+      ++issues_dropped;
+    }
+  };
   std::unique_ptr<Recorder> recorder;
   sim::GameDriver driver(config);
   sim::Game& game = driver.game();
@@ -245,10 +306,11 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
     const std::string name(game.robot(i).name());
     // The agent's decisions (info and above) go into the recording; the team agent's role
     // changes are counted.
-    clips::LogSink log = [&recorder, &role_changes,
-                          &first_role_change_s](const clips::LogRecord& rec) {
+    clips::LogSink log = [&recorder, &role_changes, &first_role_change_s,
+                          &add_issue](const clips::LogRecord& rec) {
       if (rec.level == clips::LogLevel::kDebug) return;
       if (recorder) recorder->agent(rec);
+      if (std::optional<RunIssue> issue = issue_of(rec)) add_issue(std::move(*issue));
       if (rec.text.find("production: role change") != std::string_view::npos) {
         if (role_changes++ == 0) first_role_change_s = rec.time.seconds();
       }
@@ -259,14 +321,22 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
       if (recorder) recorder->lock(name, e);
     };
     sim::AgentBrain& brain = driver.plug_agent(i, c, std::move(log), std::move(locks));
-    brain.skills().set_listener(
-        [&skill_failures, &hooks, &recorder, &streaks, &game, i](const sim::SkillStatusChange& ch) {
-          if (recorder) recorder->skill(ch);
-          if (hooks.skill) hooks.skill(ch);
-          if (ch.status == lua::SkillStatus::kFailed) ++skill_failures;
-          // A jammed robot's failures are the jam's (robot profiles), not a livelock's.
-          if (!game.robot(i).jammed()) streaks.on(ch);
-        });
+    brain.skills().set_listener([&skill_failures, &hooks, &recorder, &streaks, &game, &add_issue,
+                                 i](const sim::SkillStatusChange& ch) {
+      if (recorder) recorder->skill(ch);
+      if (hooks.skill) hooks.skill(ch);
+      if (ch.status == lua::SkillStatus::kFailed) {
+        ++skill_failures;
+        RunIssue issue;
+        issue.time_s = ch.time.seconds();
+        issue.robot = ch.robot;
+        issue.kind = "skill-failure";
+        issue.text = ch.skill_string + ": " + ch.error;
+        add_issue(std::move(issue));
+      }
+      // A jammed robot's failures are the jam's (robot profiles), not a livelock's.
+      if (!game.robot(i).jammed()) streaks.on(ch);
+    });
   }
   double lock_hold_max_s = 0.0;  // set at the end, before the test cases without a deadline
   // Test cases with a deadline are judged when the game passes it.
@@ -453,6 +523,20 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
     return false;
   });
   r.lock_hold_max_s = lock_hold_max_s;
+  for (const LockHolds::LongHold& h : lock_holds.long_holds()) {
+    RunIssue issue;
+    issue.time_s = h.to.seconds();
+    issue.robot = h.robot;
+    issue.kind = "lock-hold";
+    issue.text = "held the lock on " + h.resource + " for " + fmt_s((h.to - h.from).seconds()) +
+                 " s (from " + fmt_s(h.from.seconds()) + " s; more than " +
+                 fmt_s(RunIssue::kLongLockHold_s) + " s)";
+    add_issue(std::move(issue));
+  }
+  std::stable_sort(issues.begin(), issues.end(),
+                   [](const RunIssue& a, const RunIssue& b) { return a.time_s < b.time_s; });
+  r.issues = std::move(issues);
+  r.issues_dropped = issues_dropped;
   r.role_changes = role_changes;
   r.first_role_change_s = first_role_change_s;
   r.storage_min = storage_min;
@@ -551,6 +635,17 @@ std::string to_json(const RunResult& r) {
             {"result_hash", hash},
             {"passed", r.passed()},
             {"tests", std::move(tests)}};
+  Json issues = Json::array();
+  for (const RunIssue& i : r.issues) {
+    issues.push_back({{"time_s", number(i.time_s)},
+                      {"robot", i.robot},
+                      {"kind", i.kind},
+                      {"rule", i.rule},
+                      {"place", i.place},
+                      {"text", i.text}});
+  }
+  j["issues"] = std::move(issues);
+  j["issues_dropped"] = r.issues_dropped;
   if (r.hackathon) {
     const sim::HackathonScore& h = *r.hackathon;
     j["hackathon"] = {{"points", h.points},

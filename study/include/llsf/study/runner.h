@@ -48,6 +48,23 @@ struct OrderResult {
   int window_end_s = 0;
 };
 
+/// A mistake or anomaly of a run that an agent or skill author should see, with its place.
+struct RunIssue {
+  double time_s = 0.0;  ///< game time since the start of the run
+  std::string robot;
+  /// "runtime-error" (a rule's actions failed, incl. a work budget that stopped them),
+  /// "rule-loop" (the firing limit of a cycle was reached), "skill-failure" (a skill string
+  /// ended FAILED: `text` is the skill string and its error), "lock-hold" (one robot held one
+  /// lock longer than RunIssue::kLongLockHold_s, not counting a jammed robot's).
+  std::string kind;
+  std::string rule;   ///< the CLIPS rule, if known
+  std::string place;  ///< "file:line" of the rule, if known
+  std::string text;
+  static constexpr double kLongLockHold_s = 300.0;
+  /// "runtime-error", "rule-loop" and "lock-hold" are mistakes: `run --strict` fails on them.
+  bool is_mistake() const { return kind != "skill-failure"; }
+};
+
 /// Everything a run reports.
 struct RunResult {
   std::string scenario;
@@ -107,7 +124,12 @@ struct RunResult {
   /// "recording" (the recorder's frames) when the game was recorded.
   std::vector<std::pair<std::string, double>> time_split;
   std::vector<RunAward> awards;  ///< every points award, in order
-  std::string recording;         ///< RunHooks::record_path if the game was recorded
+  /// The run's issues in time order: the first kMaxIssues kept, `issues_dropped` counts the rest
+  /// (the counts above are complete).
+  std::vector<RunIssue> issues;
+  int issues_dropped = 0;
+  static constexpr std::size_t kMaxIssues = 200;
+  std::string recording;  ///< RunHooks::record_path if the game was recorded
   /// The hackathon score at the end (scenarios with `hackathon:` only).
   std::optional<sim::HackathonScore> hackathon;
   bool passed() const;
