@@ -342,7 +342,8 @@ Action add_run_command(CLI::App& app) {
       "Plays one game headless and prints a summary and the test-case verdicts; stores the run "
       "in the statistics store (--db, default llsfsim.db; the latest game of each variant and "
       "seed of a scenario file's content) and writes a recording of it.\n"
-      "Exit code: 0 all test cases passed, 1 one failed, 2 bad input (scenario, agent, skill "
+      "Exit code: 0 all test cases passed, 1 one failed (or, with --strict, an agent made a "
+      "mistake), 2 bad input (scenario, agent, skill "
       "file, a path that cannot be written), 3 internal error (a bug: please report it).");
   return [o](std::ostream& out, std::ostream& err) { return run(*o, out, err); };
 }
