@@ -4,13 +4,18 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <memory>
 #include <optional>
 #include <ostream>
+#include <regex>
+#include <set>
+#include <sstream>
 #include <string>
 #include <string_view>
 #include <thread>
@@ -21,6 +26,7 @@
 #include "llsf/app/cli.h"
 #include "llsf/clips/agent.h"
 #include "llsf/core/error.h"
+#include "llsf/core/text.h"
 #include "llsf/sim/agent_brain.h"
 #include "llsf/sim/driver.h"
 #include "llsf/study/recording.h"
@@ -277,12 +283,118 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
   return r.passed() ? kExitOk : kExitFailed;
 }
 
+/// An agent's source with its comments blanked (strings kept), and where each line starts.
+struct AgentSource {
+  std::string file;
+  std::string code;
+  int line_of(std::size_t pos) const {
+    return 1 +
+           static_cast<int>(std::count(code.begin(), code.begin() + static_cast<long>(pos), '\n'));
+  }
+};
+
+std::vector<AgentSource> read_agent_sources(const std::vector<std::string>& entries) {
+  std::vector<AgentSource> out;
+  for (const std::string& f : sim::agent_files(entries)) {
+    std::ifstream in(f, std::ios::binary);
+    std::ostringstream text;
+    text << in.rdbuf();
+    AgentSource src{f, text.str()};
+    bool in_string = false;
+    bool comment = false;
+    for (char& c : src.code) {
+      if (c == '\n') {
+        comment = false;
+      } else if (comment) {
+        c = ' ';
+      } else if (c == '"') {
+        in_string = !in_string;
+      } else if (c == ';' && !in_string) {
+        comment = true;
+        c = ' ';
+      }
+    }
+    out.push_back(std::move(src));
+  }
+  return out;
+}
+
+/// `check`'s warnings about one robot's agent (docs/llsfsim.md, `check`): skill names in
+/// `(skill-call NAME ...)` the skill library does not have; confval paths the scenario sets that
+/// no agent file names, and the reverse; the lock switch against the agent's use of lock facts.
+std::vector<std::string> agent_warnings(const study::RobotSpec& spec,
+                                        const sim::AgentBrain& brain) {
+  std::vector<std::string> warnings;
+  const std::vector<AgentSource> sources = read_agent_sources(spec.agent);
+  std::vector<std::string> skills;
+  for (const lua::SkillInfo& s : brain.skills().engine().skills()) skills.push_back(s.name);
+  static const std::regex kSkillCall(R"(\(skill-call\s+([A-Za-z_][A-Za-z0-9_]*))");
+  static const std::regex kConfval(R"re("(/clips-agent/[^"\s]*)")re");
+  std::vector<std::string> read_paths;  // literal paths in the agent (a trailing / is a prefix)
+  bool uses_locks = false;
+  for (const AgentSource& src : sources) {
+    for (auto it = std::sregex_iterator(src.code.begin(), src.code.end(), kSkillCall);
+         it != std::sregex_iterator(); ++it) {
+      const std::string name = (*it)[1].str();
+      if (std::find(skills.begin(), skills.end(), name) != skills.end()) continue;
+      const auto hint = core::closest_match(name, skills);
+      warnings.push_back(fmt::format(
+          "{}:{}: (skill-call {} ...): the skill library has no skill "
+          "'{}'{}",
+          src.file, src.line_of(static_cast<std::size_t>(it->position())), name, name,
+          hint ? " (did you mean '" + *hint + "'?)" : " (`llsfsim skill --list` lists them)"));
+    }
+    for (auto it = std::sregex_iterator(src.code.begin(), src.code.end(), kConfval);
+         it != std::sregex_iterator(); ++it) {
+      read_paths.push_back((*it)[1].str());
+    }
+    if (src.code.find("resource-request") != std::string::npos ||
+        src.code.find("(lock ") != std::string::npos) {
+      uses_locks = true;
+    }
+  }
+  auto read_by_agent = [&read_paths](const std::string& path) {
+    for (const std::string& p : read_paths) {
+      if (p == path || (p.ends_with('/') && path.starts_with(p))) return true;
+    }
+    return false;
+  };
+  std::vector<std::string> set_paths;
+  for (const clips::ConfigEntry& e : spec.config) {
+    if (e.path == "/clips-agent/use-locks") continue;  // the host's (robots.locks)
+    set_paths.push_back(e.path);
+    if (read_by_agent(e.path)) continue;
+    const auto hint = core::closest_match(e.path, read_paths);
+    warnings.push_back(fmt::format("robots.config: the agent reads no confval {}{}", e.path,
+                                   hint ? " (did you mean " + *hint + "?)" : ""));
+  }
+  std::sort(read_paths.begin(), read_paths.end());
+  read_paths.erase(std::unique(read_paths.begin(), read_paths.end()), read_paths.end());
+  std::string unset;
+  for (const std::string& p : read_paths) {
+    if (p.ends_with('/') || p == "/clips-agent/use-locks") continue;
+    if (std::find(set_paths.begin(), set_paths.end(), p) != set_paths.end()) continue;
+    unset += (unset.empty() ? "" : ", ") + p;
+  }
+  if (!unset.empty()) {
+    warnings.push_back("note: robots.config leaves these confvals of the agent at its defaults: " +
+                       unset);
+  }
+  if (spec.locks && !uses_locks) {
+    warnings.push_back(
+        "robots.locks is on, but the agent uses no lock facts (no resource-request or lock "
+        "fact in its files): the lock protocol runs for nothing (set `robots.locks: false`?)");
+  }
+  return warnings;
+}
+
 int check(const std::vector<std::string>& files, std::ostream& out, std::ostream& err) {
   int bad = 0;
   for (const std::string& path : files) {
     try {
       const study::ScenarioFile f = study::load_scenario(path);
       std::size_t seeds = 0;
+      std::set<std::string> warned;  // each warning once per file
       for (const study::Scenario& s : f.variants) {
         seeds += s.seeds.size();
         // Build the game and every brain: agent files are parsed, skill files loaded.
@@ -298,6 +410,14 @@ int check(const std::vector<std::string>& files, std::ostream& out, std::ostream
           const sim::AgentBrain& brain = driver.plug_agent(i, c);
           for (const std::string& e : brain.skills().engine().load_errors()) {
             throw core::ConfigError("skill file error: " + e);
+          }
+          for (const std::string& w : agent_warnings(spec, brain)) {
+            if (!warned.insert(w).second) continue;
+            if (w.starts_with("note: ")) {
+              out << "note " << path << ": " << w.substr(6) << "\n";
+            } else {
+              out << "warn " << path << ": " << w << "\n";
+            }
           }
         }
       }

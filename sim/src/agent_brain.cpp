@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <utility>
 
 namespace llsf::sim {
@@ -55,7 +57,24 @@ AgentBrain::AgentBrain(Game& game, int index, AgentBrainConfig config, clips::Lo
   io.log = std::move(log);
   io.lock_events = std::move(locks);
   agent_ = std::make_unique<clips::AgentHost>(std::move(ac), std::move(io));
-  for (const std::string& f : agent_files(config.agent_files)) agent_->load_file(f);
+  for (const std::string& f : agent_files(config.agent_files)) {
+    try {
+      agent_->load_file(f);
+    } catch (const clips::AgentLoadError& e) {
+      // The lock template exists only with the lock protocol on: name the switch.
+      const std::string what = e.what();
+      std::ifstream in(f, std::ios::binary);
+      const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+      if (!config.locks && (what.find("deftemplate lock") != std::string::npos ||
+                            text.find("(lock (") != std::string::npos)) {
+        throw clips::AgentLoadError(
+            what +
+            "\nhint: the agent uses the host's lock facts, which exist only with the lock "
+            "protocol on: set `robots.locks: true` in the scenario (docs/locks.md)");
+      }
+      throw;
+    }
+  }
 }
 
 AgentBrain::~AgentBrain() = default;
