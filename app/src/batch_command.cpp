@@ -74,7 +74,8 @@ int batch(const BatchCommandOptions& o, std::ostream& out, std::ostream& err) {
   std::vector<Loaded> loaded;
   try {
     for (const std::string& path : o.scenarios) {
-      Loaded l{path, study::load_scenario(path), study::file_content_hash(path)};
+      Loaded l{path, study::load_scenario(path), ""};
+      l.hash = study::batch_identity_hash(path, l.file);
       for (const study::Scenario& s : l.file.variants) (void)study::batch_seeds(s, o.runs);
       loaded.push_back(std::move(l));
     }

@@ -182,7 +182,7 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
       key.kind = study::BatchKey::Kind::kRun;
       key.scenario_file = o.scenario;
       key.scenario_name = s->name;
-      key.scenario_hash = study::file_content_hash(o.scenario);
+      key.scenario_hash = study::batch_identity_hash(o.scenario, file);
       key.variants = static_cast<int>(file.variants.size());
       key.seeds = s->seeds;
     } catch (const study::StatsError& e) {

@@ -10,10 +10,14 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <set>
 #include <sstream>
 
+#include "llsf/core/data_dir.h"
 #include "llsf/core/rng.h"
 #include "llsf/core/version.h"
+#include "llsf/sim/agent_brain.h"
+#include "llsf/sim/skill_brain.h"
 
 namespace llsf::study {
 
@@ -627,6 +631,40 @@ std::string file_content_hash(const std::string& path) {
   if (!in) throw StatsError(path + ": cannot read the file");
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   return hex16(core::fnv1a(std::string_view(bytes)));
+}
+
+std::string batch_identity_hash(const std::string& scenario_path, const ScenarioFile& file) {
+  namespace fs = std::filesystem;
+  std::set<std::string> files;  // sorted, each once
+  for (const Scenario& s : file.variants) {
+    for (const RobotSpec& r : s.robots) {
+      for (const std::string& f : sim::agent_files(r.agent)) files.insert(f);
+    }
+    const std::vector<std::string> dirs = s.skills.skill_dirs.empty()
+                                              ? sim::skill_library_dirs(s.game.levels.skill)
+                                              : s.skills.skill_dirs;
+    for (const std::string& d : dirs) {
+      std::error_code ec;
+      if (!fs::is_directory(d, ec)) continue;  // (the skill engine reports a missing directory)
+      for (const auto& e : fs::recursive_directory_iterator(d, ec)) {
+        if (e.is_regular_file() && e.path().extension() == ".lua") files.insert(e.path().string());
+      }
+    }
+  }
+  auto bytes_of = [](const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw StatsError(path + ": cannot read the file");
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  };
+  std::uint64_t h = core::fnv1a(std::string_view(bytes_of(scenario_path)));
+  for (const std::string& f : files) {
+    // The name relative to the data directory when inside it (a moved checkout keeps its ids).
+    const std::string data = core::data_dir() + "/";
+    const std::string name = f.starts_with(data) ? f.substr(data.size()) : f;
+    h = core::fnv1a(std::string_view(name), h);
+    h = core::fnv1a(std::string_view(bytes_of(f)), h);
+  }
+  return hex16(h);
 }
 
 std::string stored_recording_path(const std::string& db_path, const std::string& recording) {

@@ -131,9 +131,16 @@ class StatsStore {
   std::unique_ptr<Impl> impl_;
 };
 
-/// FNV-1a 64 of the file's bytes as 16 hex digits: a batch's identity. Throws StatsError if the
-/// file cannot be read.
+/// FNV-1a 64 of the file's bytes as 16 hex digits. Throws StatsError if the file cannot be read.
 std::string file_content_hash(const std::string& path);
+
+/// A batch's identity (BatchKey::scenario_hash): FNV-1a 64 over the scenario file's bytes and
+/// the names and bytes of every file its games load -- each variant's agent files (directories
+/// expanded to their *.clp files) and skill files (every *.lua under the skill directories; the
+/// skill library of the variant's skill level when the scenario names none) -- as 16 hex digits.
+/// Editing an agent or a skill makes a new batch, so a rerun plays instead of reusing old
+/// results. Throws StatsError if a file cannot be read.
+std::string batch_identity_hash(const std::string& scenario_path, const ScenarioFile& file);
 
 /// The statistics of `r` by name, in the order of docs/statistics.md: every numeric field of
 /// RunResult (points, exploration_points, ..., cpu_s, real_time_factor).
