@@ -440,7 +440,7 @@ ExperimentBatch read_batch(const std::string& name, const core::ConfigNode& n,
   b.file = p.is_absolute() ? p.string() : (dir / p).lexically_normal().string();
   try {
     b.scenario = load_scenario(b.file);
-    b.hash = file_content_hash(b.file);
+    b.hash = batch_identity_hash(b.file, b.scenario);
   } catch (const core::UserError& err) {
     n.fail(err.what());
   }

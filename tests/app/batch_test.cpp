@@ -146,7 +146,7 @@ TEST_CASE("llsfsim batch: an interrupted batch keeps its runs and the next call 
   const TempDir dir;
   const std::string scenario = write_tiny(dir);
   const llsf::study::ScenarioFile file = llsf::study::load_scenario(scenario);
-  const std::string hash = llsf::study::file_content_hash(scenario);
+  const std::string hash = llsf::study::batch_identity_hash(scenario, file);
   llsf::study::StatsStore store(dir.file("stats.db"));
 
   std::atomic<bool> stop{false};

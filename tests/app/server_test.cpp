@@ -64,8 +64,8 @@ struct Fixture {
     llsf::study::BatchOptions options;
     options.jobs = 1;
     options.recordings_dir = recordings;
-    llsf::study::run_batch(llsf::study::load_scenario(scenario),
-                           llsf::study::file_content_hash(scenario), store, options);
+    const llsf::study::ScenarioFile file = llsf::study::load_scenario(scenario);
+    llsf::study::run_batch(file, llsf::study::batch_identity_hash(scenario, file), store, options);
     runs = store.runs(1);
     write(viewer + "/index.html", "<!doctype html><title>viewer</title>");
     write(viewer + "/viewer.js", "console.log(1);");

@@ -70,7 +70,7 @@ void store_runs(StatsStore& store, const std::string& file, int runs_per_variant
   key.kind = BatchKey::Kind::kBatch;
   key.scenario_file = file;
   key.scenario_name = "x";
-  key.scenario_hash = file_content_hash(file);
+  key.scenario_hash = batch_identity_hash(file, load_scenario(file));
   key.runs_per_variant = runs_per_variant;
   key.variants = static_cast<int>(variants.size());
   const std::int64_t batch = store.open_batch(key);
@@ -467,7 +467,7 @@ TEST_CASE("experiment: an incomplete or missing batch is evaluated with what is 
     key.kind = BatchKey::Kind::kBatch;
     key.scenario_file = f.dir.file("conf.yaml");
     key.scenario_name = "conf";
-    key.scenario_hash = file_content_hash(key.scenario_file);
+    key.scenario_hash = batch_identity_hash(key.scenario_file, load_scenario(key.scenario_file));
     key.runs_per_variant = 4;
     key.variants = 4;
     const std::int64_t b = store.open_batch(key);
@@ -482,7 +482,7 @@ TEST_CASE("experiment: an incomplete or missing batch is evaluated with what is 
     }
     key.runs_per_variant = 2;  // the sweep file played with --runs 2
     key.scenario_file = f.dir.file("sweep.yaml");
-    key.scenario_hash = file_content_hash(key.scenario_file);
+    key.scenario_hash = batch_identity_hash(key.scenario_file, load_scenario(key.scenario_file));
     store.open_batch(key);
   }
   const Experiment e = load_experiment(f.experiment(

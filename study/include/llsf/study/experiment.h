@@ -23,7 +23,7 @@ struct ExperimentBatch {
   std::string file_as_given;  ///< as written in the experiment file
   std::string where;          ///< "file:line:column" of its entry (for errors)
   ScenarioFile scenario;      ///< loaded and expanded
-  std::string hash;           ///< file_content_hash(file): the batch's identity in a store
+  std::string hash;  ///< batch_identity_hash(file, scenario): the batch's identity in a store
   /// The values of each matrix axis (ScenarioFile::axes' order), in file order.
   std::vector<std::vector<std::string>> axis_values;
   /// Per variant (ScenarioFile::variants' order): its value of each axis.

@@ -38,7 +38,7 @@ struct BatchKey {
   Kind kind = Kind::kBatch;
   std::string scenario_file;  ///< the path as given (metadata)
   std::string scenario_name;
-  std::string scenario_hash;  ///< file_content_hash() of the scenario file (identity)
+  std::string scenario_hash;  ///< batch_identity_hash(): scenario, agent and skill files (identity)
   int runs_per_variant = 0;   ///< identity; 0 for kRun
   int variants = 1;
   std::vector<std::uint64_t> seeds;  ///< the first variant's seeds (metadata)
