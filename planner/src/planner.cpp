@@ -428,7 +428,10 @@ const Place* Planner::place(std::string_view name) const {
   return nullptr;
 }
 
-PlanResult Planner::plan(const PlanRequest& request) { return impl_->plan(request); }
+PlanResult Planner::plan(const PlanRequest& request) {
+  ++plan_count_;
+  return impl_->plan(request);
+}
 
 bool Planner::is_free(const Vec2& p, std::span<const DiscObstacle> obstacles,
                       double obstacle_clearance_m) const {

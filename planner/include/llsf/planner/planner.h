@@ -89,6 +89,8 @@ class Planner {
   /// Plans from request.start to request.goal. Allocates; meant for a few hundred queries per
   /// game, not for every step.
   PlanResult plan(const PlanRequest& request);
+  /// The number of plan() calls so far, whatever their outcome.
+  std::int64_t plan_count() const { return plan_count_; }
 
   /// True if a robot centred at `p` keeps the inflated radius from static obstacles and walls,
   /// and radius + clearance from the discs (hand-written check, the planner's hot path).
@@ -103,6 +105,7 @@ class Planner {
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+  std::int64_t plan_count_ = 0;
 };
 
 }  // namespace llsf::planner
