@@ -99,7 +99,8 @@ class Planner {
   /// True if the straight segment [a, b] is free in the same sense (exact, not sampled).
   bool is_segment_free(const Vec2& a, const Vec2& b, std::span<const DiscObstacle> obstacles = {},
                        double obstacle_clearance_m = 0.0) const;
-  /// Exact distance from `p` to the nearest static obstacle or wall (FCL distance query).
+  /// The nearest static obstacle or wall of `p` and its exact signed distance (hand-written
+  /// geometry of the static map, as the hot-path checks).
   Clearance clearance(const Vec2& p) const;
 
  private:
