@@ -12,6 +12,8 @@ namespace llsf::comm {
 
 namespace {
 
+constexpr std::size_t kFrameReserveBytes = 2048;
+
 /// Min-heap order on (due, seq): std::push_heap keeps the *largest* on top, so invert.
 struct Later {
   template <class P>
@@ -156,7 +158,9 @@ int Hub::acquire_frame() {
     free_frames_.pop_back();
     return f;
   }
-  frames_.emplace_back();
+  // A new frame has room for every message of a 2013 game, so that a frame reused for a larger
+  // message than before (an OrderInfo after a late order) does not allocate in the tick.
+  frames_.emplace_back().bytes.reserve(kFrameReserveBytes);
   return static_cast<int>(frames_.size()) - 1;
 }
 

@@ -437,7 +437,7 @@ VelocityCommand Navigator::start_backoff(core::SimTime now, const Pose2D& pose,
           const Vec2 target = p + d * dist;
           if (!usable(target)) continue;
           if (std::abs(dist * std::sin(a)) >= lateral) {
-            follower_.set_path(Path{{p, target}, pose.theta}, forward_);
+            follower_.set_segment(p, target, pose.theta, forward_);
             return follower_.update(pose, dt);
           }
           if (!partial && dist >= 0.3) partial = target;
@@ -450,11 +450,11 @@ VelocityCommand Navigator::start_backoff(core::SimTime now, const Pose2D& pose,
       if (usable(p + away * dist)) partial = p + away * dist;
     }
     if (partial) {
-      follower_.set_path(Path{{p, *partial}, pose.theta}, forward_);
+      follower_.set_segment(p, *partial, pose.theta, forward_);
       return follower_.update(pose, dt);
     }
   }
-  follower_.set_path(Path{{p, p}, pose.theta});
+  follower_.set_segment(p, p, pose.theta);
   return follower_.brake(pose, dt);
 }
 

@@ -24,9 +24,21 @@ constexpr double kForwardCone = 1.2;  // rad: forward mode turns on the spot bey
 PathFollower::PathFollower(const ControllerConfig& config) : config_(config) {}
 
 void PathFollower::set_path(Path path, bool forward) {
-  forward_ = forward;
   LLSF_DEMAND(path.points.size() >= 2);
   path_ = std::move(path);
+  start(forward);
+}
+
+void PathFollower::set_segment(const Vec2& from, const Vec2& to, double goal_theta, bool forward) {
+  path_.points.clear();
+  path_.points.push_back(from);
+  path_.points.push_back(to);
+  path_.goal_theta = goal_theta;
+  start(forward);
+}
+
+void PathFollower::start(bool forward) {
+  forward_ = forward;
   const auto& pts = path_.points;
   const int n = static_cast<int>(pts.size());
   cum_.assign(n, 0.0);

@@ -30,7 +30,6 @@
 #include <limits>
 #include <mutex>
 
-#include "fcl_distance.h"
 #include "llsf/core/assert.h"
 #include "llsf/core/rng.h"
 #include "places.h"
@@ -195,7 +194,6 @@ struct Planner::Impl {
   FieldMap field;
   PlannerConfig config;
   StaticMap map;
-  detail::FclDistance fcl;
   std::vector<Place> places;
   QueryContext query;
   ob::SpaceInformationPtr si;
@@ -206,7 +204,6 @@ struct Planner::Impl {
       : field(std::move(f)),
         config(std::move(c)),
         map(field, config.inflated_radius_m()),
-        fcl(map),
         places(detail::derive_places(field, config.places, map)) {
     static std::once_flag quiet;
     std::call_once(quiet, [] { ompl::msg::setLogLevel(ompl::msg::LOG_WARN); });
@@ -263,8 +260,7 @@ struct Planner::Impl {
 
   Clearance clearance(const Vec2& p) const {
     int which = 0;
-    double d = fcl.distance(p, &which);
-    if (d <= 0.0) d = map.signed_distance(p, &which);  // inside: the depth, by hand
+    const double d = map.signed_distance(p, &which);
     return {d, map.obstacle_name(which)};
   }
 
@@ -428,7 +424,10 @@ const Place* Planner::place(std::string_view name) const {
   return nullptr;
 }
 
-PlanResult Planner::plan(const PlanRequest& request) { return impl_->plan(request); }
+PlanResult Planner::plan(const PlanRequest& request) {
+  ++plan_count_;
+  return impl_->plan(request);
+}
 
 bool Planner::is_free(const Vec2& p, std::span<const DiscObstacle> obstacles,
                       double obstacle_clearance_m) const {

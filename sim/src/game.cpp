@@ -297,12 +297,21 @@ void Game::apply_symbolic(int robot) {
 void Game::step() {
   // Optional profile of the tick's steps (steady clock; a measurement, never a game input).
   std::chrono::steady_clock::time_point last;
-  if (profiling_) last = std::chrono::steady_clock::now();
+  std::int64_t last_count = 0;
+  if (profiling_) {
+    last = std::chrono::steady_clock::now();
+    if (profile_counter_ != nullptr) last_count = profile_counter_();
+  }
   auto mark = [&](int step) {
     if (!profiling_) return;
     const auto t = std::chrono::steady_clock::now();
     profile_.ns[static_cast<std::size_t>(step)] += (t - last).count();
     last = t;
+    if (profile_counter_ != nullptr) {
+      const std::int64_t c = profile_counter_();
+      profile_.counts[static_cast<std::size_t>(step)] += c - last_count;
+      last_count = c;
+    }
   };
 
   // 1. Time advances by the physics step; everything in this tick happens at `now`.

@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: MIT
-// Planner: map, places, queries, clearance, determinism.
+// Planner: map, places, queries, clearance (FCL as the oracle), determinism.
 #include <doctest/doctest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <thread>
 
-#include "fcl_distance.h"
+#include "fcl_oracle.h"
 #include "llsf/core/error.h"
 #include "static_map.h"
 #include "world_fixture.h"
@@ -69,7 +69,7 @@ std::vector<Vec2> free_grid(const Planner& p, double step) {
 TEST_CASE("the static map's exact checks agree with FCL and with the world's geometry") {
   const FieldMap f = field_from_world(world2013());
   const detail::StaticMap map(f, 0.26);
-  const detail::FclDistance fcl(map);
+  const test::FclOracle fcl(map);
   core::RandomStream rng(7);
   int inside = 0;
   for (int k = 0; k < 2000; ++k) {
@@ -103,6 +103,72 @@ TEST_CASE("segment checks are exact: a segment grazing a box corner") {
   CHECK_FALSE(map.segment_free(c + n * 0.199 - dir, c + n * 0.199 + dir));
   // Both ends free, the middle crosses the box.
   CHECK_FALSE(map.segment_free({1.0, 2.0}, {3.0, 2.0}));
+}
+
+TEST_CASE("the FCL oracle measures segments: a box beside, across and at its corner") {
+  FieldMap f;
+  f.obstacles.push_back({"box", OrientedBox{Pose2D{2.0, 2.0, 0.0}, Vec2(0.1, 0.1)}});
+  const detail::StaticMap map(f, 0.2);
+  const test::FclOracle fcl(map);
+  int which = -9;
+  CHECK(fcl.segment_distance({1.5, 2.3}, {2.5, 2.3}, &which) == doctest::Approx(0.2).epsilon(1e-6));
+  CHECK(which == 0);
+  CHECK(fcl.segment_distance({1.5, 2.0}, {2.5, 2.0}) == 0.0);  // through the box
+  // Diagonally past the corner (2.1, 2.1) at 0.2 m.
+  const Vec2 n = Vec2(1.0, 1.0).normalized(), dir = Vec2(1.0, -1.0).normalized();
+  const Vec2 c = Vec2(2.1, 2.1) + 0.2 * n;
+  CHECK(fcl.segment_distance(c - dir, c + dir) == doctest::Approx(0.2).epsilon(1e-6));
+  CHECK(test::FclOracle::segment_disc_distance({0.0, 1.0}, {2.0, 1.0}, {1.0, 1.5}, 0.26) ==
+        doctest::Approx(0.24).epsilon(1e-6));
+  CHECK(test::FclOracle::segment_disc_distance({0.0, 1.0}, {2.0, 1.0}, {1.0, 1.2}, 0.26) == 0.0);
+}
+
+TEST_CASE("planned paths: the robot's footprint swept along them, checked with FCL") {
+  // Every segment of every found path, as a capsule, against FCL's walls and boxes and against
+  // the other robots as cylinders: the swept footprint keeps the inflated radius from the map
+  // and radius + clearance from the discs (FCL's GJK distance, to 1 um). Paths graze the limit:
+  // asking 1 mm more fails 7 segments.
+  Planner& p = shared_planner();
+  const detail::StaticMap map(field_from_world(world2013()), p.config().inflated_radius_m());
+  const test::FclOracle fcl(map);
+  const auto pts = free_grid(p, 0.3);
+  core::RandomStream rng(11);
+  const double r = p.config().inflated_radius_m();
+  constexpr double kClearance = 0.05;
+  constexpr double kTol = 1e-6;
+  int found = 0, around = 0;
+  for (int k = 0; k < 200; ++k) {
+    const Vec2& a = pts[rng.uniform_int(0, static_cast<int>(pts.size()) - 1)];
+    const Vec2& b = pts[rng.uniform_int(0, static_cast<int>(pts.size()) - 1)];
+    // Up to three other robots, off the start and the goal.
+    std::vector<DiscObstacle> discs;
+    const int n = rng.uniform_int(0, 3);
+    while (static_cast<int>(discs.size()) < n) {
+      const Vec2& c = pts[rng.uniform_int(0, static_cast<int>(pts.size()) - 1)];
+      if ((c - a).norm() > 2 * r + kClearance + 0.1 && (c - b).norm() > 2 * r + kClearance + 0.1) {
+        discs.push_back({static_cast<int>(discs.size()), c, r});
+      }
+    }
+    const PlanResult res =
+        p.plan({{a.x(), a.y(), 0.0}, {b.x(), b.y(), 1.0}, discs, kClearance, rng.next_u64()});
+    if (res.status != PlanStatus::kFound) continue;
+    ++found;
+    if (!discs.empty()) ++around;
+    for (std::size_t i = 1; i < res.path.points.size(); ++i) {
+      const Vec2& s0 = res.path.points[i - 1];
+      const Vec2& s1 = res.path.points[i];
+      int which = 0;
+      const double d = fcl.segment_distance(s0, s1, &which);
+      INFO("query ", k, " segment ", i, " nearest ", map.obstacle_name(which));
+      CHECK(d >= r - kTol);
+      for (const DiscObstacle& o : discs) {
+        CHECK(test::FclOracle::segment_disc_distance(s0, s1, o.position, o.radius_m) >=
+              r + kClearance - kTol);
+      }
+    }
+  }
+  CHECK(found > 150);
+  CHECK(around > 100);
 }
 
 TEST_CASE("places: names, poses facing the devices, and the held puck in the RFID zone") {

@@ -29,6 +29,9 @@ class PathFollower {
   /// `forward`: face along the path and never drive backwards (a robot carrying a puck; the
   /// assisted holder lets go when driven backwards), turning to the goal heading at the end.
   void set_path(Path path, bool forward = false);
+  /// set_path with the straight path [from, to] and `goal_theta`, in the memory of the current
+  /// path (a back-off step allocates nothing).
+  void set_segment(const Vec2& from, const Vec2& to, double goal_theta, bool forward = false);
   bool forward() const { return forward_; }
   const Path& path() const { return path_; }
   bool has_path() const { return !path_.points.empty(); }
@@ -59,6 +62,8 @@ class PathFollower {
   const std::vector<double>& vertex_arc() const { return cum_; }
 
  private:
+  /// Starts following path_ from its beginning (arc lengths and corner speeds).
+  void start(bool forward);
   VelocityCommand output(const Pose2D& pose, const Vec2& v_world_target, double omega_target,
                          double dt_s);
   void project(const Vec2& p);

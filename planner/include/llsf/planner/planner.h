@@ -89,6 +89,8 @@ class Planner {
   /// Plans from request.start to request.goal. Allocates; meant for a few hundred queries per
   /// game, not for every step.
   PlanResult plan(const PlanRequest& request);
+  /// The number of plan() calls so far, whatever their outcome.
+  std::int64_t plan_count() const { return plan_count_; }
 
   /// True if a robot centred at `p` keeps the inflated radius from static obstacles and walls,
   /// and radius + clearance from the discs (hand-written check, the planner's hot path).
@@ -97,12 +99,14 @@ class Planner {
   /// True if the straight segment [a, b] is free in the same sense (exact, not sampled).
   bool is_segment_free(const Vec2& a, const Vec2& b, std::span<const DiscObstacle> obstacles = {},
                        double obstacle_clearance_m = 0.0) const;
-  /// Exact distance from `p` to the nearest static obstacle or wall (FCL distance query).
+  /// The nearest static obstacle or wall of `p` and its exact signed distance (hand-written
+  /// geometry of the static map, as the hot-path checks).
   Clearance clearance(const Vec2& p) const;
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+  std::int64_t plan_count_ = 0;
 };
 
 }  // namespace llsf::planner

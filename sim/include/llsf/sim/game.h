@@ -147,11 +147,17 @@ class Game {
   struct TickProfile {
     static constexpr int kSteps = 9;
     std::array<std::int64_t, kSteps> ns{};
+    /// With a profile counter set: its increase per tick step, summed (e.g. heap allocations).
+    std::array<std::int64_t, kSteps> counts{};
     std::int64_t ticks = 0;
     /// "actuators+navigation", "world", "refbox", "radio", "sensors", "skills", "agents", ...
     static const char* step_name(int step);
   };
   void enable_profile(bool on) { profiling_ = on; }
+  /// A monotonic counter read at every tick step boundary while profiling, its increases summed
+  /// in TickProfile::counts (tests/sim/alloc_test.cpp: a count of heap allocations); nullptr:
+  /// none. Must not allocate.
+  void set_profile_counter(std::int64_t (*counter)()) { profile_counter_ = counter; }
   const TickProfile& profile() const { return profile_; }
 
  private:
@@ -213,6 +219,7 @@ class Game {
   std::int64_t refbox_rejected_ = 0;
   std::int64_t controller_rejected_ = 0;
   bool profiling_ = false;
+  std::int64_t (*profile_counter_)() = nullptr;
   TickProfile profile_;
 };
 
