@@ -36,8 +36,9 @@ std::string num(double v) { return core::number_text(v); }
   throw ConfigError(path + ": " + reason);
 }
 
-void require_non_negative(const std::string& path, SimTime t) {
-  if (t.ns() < 0) fail(path, "must be >= 0 (got " + num(t.seconds() * 1e3) + " ms)");
+/// A delay given in ms (the key says so) must not be negative.
+void require_delay(const std::string& path, SimTime t) {
+  core::require(path, t.seconds() * 1e3, core::non_negative());
 }
 
 /// In the burst model a link with long-run loss p and mean burst length L enters the bad state
@@ -62,8 +63,8 @@ void HubConfig::validate() const {
   if (loss_model == LossModel::kBurst) {
     require_burst_feasible("loss.probability", loss_probability, mean_burst_length);
   }
-  require_non_negative("delay.fixed_ms", delay.fixed);
-  require_non_negative("delay.jitter_ms", delay.jitter);
+  require_delay("delay.fixed_ms", delay.fixed);
+  require_delay("delay.jitter_ms", delay.jitter);
   core::require("max_frame_bytes", max_frame_bytes, core::in_range(kHeaderSize, 65507));
   for (std::size_t i = 0; i < links.size(); ++i) {
     const LinkConfig& l = links[i];
@@ -82,8 +83,8 @@ void HubConfig::validate() const {
         require_burst_feasible(p + ".loss_probability", *l.loss_probability, mean_burst_length);
       }
     }
-    if (l.delay_fixed) require_non_negative(p + ".fixed_ms", *l.delay_fixed);
-    if (l.delay_jitter) require_non_negative(p + ".jitter_ms", *l.delay_jitter);
+    if (l.delay_fixed) require_delay(p + ".fixed_ms", *l.delay_fixed);
+    if (l.delay_jitter) require_delay(p + ".jitter_ms", *l.delay_jitter);
   }
   for (std::size_t i = 0; i < outages.size(); ++i) {
     const OutageConfig& o = outages[i];

@@ -16,7 +16,10 @@ namespace llsf::core {
 
 std::string number_text(double v) {
   char buf[64];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  // Whole numbers in full ("100000", not the shorter "1e+05").
+  const bool whole = std::abs(v) < 1e15 && v == std::trunc(v);
+  const auto r = whole ? std::to_chars(buf, buf + sizeof buf, v, std::chars_format::fixed)
+                       : std::to_chars(buf, buf + sizeof buf, v);
   return std::string(buf, r.ptr);
 }
 
@@ -229,12 +232,6 @@ void ConfigNode::no_other_keys() const {
   }
 }
 
-void ConfigNode::check_keys(std::initializer_list<std::string_view> allowed) const {
-  if (!is_map()) return;
-  for (auto a : allowed) impl_->asked->ask(impl_->path, a);
-  no_other_keys();
-}
-
 double ConfigNode::as_double() const {
   if (!is_scalar()) fail("expected a number, got " + describe(impl_->node));
   const std::string& s = impl_->node.Scalar();
@@ -279,6 +276,18 @@ std::string ConfigNode::as_string() const {
   return impl_->node.Scalar();
 }
 
+double ConfigNode::as_double(const Bound& bound) const {
+  const double v = as_double();
+  if (std::string why = bound.violation(v); !why.empty()) fail(why);
+  return v;
+}
+
+std::int64_t ConfigNode::as_int(const Bound& bound) const {
+  const std::int64_t v = as_int();
+  if (std::string why = bound.violation(static_cast<double>(v)); !why.empty()) fail(why);
+  return v;
+}
+
 void ConfigNode::read(std::string_view key, double& out) const {
   if (auto c = (*this)[key]; c.defined()) out = c.as_double();
 }
@@ -299,11 +308,7 @@ void ConfigNode::read(std::string_view key, std::string& out) const {
   if (auto c = (*this)[key]; c.defined()) out = c.as_string();
 }
 void ConfigNode::read(std::string_view key, double& out, const Bound& bound) const {
-  if (auto c = (*this)[key]; c.defined()) {
-    const double v = c.as_double();
-    if (std::string why = bound.violation(v); !why.empty()) c.fail(why);
-    out = v;
-  }
+  if (auto c = (*this)[key]; c.defined()) out = c.as_double(bound);
 }
 void ConfigNode::read(std::string_view key, int& out, const Bound& bound) const {
   if (auto c = (*this)[key]; c.defined()) {

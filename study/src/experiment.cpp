@@ -51,11 +51,15 @@ const std::vector<std::string>& known_statistics() {
   return names;
 }
 
-std::string required_string(const core::ConfigNode& map, std::string_view key) {
+/// The non-empty string under `key`; "missing key 'key'" at `map` if absent. `node`, if given,
+/// becomes the value's node (for later errors about the value).
+std::string required_string(const core::ConfigNode& map, std::string_view key,
+                            core::ConfigNode* node = nullptr) {
   const core::ConfigNode n = map[key];
   if (!n.defined()) map.fail("missing key '" + std::string(key) + "'");
   const std::string s = n.as_string();
   if (s.empty()) n.fail("must not be empty");
+  if (node != nullptr) *node = n;
   return s;
 }
 
@@ -84,7 +88,8 @@ std::vector<std::string> split_variant(const std::string& variant,
 }
 
 const ExperimentBatch& batch_of(const Experiment& e, const core::ConfigNode& node, int* index) {
-  const std::string name = required_string(node, "batch");
+  core::ConfigNode at;
+  const std::string name = required_string(node, "batch", &at);
   for (std::size_t i = 0; i < e.batches.size(); ++i) {
     if (e.batches[i].name == name) {
       *index = static_cast<int>(i);
@@ -93,7 +98,7 @@ const ExperimentBatch& batch_of(const Experiment& e, const core::ConfigNode& nod
   }
   std::vector<std::string> names;
   for (const ExperimentBatch& b : e.batches) names.push_back(b.name);
-  node["batch"].fail("unknown batch '" + name + "' (batches: " + join(names, ", ") + ")");
+  at.fail("unknown batch '" + name + "' (batches: " + join(names, ", ") + ")");
 }
 
 /// Checks that `axis` is one of the batch's axes.
@@ -134,11 +139,12 @@ AxisFilter read_filter(const Experiment& e, const ExperimentBatch& b, const core
 }
 
 std::string read_statistic(const core::ConfigNode& map) {
-  const std::string s = required_string(map, "statistic");
+  core::ConfigNode at;
+  const std::string s = required_string(map, "statistic", &at);
   if (!contains(known_statistics(), s)) {
-    map["statistic"].fail("unknown statistic '" + s +
-                          "' (docs/statistics.md; e.g. points, production_points, deliveries, "
-                          "first_complex_s, storage_empty_s, role_changes, jams)");
+    at.fail("unknown statistic '" + s +
+            "' (docs/statistics.md; e.g. points, production_points, deliveries, "
+            "first_complex_s, storage_empty_s, role_changes, jams)");
   }
   return s;
 }
@@ -151,15 +157,11 @@ std::pair<double, double> read_range(const core::ConfigNode& n) {
   return {lo, hi};
 }
 
-double read_share(const core::ConfigNode& n) {
-  const double v = n.as_double();
-  if (!(v >= 0.0 && v <= 1.0)) n.fail("a share must be in 0..1");
-  return v;
-}
-
-std::vector<std::string> read_groups(const Experiment& e, const core::ConfigNode& map) {
+/// The `groups` of an entry (`n`, possibly undefined); with `batch` (a calibration target, sweep or
+/// table), that batch must have the group_by axis.
+std::vector<std::string> read_groups(const Experiment& e, const core::ConfigNode& n,
+                                     const ExperimentBatch* batch) {
   std::vector<std::string> out;
-  const core::ConfigNode n = map["groups"];
   if (!n.defined()) return out;
   if (e.group_by.empty()) n.fail("groups need `group_by` at the top level");
   if (!n.is_sequence() || n.size() == 0) n.fail("expected a list of group values");
@@ -171,15 +173,39 @@ std::vector<std::string> read_groups(const Experiment& e, const core::ConfigNode
     }
     if (!contains(out, v)) out.push_back(v);
   }
+  if (batch != nullptr && batch->axis_index(e.group_by) < 0) {
+    n.fail("batch '" + batch->name + "' has no axis '" + e.group_by + "'");
+  }
   return out;
+}
+
+/// The end of a sweep or table: every axis of its batch other than `free` (the swept and
+/// compared axes, or the rows) and the group_by axis must be fixed by `fixed` -- a statistic
+/// over pooled variants would mean nothing (`free_are` names the free axes in the message) --
+/// and its `groups`.
+std::vector<std::string> read_fixed_rest_and_groups(const Experiment& e, const ExperimentBatch& b,
+                                                    const core::ConfigNode& n,
+                                                    const AxisFilter& fixed,
+                                                    const std::vector<std::string>& free,
+                                                    std::string_view free_are) {
+  for (const std::string& axis : b.scenario.axes) {
+    if (contains(free, axis) || axis == e.group_by) continue;
+    const bool is_fixed =
+        std::any_of(fixed.begin(), fixed.end(), [&](const auto& f) { return f.first == axis; });
+    if (!is_fixed) {
+      n.fail("axis '" + axis + "' of batch '" + b.name + "' is neither " + std::string(free_are) +
+             " nor fixed: give it in `where: {" + axis + ": ...}`");
+    }
+  }
+  return read_groups(e, n["groups"], &b);
 }
 
 /// ignore_below and above of a selection; `above` only where a share is taken.
 void read_selection_options(const core::ConfigNode& map, bool share, Selection& sel) {
-  if (map["ignore_below"].defined()) sel.ignore_below = map["ignore_below"].as_double();
-  if (map["above"].defined()) {
-    if (!share) map["above"].fail("only share_at_most and share_at_least take `above`");
-    sel.above = map["above"].as_double();
+  if (const core::ConfigNode n = map["ignore_below"]; n.defined()) sel.ignore_below = n.as_double();
+  if (const core::ConfigNode n = map["above"]; n.defined()) {
+    if (!share) n.fail("only share_at_most and share_at_least take `above`");
+    sel.above = n.as_double();
   }
 }
 
@@ -205,7 +231,7 @@ std::optional<Check::Kind> kind_of(const std::string& s) {
 /// Sets a check's bound from the node of its range or share value.
 void read_bound(Check& c, const core::ConfigNode& n) {
   if (is_share(c.kind)) {
-    const double v = read_share(n);
+    const double v = n.as_double(core::probability());
     c.low = c.kind == Check::Kind::kShareAtLeast ? v : 0.0;
     c.high = c.kind == Check::Kind::kShareAtMost ? v : 1.0;
   } else {
@@ -213,12 +239,13 @@ void read_bound(Check& c, const core::ConfigNode& n) {
   }
 }
 
-CalibrationTarget read_target(const Experiment& e, const core::ConfigNode& n) {
+CalibrationTarget read_target(const Experiment& e, const core::ConfigNode& n,
+                              std::set<std::string>& names) {
   n.require_map();
-  n.check_keys({"name", "source", "batch", "where", "groups", "statistic", "ignore_below", "above",
-                "mean_in", "median_in", "share_at_most", "share_at_least"});
   CalibrationTarget t;
-  t.name = required_string(n, "name");
+  core::ConfigNode name;
+  t.name = required_string(n, "name", &name);
+  if (!names.insert(t.name).second) name.fail("a second target of this name");
   t.source = optional_string(n, "source");
   Check& c = t.check;
   c.where = where_of(n);
@@ -227,19 +254,18 @@ CalibrationTarget read_target(const Experiment& e, const core::ConfigNode& n) {
   c.sel.statistic = read_statistic(n);
   int kinds = 0;
   for (const char* key : {"mean_in", "median_in", "share_at_most", "share_at_least"}) {
-    if (!n[key].defined()) continue;
+    const core::ConfigNode bound = n[key];
+    if (!bound.defined()) continue;
     ++kinds;
     c.kind = *kind_of(key);
-    read_bound(c, n[key]);
+    read_bound(c, bound);
   }
   if (kinds != 1) {
     n.fail("give exactly one of mean_in, median_in, share_at_most, share_at_least");
   }
   read_selection_options(n, is_share(c.kind), c.sel);
-  t.groups = read_groups(e, n);
-  if (!t.groups.empty() && b.axis_index(e.group_by) < 0) {
-    n["groups"].fail("batch '" + b.name + "' has no axis '" + e.group_by + "'");
-  }
+  t.groups = read_groups(e, n["groups"], &b);
+  n.no_other_keys();
   return t;
 }
 
@@ -263,51 +289,53 @@ Check read_check(const Experiment& e, const core::ConfigNode& entry) {
   Check c;
   c.kind = *kind;
   c.where = where_of(n);
-  if (is_comparison(c.kind)) {
-    if (c.kind == Check::Kind::kDifferenceIn) {
-      n.check_keys({"batch", "statistic", "a", "b", "ignore_below", "range"});
-    } else {
-      n.check_keys({"batch", "statistic", "a", "b", "ignore_below"});
-    }
-  } else if (is_share(c.kind)) {
-    n.check_keys({"batch", "where", "statistic", "ignore_below", "above", "value"});
-  } else {
-    n.check_keys({"batch", "where", "statistic", "ignore_below", "range"});
-  }
   const ExperimentBatch& b = batch_of(e, n, &c.sel.batch);
   c.sel.statistic = read_statistic(n);
   read_selection_options(n, is_share(c.kind), c.sel);
+  // Each kind asks for its own keys -- a comparison `a` and `b` (and a difference `range`), the
+  // others `where` and `range` or a share's `value` -- before no_other_keys().
   if (is_comparison(c.kind)) {
-    if (!n["a"].defined()) n.fail("missing key 'a' (the axis values of the first side)");
-    if (!n["b"].defined()) n.fail("missing key 'b' (the axis values of the second side)");
-    c.a = read_filter(e, b, n["a"]);
-    c.b = read_filter(e, b, n["b"]);
+    const core::ConfigNode a = n["a"];
+    const core::ConfigNode bn = n["b"];
+    const core::ConfigNode range =
+        c.kind == Check::Kind::kDifferenceIn ? n["range"] : core::ConfigNode();
+    n.no_other_keys();
+    if (!a.defined()) n.fail("missing key 'a' (the axis values of the first side)");
+    if (!bn.defined()) n.fail("missing key 'b' (the axis values of the second side)");
+    c.a = read_filter(e, b, a);
+    c.b = read_filter(e, b, bn);
     if (c.a == c.b) n.fail("'a' and 'b' select the same runs");
     if (c.kind == Check::Kind::kDifferenceIn) {
-      if (!n["range"].defined()) n.fail("missing key 'range' ([low, high])");
-      read_bound(c, n["range"]);
+      if (!range.defined()) n.fail("missing key 'range' ([low, high])");
+      read_bound(c, range);
     }
   } else {
-    c.a = read_filter(e, b, n["where"]);
-    const char* bound = is_share(c.kind) ? "value" : "range";
-    if (!n[bound].defined()) {
-      n.fail(std::string("missing key '") + bound + "'" +
+    const core::ConfigNode where = n["where"];
+    const char* bound_key = is_share(c.kind) ? "value" : "range";
+    const core::ConfigNode bound = n[bound_key];
+    n.no_other_keys();
+    c.a = read_filter(e, b, where);
+    if (!bound.defined()) {
+      n.fail(std::string("missing key '") + bound_key + "'" +
              (is_share(c.kind) ? " (the share, 0..1)" : " ([low, high])"));
     }
-    read_bound(c, n[bound]);
+    read_bound(c, bound);
   }
   return c;
 }
 
-Finding read_finding(const Experiment& e, const core::ConfigNode& n) {
+Finding read_finding(const Experiment& e, const core::ConfigNode& n, std::set<std::string>& ids) {
   n.require_map();
-  n.check_keys({"id", "claim", "source", "groups", "checks"});
   Finding f;
-  f.id = required_string(n, "id");
+  core::ConfigNode id;
+  f.id = required_string(n, "id", &id);
+  if (!ids.insert(f.id).second) id.fail("a second finding of this id");
   f.claim = required_string(n, "claim");
   f.source = optional_string(n, "source");
-  f.groups = read_groups(e, n);
+  const core::ConfigNode groups = n["groups"];
+  f.groups = read_groups(e, groups, nullptr);
   const core::ConfigNode checks = n["checks"];
+  n.no_other_keys();
   if (!checks.defined()) n.fail("missing key 'checks'");
   if (!checks.is_sequence() || checks.size() == 0) checks.fail("expected a list of checks");
   for (const core::ConfigNode& c : checks.elements()) f.checks.push_back(read_check(e, c));
@@ -315,79 +343,70 @@ Finding read_finding(const Experiment& e, const core::ConfigNode& n) {
     return e.batches[static_cast<std::size_t>(c.sel.batch)].axis_index(e.group_by) >= 0;
   });
   if (!f.groups.empty() && !grouped) {
-    n["groups"].fail("none of the checks' batches has an axis '" + e.group_by + "'");
+    groups.fail("none of the checks' batches has an axis '" + e.group_by + "'");
   }
   return f;
 }
 
-Sweep read_sweep(const Experiment& e, const core::ConfigNode& n) {
+Sweep read_sweep(const Experiment& e, const core::ConfigNode& n, std::set<std::string>& names) {
   n.require_map();
-  n.check_keys({"name", "source", "batch", "axis", "compare", "statistic", "baseline", "where",
-                "groups", "ignore_below"});
   Sweep s;
-  s.name = required_string(n, "name");
+  core::ConfigNode name;
+  s.name = required_string(n, "name", &name);
+  if (!names.insert(s.name).second) name.fail("a second sweep of this name");
   s.source = optional_string(n, "source");
   s.where = where_of(n);
   const ExperimentBatch& b = batch_of(e, n, &s.sel.batch);
   s.sel.statistic = read_statistic(n);
   read_selection_options(n, false, s.sel);
-  s.axis = required_string(n, "axis");
-  require_axis(b, s.axis, n["axis"]);
-  s.compare = required_string(n, "compare");
-  require_axis(b, s.compare, n["compare"]);
-  if (s.compare == s.axis) n["compare"].fail("must be another axis than `axis`");
-  for (const char* key : {"axis", "compare"}) {
-    if (n[key].as_string() == e.group_by) {
-      n[key].fail("'" + e.group_by + "' is the group_by axis (sweeps are evaluated per group)");
+  core::ConfigNode axis_node;
+  s.axis = required_string(n, "axis", &axis_node);
+  require_axis(b, s.axis, axis_node);
+  core::ConfigNode compare_node;
+  s.compare = required_string(n, "compare", &compare_node);
+  require_axis(b, s.compare, compare_node);
+  if (s.compare == s.axis) compare_node.fail("must be another axis than `axis`");
+  for (const core::ConfigNode& a : {axis_node, compare_node}) {
+    if (a.as_string() == e.group_by) {
+      a.fail("'" + e.group_by + "' is the group_by axis (sweeps are evaluated per group)");
     }
   }
   const auto& rows = b.axis_values[static_cast<std::size_t>(b.axis_index(s.axis))];
   s.baseline = rows.front();
-  if (n["baseline"].defined()) {
-    s.baseline = n["baseline"].as_string();
-    require_value(b, s.axis, s.baseline, n["baseline"]);
+  if (const core::ConfigNode baseline = n["baseline"]; baseline.defined()) {
+    s.baseline = baseline.as_string();
+    require_value(b, s.axis, s.baseline, baseline);
   }
-  s.fixed = read_filter(e, b, n["where"]);
+  const core::ConfigNode where = n["where"];
+  s.fixed = read_filter(e, b, where);
   for (const auto& [axis, value] : s.fixed) {
     if (axis == s.axis || axis == s.compare) {
-      n["where"][axis].fail("'" + axis + "' is swept or compared; it cannot be fixed");
+      where[axis].fail("'" + axis + "' is swept or compared; it cannot be fixed");
     }
   }
-  // Every other axis must be fixed: a ranking over pooled variants would mean nothing.
-  for (const std::string& axis : b.scenario.axes) {
-    if (axis == s.axis || axis == s.compare || axis == e.group_by) continue;
-    const bool fixed =
-        std::any_of(s.fixed.begin(), s.fixed.end(), [&](const auto& f) { return f.first == axis; });
-    if (!fixed) {
-      n.fail("axis '" + axis + "' of batch '" + b.name +
-             "' is neither swept, compared nor fixed: give it in `where: {" + axis + ": ...}`");
-    }
-  }
-  s.groups = read_groups(e, n);
-  if (!s.groups.empty() && b.axis_index(e.group_by) < 0) {
-    n["groups"].fail("batch '" + b.name + "' has no axis '" + e.group_by + "'");
-  }
+  s.groups = read_fixed_rest_and_groups(e, b, n, s.fixed, {s.axis, s.compare}, "swept, compared");
+  n.no_other_keys();
   return s;
 }
 
-Table read_table(const Experiment& e, const core::ConfigNode& n) {
+Table read_table(const Experiment& e, const core::ConfigNode& n, std::set<std::string>& names) {
   n.require_map();
-  n.check_keys({"name", "source", "batch", "rows", "values", "statistics", "where", "groups",
-                "ignore_below"});
   Table t;
-  t.name = required_string(n, "name");
+  core::ConfigNode name;
+  t.name = required_string(n, "name", &name);
+  if (!names.insert(t.name).second) name.fail("a second table of this name");
   t.source = optional_string(n, "source");
   t.where = where_of(n);
   const ExperimentBatch& b = batch_of(e, n, &t.sel.batch);
   read_selection_options(n, false, t.sel);
-  t.rows = required_string(n, "rows");
-  require_axis(b, t.rows, n["rows"]);
+  core::ConfigNode rows;
+  t.rows = required_string(n, "rows", &rows);
+  require_axis(b, t.rows, rows);
   if (t.rows == e.group_by) {
-    n["rows"].fail("'" + e.group_by + "' is the group_by axis (tables are made per group)");
+    rows.fail("'" + e.group_by + "' is the group_by axis (tables are made per group)");
   }
   const auto& all = b.axis_values[static_cast<std::size_t>(b.axis_index(t.rows))];
-  if (n["values"].defined()) {
-    const core::ConfigNode v = n["values"];
+  if (const core::ConfigNode v = n["values"]; v.defined()) {
     if (!v.is_sequence() || v.size() == 0) v.fail("expected a list of values of '" + t.rows + "'");
     for (const core::ConfigNode& x : v.elements()) {
       require_value(b, t.rows, x.as_string(), x);
@@ -407,24 +426,13 @@ Table read_table(const Experiment& e, const core::ConfigNode& n) {
     }
     t.statistics.push_back(st);
   }
-  t.fixed = read_filter(e, b, n["where"]);
+  const core::ConfigNode where = n["where"];
+  t.fixed = read_filter(e, b, where);
   for (const auto& [axis, value] : t.fixed) {
-    if (axis == t.rows) n["where"][axis].fail("'" + axis + "' makes the rows; it cannot be fixed");
+    if (axis == t.rows) where[axis].fail("'" + axis + "' makes the rows; it cannot be fixed");
   }
-  // Every other axis must be fixed: a mean over pooled variants would mean nothing.
-  for (const std::string& axis : b.scenario.axes) {
-    if (axis == t.rows || axis == e.group_by) continue;
-    const bool fixed =
-        std::any_of(t.fixed.begin(), t.fixed.end(), [&](const auto& f) { return f.first == axis; });
-    if (!fixed) {
-      n.fail("axis '" + axis + "' of batch '" + b.name +
-             "' is neither the rows nor fixed: give it in `where: {" + axis + ": ...}`");
-    }
-  }
-  t.groups = read_groups(e, n);
-  if (!t.groups.empty() && b.axis_index(e.group_by) < 0) {
-    n["groups"].fail("batch '" + b.name + "' has no axis '" + e.group_by + "'");
-  }
+  t.groups = read_fixed_rest_and_groups(e, b, n, t.fixed, {t.rows}, "the rows");
+  n.no_other_keys();
   return t;
 }
 
@@ -494,32 +502,43 @@ std::string to_string(Check::Kind k) {
 Experiment load_experiment(const std::string& path) {
   const core::ConfigNode root = core::ConfigNode::load_file(path);
   if (!root.is_map()) root.fail("an experiment file is a map (name, batches, findings, ...)");
-  root.check_keys({"name", "description", "batches", "group_by", "calibration", "findings",
-                   "sweeps", "tables"});
   Experiment e;
   e.file = path;
-  e.name = required_string(root, "name");
+  core::ConfigNode name;
+  e.name = required_string(root, "name", &name);
   for (const char c : e.name) {
     if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.')) {
-      root["name"].fail("use letters, digits, '-', '_' and '.' (it names the report's markers)");
+      name.fail("use letters, digits, '-', '_' and '.' (it names the report's markers)");
     }
   }
   e.description = optional_string(root, "description");
+  const core::ConfigNode batches = root["batches"];
+  const core::ConfigNode group_by = root["group_by"];
+  auto list = [&](std::string_view key) {
+    const core::ConfigNode n = root[key];
+    if (!n.defined() || n.is_null()) return std::vector<core::ConfigNode>{};
+    if (!n.is_sequence()) n.fail("expected a list");
+    return n.elements();
+  };
+  const std::vector<core::ConfigNode> calibration = list("calibration");
+  const std::vector<core::ConfigNode> findings = list("findings");
+  const std::vector<core::ConfigNode> sweeps = list("sweeps");
+  const std::vector<core::ConfigNode> tables = list("tables");
+  root.no_other_keys();  // before the batches are loaded, which takes a while
 
   // The batches: every scenario file loaded now, so that a bad one costs no playing time.
-  const core::ConfigNode batches = root["batches"];
   if (!batches.defined()) root.fail("missing key 'batches' (name: scenario file)");
   if (!batches.is_map() || batches.size() == 0) {
     batches.fail("expected a map of batch names to scenario files");
   }
   const std::filesystem::path dir = std::filesystem::path(path).parent_path();
-  for (const std::string& name : batches.keys()) {
-    e.batches.push_back(read_batch(name, batches[name], dir));
+  for (const std::string& batch : batches.keys()) {
+    e.batches.push_back(read_batch(batch, batches[batch], dir));
   }
 
   // The groups: the values of the group_by axis over every batch that has it.
-  if (root["group_by"].defined()) {
-    e.group_by = root["group_by"].as_string();
+  if (group_by.defined()) {
+    e.group_by = group_by.as_string();
     for (const ExperimentBatch& b : e.batches) {
       const int a = b.axis_index(e.group_by);
       if (a < 0) continue;
@@ -527,36 +546,17 @@ Experiment load_experiment(const std::string& path) {
         if (!contains(e.groups, v)) e.groups.push_back(v);
       }
     }
-    if (e.groups.empty()) root["group_by"].fail("no batch has an axis '" + e.group_by + "'");
+    if (e.groups.empty()) group_by.fail("no batch has an axis '" + e.group_by + "'");
   }
 
-  auto list = [&](std::string_view key) {
-    const core::ConfigNode n = root[key];
-    if (!n.defined() || n.is_null()) return std::vector<core::ConfigNode>{};
-    if (!n.is_sequence()) n.fail("expected a list");
-    return n.elements();
-  };
   std::set<std::string> names;
-  for (const core::ConfigNode& n : list("calibration")) {
-    e.calibration.push_back(read_target(e, n));
-    if (!names.insert(e.calibration.back().name).second)
-      n["name"].fail("a second target of this name");
-  }
+  for (const core::ConfigNode& n : calibration) e.calibration.push_back(read_target(e, n, names));
   names.clear();
-  for (const core::ConfigNode& n : list("findings")) {
-    e.findings.push_back(read_finding(e, n));
-    if (!names.insert(e.findings.back().id).second) n["id"].fail("a second finding of this id");
-  }
+  for (const core::ConfigNode& n : findings) e.findings.push_back(read_finding(e, n, names));
   names.clear();
-  for (const core::ConfigNode& n : list("sweeps")) {
-    e.sweeps.push_back(read_sweep(e, n));
-    if (!names.insert(e.sweeps.back().name).second) n["name"].fail("a second sweep of this name");
-  }
+  for (const core::ConfigNode& n : sweeps) e.sweeps.push_back(read_sweep(e, n, names));
   names.clear();
-  for (const core::ConfigNode& n : list("tables")) {
-    e.tables.push_back(read_table(e, n));
-    if (!names.insert(e.tables.back().name).second) n["name"].fail("a second table of this name");
-  }
+  for (const core::ConfigNode& n : tables) e.tables.push_back(read_table(e, n, names));
   if (e.calibration.empty() && e.findings.empty() && e.sweeps.empty() && e.tables.empty()) {
     root.fail("nothing to evaluate: give calibration targets, findings, sweeps or tables");
   }

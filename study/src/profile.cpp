@@ -2,7 +2,6 @@
 #include "llsf/study/profile.h"
 
 #include <cmath>
-#include <sstream>
 #include <stdexcept>
 
 #include "llsf/core/error.h"
@@ -11,28 +10,6 @@
 namespace llsf::study {
 
 namespace {
-
-[[noreturn]] void fail(const std::string& field, const std::string& reason) {
-  throw core::ConfigError("profile." + field + ": " + reason);
-}
-
-std::string num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
-void positive(const char* field, double v) {
-  if (!(v > 0.0) || !std::isfinite(v)) fail(field, "must be > 0 (got " + num(v) + ")");
-}
-
-void non_negative(const char* field, double v) {
-  if (!(v >= 0.0) || !std::isfinite(v)) fail(field, "must be >= 0 (got " + num(v) + ")");
-}
-
-void at_most(const char* field, double v, double max) {
-  if (v > max) fail(field, "must be at most " + num(max) + " (got " + num(v) + ")");
-}
 
 // The 2013 Carologistics Robotino as the thesis' Gazebo games show it. docs/profiles.md has the
 // same table with the reasoning; keep both in step.
@@ -89,33 +66,34 @@ RobotProfile RobotProfile::named(std::string_view name) {
 }
 
 void RobotProfile::validate() const {
-  positive("max_speed_mps", max_speed_mps);
-  positive("max_omega_rps", max_omega_rps);
-  positive("max_accel_mps2", max_accel_mps2);
-  positive("max_alpha_rps2", max_alpha_rps2);
-  at_most("max_speed_mps", max_speed_mps, 3.0);
-  non_negative("motor_max_speed_mps", motor_max_speed_mps);
-  non_negative("motor_max_omega_rps", motor_max_omega_rps);
-  non_negative("align_s", align_s);
-  at_most("align_s", align_s, 60.0);
-  positive("light_frame_rate_hz", light_frame_rate_hz);
-  at_most("light_frame_rate_hz", light_frame_rate_hz, 100.0);
-  non_negative("light_delay_s", light_delay_s);
-  at_most("light_delay_s", light_delay_s, 60.0);
-  if (!(light_error_rate >= 0.0 && light_error_rate <= 1.0))
-    fail("light_error_rate", "must be in [0, 1] (got " + num(light_error_rate) + ")");
-  positive("laser_rate_hz", laser_rate_hz);
-  at_most("laser_rate_hz", laser_rate_hz, 100.0);
-  non_negative("position_noise_m", position_noise_m);
-  non_negative("heading_noise_rad", heading_noise_rad);
-  non_negative("wait_before_replan_s", wait_before_replan_s);
-  non_negative("backoff_min_s", backoff_min_s);
-  if (!(backoff_max_s >= backoff_min_s) || !std::isfinite(backoff_max_s))
-    fail("backoff_max_s", "must be >= backoff_min_s (got " + num(backoff_max_s) + ")");
-  positive("blocked_timeout_s", blocked_timeout_s);
-  at_most("blocked_timeout_s", blocked_timeout_s, 3600.0);
-  if (!(jam_probability >= 0.0 && jam_probability <= 1.0))
-    fail("jam_probability", "must be in [0, 1] (got " + num(jam_probability) + ")");
+  const std::string p = "profile.";
+  core::require(p + "max_speed_mps", max_speed_mps, core::positive());
+  core::require(p + "max_omega_rps", max_omega_rps, core::positive());
+  core::require(p + "max_accel_mps2", max_accel_mps2, core::positive());
+  core::require(p + "max_alpha_rps2", max_alpha_rps2, core::positive());
+  core::require(p + "max_speed_mps", max_speed_mps, core::at_most(3.0));
+  core::require(p + "motor_max_speed_mps", motor_max_speed_mps, core::non_negative());
+  core::require(p + "motor_max_omega_rps", motor_max_omega_rps, core::non_negative());
+  core::require(p + "align_s", align_s, core::non_negative());
+  core::require(p + "align_s", align_s, core::at_most(60.0));
+  core::require(p + "light_frame_rate_hz", light_frame_rate_hz, core::positive());
+  core::require(p + "light_frame_rate_hz", light_frame_rate_hz, core::at_most(100.0));
+  core::require(p + "light_delay_s", light_delay_s, core::non_negative());
+  core::require(p + "light_delay_s", light_delay_s, core::at_most(60.0));
+  core::require(p + "light_error_rate", light_error_rate, core::probability());
+  core::require(p + "laser_rate_hz", laser_rate_hz, core::positive());
+  core::require(p + "laser_rate_hz", laser_rate_hz, core::at_most(100.0));
+  core::require(p + "position_noise_m", position_noise_m, core::non_negative());
+  core::require(p + "heading_noise_rad", heading_noise_rad, core::non_negative());
+  core::require(p + "wait_before_replan_s", wait_before_replan_s, core::non_negative());
+  core::require(p + "backoff_min_s", backoff_min_s, core::non_negative());
+  if (!(backoff_max_s >= backoff_min_s) || !std::isfinite(backoff_max_s)) {
+    throw core::ConfigError(p + "backoff_max_s: must be >= backoff_min_s (got " +
+                            core::number_text(backoff_max_s) + ")");
+  }
+  core::require(p + "blocked_timeout_s", blocked_timeout_s, core::positive());
+  core::require(p + "blocked_timeout_s", blocked_timeout_s, core::at_most(3600.0));
+  core::require(p + "jam_probability", jam_probability, core::probability());
 }
 
 void RobotProfile::apply(sim::GameConfig& game, lua::SkillEngineConfig& skills) const {
@@ -157,8 +135,8 @@ void RobotProfile::apply(sim::GameConfig& game, lua::SkillEngineConfig& skills) 
 
 namespace {
 
-// The profile's figures by key: what load_profile reads (and accepts besides name, light,
-// localization).
+// The profile's figures by key: what load_profile reads besides name, light, localization,
+// light_reads_states and stuck_detection.
 struct NumberKey {
   const char* key;
   double RobotProfile::*field;
@@ -192,56 +170,33 @@ RobotProfile named_or_fail(const core::ConfigNode& n) {
   }
 }
 
-template <class E>
-void read_level(const core::ConfigNode& node, const char* key, E& out, const char* a, E va,
-                const char* b, E vb) {
-  if (!node[key].defined()) return;
-  const std::string v = node[key].as_string();
-  if (v == a) {
-    out = va;
-  } else if (v == b) {
-    out = vb;
-  } else {
-    node[key].fail("'" + v + "' is not one of " + a + ", " + b);
-  }
-}
-
 }  // namespace
 
 RobotProfile load_profile(const core::ConfigNode& node) {
   if (node.is_scalar()) return named_or_fail(node);
   node.require_map();
-  for (const std::string& key : node.keys()) {
-    bool known = key == "name" || key == "light" || key == "localization" ||
-                 key == "light_reads_states" || key == "stuck_detection";
-    for (const NumberKey& k : kNumbers) known = known || key == k.key;
-    if (!known) {
-      std::string allowed = "name, light, localization, light_reads_states, stuck_detection";
-      for (const NumberKey& k : kNumbers) allowed += std::string(", ") + k.key;
-      node[key].fail("unknown key '" + key + "' (allowed: " + allowed + ")");
-    }
-  }
   RobotProfile p;
-  if (node["name"].defined()) p = named_or_fail(node["name"]);
+  if (const core::ConfigNode name = node["name"]; name.defined()) p = named_or_fail(name);
   for (const NumberKey& k : kNumbers) node.read(k.key, p.*k.field);
-  read_level(node, "light", p.light, "ground_truth", sim::DetectionLevel::kGroundTruth, "vision",
-             sim::DetectionLevel::kVision);
-  read_level(node, "localization", p.localization, "ground_truth",
-             sim::LocalizationLevel::kGroundTruth, "noisy", sim::LocalizationLevel::kNoisy);
+  node.read_enum("light", p.light,
+                 {{"ground_truth", sim::DetectionLevel::kGroundTruth},
+                  {"vision", sim::DetectionLevel::kVision}},
+                 "detection level");
+  node.read_enum("localization", p.localization,
+                 {{"ground_truth", sim::LocalizationLevel::kGroundTruth},
+                  {"noisy", sim::LocalizationLevel::kNoisy}},
+                 "localization level");
   node.read("light_reads_states", p.light_reads_states);
   node.read("stuck_detection", p.stuck_detection);
+  node.no_other_keys();
   try {
     p.validate();
   } catch (const core::ConfigError& e) {
-    // Name the key in the file: "profile.max_speed_mps: ..." -> that key's node.
+    // validate() names fields "profile.<key>"; the key is this map's.
     const std::string what = e.what();
     const std::string prefix = "profile.";
-    const std::size_t colon = what.find(':');
-    if (what.rfind(prefix, 0) == 0 && colon != std::string::npos) {
-      const std::string key = what.substr(prefix.size(), colon - prefix.size());
-      if (node[key].defined()) node[key].fail(what.substr(colon + 2));
-    }
-    node.fail(what);
+    node.relocate(
+        core::ConfigError(what.rfind(prefix, 0) == 0 ? what.substr(prefix.size()) : what));
   }
   return p;
 }

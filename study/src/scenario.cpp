@@ -50,65 +50,46 @@ std::vector<std::string> string_list(const core::ConfigNode& n) {
   return out;
 }
 
-template <class E>
-E enum_of(const core::ConfigNode& n, std::initializer_list<std::pair<const char*, E>> values) {
-  const std::string s = n.as_string();
-  std::string allowed;
-  for (const auto& [name, v] : values) {
-    if (s == name) return v;
-    allowed += allowed.empty() ? "" : ", ";
-    allowed += name;
-  }
-  n.fail("'" + s + "' is not one of " + allowed);
-}
-
-double positive(const core::ConfigNode& n) {
-  const double v = n.as_double();
-  if (!(v > 0.0)) n.fail("must be > 0");
-  return v;
-}
-
 void read_levels(const core::ConfigNode& n, sim::RobotLevelsConfig& l) {
   if (!n.defined()) return;
   n.require_map();
-  n.check_keys({"localization", "light", "puck", "skill", "position_noise_m", "heading_noise_rad",
-                "light_error_rate", "light_delay_s", "cruise_speed_mps"});
-  if (n["localization"].defined()) {
-    l.localization.level = enum_of<sim::LocalizationLevel>(
-        n["localization"], {{"ground_truth", sim::LocalizationLevel::kGroundTruth},
-                            {"noisy", sim::LocalizationLevel::kNoisy}});
-  }
-  auto detection = [](const core::ConfigNode& c) {
-    return enum_of<sim::DetectionLevel>(c, {{"ground_truth", sim::DetectionLevel::kGroundTruth},
-                                            {"vision", sim::DetectionLevel::kVision}});
-  };
-  if (n["light"].defined()) l.light.level = detection(n["light"]);
-  if (n["puck"].defined()) l.puck.level = detection(n["puck"]);
-  if (n["skill"].defined()) {
-    l.skill = enum_of<sim::SkillLevel>(n["skill"], {{"physical", sim::SkillLevel::kPhysical},
-                                                    {"symbolic", sim::SkillLevel::kSymbolic}});
-  }
+  n.read_enum("localization", l.localization.level,
+              {{"ground_truth", sim::LocalizationLevel::kGroundTruth},
+               {"noisy", sim::LocalizationLevel::kNoisy}},
+              "localization level");
+  n.read_enum("light", l.light.level,
+              {{"ground_truth", sim::DetectionLevel::kGroundTruth},
+               {"vision", sim::DetectionLevel::kVision}},
+              "detection level");
+  n.read_enum("puck", l.puck.level,
+              {{"ground_truth", sim::DetectionLevel::kGroundTruth},
+               {"vision", sim::DetectionLevel::kVision}},
+              "detection level");
+  n.read_enum("skill", l.skill,
+              {{"physical", sim::SkillLevel::kPhysical}, {"symbolic", sim::SkillLevel::kSymbolic}},
+              "skill level");
   n.read("position_noise_m", l.localization.position_noise_m);
   n.read("heading_noise_rad", l.localization.heading_noise_rad);
   n.read("light_error_rate", l.light.error_rate);
-  if (n["light_delay_s"].defined()) {
-    l.light.delay = core::SimTime::from_seconds(n["light_delay_s"].as_double());
+  if (const core::ConfigNode delay = n["light_delay_s"]; delay.defined()) {
+    l.light.delay = core::SimTime::from_seconds(delay.as_double());
   }
   n.read("cruise_speed_mps", l.symbolic.cruise_speed_mps);
+  n.no_other_keys();
 }
 
 void read_rates(const core::ConfigNode& n, sim::GameConfig& g) {
   if (!n.defined()) return;
   n.require_map();
-  n.check_keys({"physics_hz", "skill_hz", "agent_hz", "beacon_period_s"});
-  if (n["physics_hz"].defined()) {
-    g.world.physics.step = core::SimTime::period_of_hz(positive(n["physics_hz"]));
-  }
-  if (n["skill_hz"].defined()) g.skill_rate_hz = positive(n["skill_hz"]);
-  if (n["agent_hz"].defined()) g.agent_rate_hz = positive(n["agent_hz"]);
-  if (n["beacon_period_s"].defined()) {
-    g.beacon_period = core::SimTime::from_seconds(positive(n["beacon_period_s"]));
-  }
+  double physics_hz = 0.0;  // 0: not given
+  n.read("physics_hz", physics_hz, core::positive());
+  if (physics_hz > 0.0) g.world.physics.step = core::SimTime::period_of_hz(physics_hz);
+  n.read("skill_hz", g.skill_rate_hz, core::positive());
+  n.read("agent_hz", g.agent_rate_hz, core::positive());
+  double beacon_period_s = 0.0;  // 0: not given
+  n.read("beacon_period_s", beacon_period_s, core::positive());
+  if (beacon_period_s > 0.0) g.beacon_period = core::SimTime::from_seconds(beacon_period_s);
+  n.no_other_keys();
 }
 
 std::vector<std::uint64_t> read_seeds(const core::ConfigNode& root) {
@@ -116,18 +97,16 @@ std::vector<std::uint64_t> read_seeds(const core::ConfigNode& root) {
   const core::ConfigNode seeds = root["seeds"];
   if (seed.defined() && seeds.defined()) seeds.fail("give either 'seed' or 'seeds', not both");
   auto one = [](const core::ConfigNode& n) {
-    const std::int64_t v = n.as_int();
-    if (v < 0) n.fail("a seed must be >= 0");
-    return static_cast<std::uint64_t>(v);
+    return static_cast<std::uint64_t>(n.as_int(core::non_negative()));
   };
   if (seed.defined()) return {one(seed)};
   if (!seeds.defined()) return {1};
   std::vector<std::uint64_t> out;
   if (seeds.is_map()) {
-    seeds.check_keys({"first", "count"});
-    const std::uint64_t first = seeds["first"].defined() ? one(seeds["first"]) : 1;
-    const std::int64_t count = seeds.at("count").as_int();
-    if (count < 1 || count > 100000) seeds["count"].fail("must be in 1..100000");
+    std::uint64_t first = 1;
+    if (const core::ConfigNode f = seeds["first"]; f.defined()) first = one(f);
+    const std::int64_t count = seeds.at("count").as_int(core::in_range(1, 100000));
+    seeds.no_other_keys();
     for (std::int64_t i = 0; i < count; ++i) out.push_back(first + static_cast<std::uint64_t>(i));
     return out;
   }
@@ -163,28 +142,29 @@ void read_robots(const core::ConfigNode& n, const std::string& dir, Scenario& s)
   int count = static_cast<int>(s.game.world.robots.size());
   std::vector<std::string> agent;
   clips::ConfigEntries config;
+  bool locks = false;
+  core::ConfigNode each;
   if (n.defined()) {
     n.require_map();
-    n.check_keys({"count", "agent", "config", "locks", "each"});
-    if (n["count"].defined()) {
-      const std::int64_t c = n["count"].as_int();
-      if (c < 1 || c > static_cast<std::int64_t>(s.game.world.robots.size())) {
-        n["count"].fail("must be in 1.." + std::to_string(s.game.world.robots.size()) +
-                        " (the robots of the world)");
+    if (const core::ConfigNode c = n["count"]; c.defined()) {
+      const std::int64_t v = c.as_int();
+      if (v < 1 || v > static_cast<std::int64_t>(s.game.world.robots.size())) {
+        c.fail("must be in 1.." + std::to_string(s.game.world.robots.size()) +
+               " (the robots of the world)");
       }
-      count = static_cast<int>(c);
+      count = static_cast<int>(v);
     }
-    if (n["agent"].defined()) agent = read_agent(n["agent"], dir);
-    if (n["config"].defined()) {
-      n["config"].require_map();
-      config = clips::config_from_node(n["config"], "/clips-agent");
+    if (const core::ConfigNode a = n["agent"]; a.defined()) agent = read_agent(a, dir);
+    if (const core::ConfigNode c = n["config"]; c.defined()) {
+      c.require_map();
+      config = clips::config_from_node(c, "/clips-agent");
     }
+    n.read("locks", locks);
+    each = n["each"];
+    n.no_other_keys();
   }
-  bool locks = false;
-  if (n.defined()) n.read("locks", locks);
   s.game.world.robots.resize(static_cast<std::size_t>(count));
   s.robots.assign(static_cast<std::size_t>(count), RobotSpec{agent, config, locks});
-  const core::ConfigNode each = n.defined() ? n["each"] : core::ConfigNode();
   if (!each.defined()) return;
   if (!each.is_sequence()) each.fail("expected a list with one entry per robot");
   if (each.size() > count) each.fail("more entries than robots (" + std::to_string(count) + ")");
@@ -192,26 +172,25 @@ void read_robots(const core::ConfigNode& n, const std::string& dir, Scenario& s)
     const core::ConfigNode r = each.at(i);
     if (r.is_null()) continue;
     r.require_map();
-    r.check_keys({"agent", "config", "name", "jersey", "start"});
     RobotSpec& spec = s.robots[static_cast<std::size_t>(i)];
-    if (r["agent"].defined()) spec.agent = read_agent(r["agent"], dir);
-    if (r["config"].defined()) {
-      r["config"].require_map();
-      merge_config(spec.config, clips::config_from_node(r["config"], "/clips-agent"));
+    if (const core::ConfigNode a = r["agent"]; a.defined()) spec.agent = read_agent(a, dir);
+    if (const core::ConfigNode c = r["config"]; c.defined()) {
+      c.require_map();
+      merge_config(spec.config, clips::config_from_node(c, "/clips-agent"));
     }
     kinematic::RobotStart& start = s.game.world.robots[static_cast<std::size_t>(i)];
     r.read("name", start.name);
     r.read("jersey", start.jersey);
-    if (r["start"].defined()) {
-      const core::ConfigNode p = r["start"];
+    if (const core::ConfigNode p = r["start"]; p.defined()) {
       p.require_map();
-      p.check_keys({"x", "y", "ori_deg"});
       double x = start.pose.x, y = start.pose.y, ori = start.pose.theta * 180.0 / core::kPi;
       p.read("x", x);
       p.read("y", y);
       p.read("ori_deg", ori);
+      p.no_other_keys();
       start.pose = {x, y, ori * core::kPi / 180.0};
     }
+    r.no_other_keys();
   }
 }
 
@@ -220,21 +199,17 @@ void read_tests(const core::ConfigNode& n, Scenario& s) {
   if (!n.is_sequence()) n.fail("expected a list of test cases");
   for (const core::ConfigNode& t : n.elements()) {
     t.require_map();
-    t.check_keys({"name", "points_at_least", "exploration_points_at_least",
-                  "production_points_at_least", "deliveries_at_least", "collisions_at_most",
-                  "no_agent_errors", "skill_failure_streak_at_most", "lock_hold_at_most_s",
-                  "by_s"});
     TestCase tc;
     int kinds = 0;
     auto kind = [&](const char* key, TestCase::Kind k) {
-      if (!t[key].defined()) return;
+      const core::ConfigNode c = t[key];
+      if (!c.defined()) return;
       ++kinds;
       tc.kind = k;
       if (k == TestCase::Kind::kNoAgentErrors) {
-        if (!t[key].as_bool()) t[key].fail("only 'true' makes sense");
+        if (!c.as_bool()) c.fail("only 'true' makes sense");
       } else {
-        tc.value = t[key].as_double();
-        if (tc.value < 0.0) t[key].fail("must be >= 0");
+        tc.value = c.as_double(core::non_negative());
       }
     };
     kind("points_at_least", TestCase::Kind::kPointsAtLeast);
@@ -245,60 +220,62 @@ void read_tests(const core::ConfigNode& n, Scenario& s) {
     kind("no_agent_errors", TestCase::Kind::kNoAgentErrors);
     kind("skill_failure_streak_at_most", TestCase::Kind::kSkillFailureStreakAtMost);
     kind("lock_hold_at_most_s", TestCase::Kind::kLockHoldAtMost);
+    const core::ConfigNode by = t["by_s"];
+    const core::ConfigNode name = t["name"];
+    t.no_other_keys();  // before the condition count: a misspelt condition is the likely cause
     if (kinds != 1) t.fail("a test case needs exactly one condition (e.g. points_at_least: 30)");
-    if (t["by_s"].defined()) {
+    if (by.defined()) {
       if (tc.kind != TestCase::Kind::kPointsAtLeast &&
           tc.kind != TestCase::Kind::kDeliveriesAtLeast) {
-        t["by_s"].fail("by_s works with points_at_least and deliveries_at_least");
+        by.fail("by_s works with points_at_least and deliveries_at_least");
       }
-      tc.by_s = t["by_s"].as_double();
-      if (*tc.by_s <= 0.0) t["by_s"].fail("must be > 0");
+      tc.by_s = by.as_double(core::positive());
     }
-    tc.name = t["name"].defined() ? t["name"].as_string() : describe(tc);
+    tc.name = name.defined() ? name.as_string() : describe(tc);
     s.tests.push_back(std::move(tc));
   }
 }
 
 Scenario read_scenario(const core::ConfigNode& root, const std::string& file) {
   root.require_map();
-  root.check_keys({"name", "description", "seed", "seeds", "start", "duration_s", "refbox", "world",
-                   "radio", "navigation", "levels", "rates", "team", "robots", "skills", "tests",
-                   "matrix", "hackathon", "profile"});
   const std::string dir = fs::path(file).parent_path().string();
   Scenario s;
   s.file = file;
-  s.name = root.at("name").as_string();
-  if (s.name.empty()) root["name"].fail("must not be empty");
+  const core::ConfigNode name = root.at("name");
+  s.name = name.as_string();
+  if (s.name.empty()) name.fail("must not be empty");
   root.read("description", s.description);
   s.seeds = read_seeds(root);
-  if (root["refbox"].defined()) s.game.refbox = refbox::load_refbox_config(root["refbox"]);
+  if (const core::ConfigNode n = root["refbox"]; n.defined()) {
+    s.game.refbox = refbox::load_refbox_config(n);
+  }
   // The robot profile first: world, navigation and levels keys override its figures.
   RobotProfile profile;
-  if (root["profile"].defined()) profile = load_profile(root["profile"]);
+  if (const core::ConfigNode n = root["profile"]; n.defined()) profile = load_profile(n);
   profile.apply(s.game, s.skills);
-  if (root["world"].defined()) {
-    s.game.world = kinematic::load_world_config(root["world"], s.game.world);
+  if (const core::ConfigNode n = root["world"]; n.defined()) {
+    s.game.world = kinematic::load_world_config(n, s.game.world);
   }
-  if (root["radio"].defined()) s.game.hub = comm::load_hub_config(root["radio"]);
-  if (root["navigation"].defined()) {
+  if (const core::ConfigNode n = root["radio"]; n.defined()) s.game.hub = comm::load_hub_config(n);
+  if (const core::ConfigNode n = root["navigation"]; n.defined()) {
     planner::NavigationConfig nav{s.game.planner, s.game.controller};
-    nav = planner::load_navigation_config(root["navigation"], nav);
+    nav = planner::load_navigation_config(n, nav);
     s.game.planner = nav.planner;
     s.game.controller = nav.controller;
   }
   read_levels(root["levels"], s.game.levels);
   read_rates(root["rates"], s.game);
   root.read("team", s.game.team);
-  if (root["hackathon"].defined()) {
-    s.game.hackathon = sim::load_hackathon_config(root["hackathon"], s.game.world);
+  if (const core::ConfigNode n = root["hackathon"]; n.defined()) {
+    s.game.hackathon = sim::load_hackathon_config(n, s.game.world);
     s.start = StartMode::kNone;
   }
-  if (root["start"].defined()) {
-    s.start = enum_of<StartMode>(root["start"], {{"game", StartMode::kGame},
-                                                 {"exploration", StartMode::kExploration},
-                                                 {"production", StartMode::kProduction},
-                                                 {"none", StartMode::kNone}});
-  }
+  root.read_enum("start", s.start,
+                 {{"game", StartMode::kGame},
+                  {"exploration", StartMode::kExploration},
+                  {"production", StartMode::kProduction},
+                  {"none", StartMode::kNone}},
+                 "start mode");
   const refbox::RefboxConfig& rb = s.game.refbox;
   double duration = rb.production_duration.seconds();
   if (s.start != StartMode::kProduction) duration += rb.exploration_duration.seconds();
@@ -306,16 +283,18 @@ Scenario read_scenario(const core::ConfigNode& root, const std::string& file) {
     duration += rb.setup_duration.seconds();
   }
   if (s.game.hackathon) duration = kHackathonDefaultDuration.seconds();
-  if (root["duration_s"].defined()) duration = positive(root["duration_s"]);
+  root.read("duration_s", duration, core::positive());
   s.duration = core::SimTime::from_seconds(duration);
   read_robots(root["robots"], dir, s);
-  if (root["skills"].defined()) {
-    s.skills = lua::SkillEngineConfig::from_config(root["skills"]);
+  if (const core::ConfigNode n = root["skills"]; n.defined()) {
+    s.skills = lua::SkillEngineConfig::from_config(n);
     for (std::string& d : s.skills.skill_dirs) d = resolve(dir, d);
     s.skills.profile = profile.name;
     s.skills.stuck_detection = profile.stuck_detection;
   }
   read_tests(root["tests"], s);
+  // `matrix` is read by the callers (load_scenario, read_scenario_map) on this document.
+  root.no_other_keys();
   s.game.seed = s.seeds.front();
   try {
     s.game.validate();

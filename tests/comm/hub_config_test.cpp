@@ -114,7 +114,7 @@ TEST_CASE("bad input names file, line and field") {
   CHECK(error_of("outages:\n  - {peer: r1, from_s: 5, until_s: 4}\n") ==
         "hub.yaml:2:36: outages[0].until_s: must be after from_s");
   CHECK(error_of("loss: {model: per_link}\nlinks:\n  - {from: a, to: b, jitter_ms: -2}\n") ==
-        "hub.yaml:3:33: links[0].jitter_ms: must be >= 0 (got -2 ms)");
+        "hub.yaml:3:33: links[0].jitter_ms: must be >= 0 (got -2)");
   CHECK(contains(error_of("max_frame_bytes: 4\n"), "hub.yaml:1:18: max_frame_bytes: must be in"));
   CHECK(contains(error_of("bogus: 1\n"), "bogus"));
 }

@@ -283,6 +283,11 @@ TEST_CASE("validated reads and require() share one wording; loaders add file:lin
   CHECK_THROWS_WITH_AS(puck.read("beams", beams, core::in_range(1, 100)),
                        "p.yaml:4:10: puck.beams: must be in [1, 100] (got 0)", ConfigError);
   CHECK(beams == 1);
+  CHECK_THROWS_WITH_AS(puck["beams"].as_int(core::at_least(1)),
+                       "p.yaml:4:10: puck.beams: must be >= 1 (got 0)", ConfigError);
+  CHECK(puck["beams"].as_int(core::non_negative()) == 0);
+  CHECK_THROWS_WITH_AS(puck["restitution"].as_double(core::at_most(1)),
+                       "p.yaml:3:16: puck.restitution: must be at most 1 (got 1.5)", ConfigError);
   enum class Mode { kA, kB };
   Mode m = Mode::kA;
   CHECK_THROWS_WITH_AS(
@@ -295,6 +300,11 @@ TEST_CASE("validated reads and require() share one wording; loaders add file:lin
   CHECK_THROWS_WITH_AS(core::require("x", 0.0, core::fraction()), "x: must be in (0, 1] (got 0)",
                        ConfigError);
   CHECK_NOTHROW(core::require("x", 0.5, core::fraction()));
+  CHECK(core::number_text(100000) == "100000");
+  CHECK(core::number_text(-3) == "-3");
+  CHECK(core::number_text(0.1) == "0.1");
+  CHECK(core::number_text(1e-05) == "1e-05");
+  CHECK(core::number_text(1e20) == "1e+20");
   CHECK_THROWS_WITH_AS(core::require("p", 70000, core::port()),
                        "p: must be a port in [0, 65535] (got 70000)", ConfigError);
   // A validate() error on a struct gets the location of the value it names.

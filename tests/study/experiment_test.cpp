@@ -233,6 +233,18 @@ TEST_CASE("experiment files: errors name file:line and the key") {
   const std::vector<Case> cases{
       {"findings: []\nfrobnicate: 1\n", ":8:", "unknown key 'frobnicate'"},
       {"findings: []\n", ":1:", "nothing to evaluate"},
+      {"findngs: []\n", ":7:10:", "findngs: unknown key 'findngs' (did you mean 'findings'?)"},
+      {"calibration:\n  - name: t\n    batch: conf\n    statistic: points\n    mean_in: [1, 2]\n"
+       "    ignore_belo: 3\n",
+       ":12:18:",
+       "calibration[0].ignore_belo: unknown key 'ignore_belo' (did you mean 'ignore_below'?)"},
+      {"findings:\n  - id: F1\n    claim: c\n    checks:\n"
+       "      - mean_in: {batch: conf, statistic: points, range: [1, 2], wher: {config: A}}\n",
+       ":11:", "unknown key 'wher' (did you mean 'where'?)"},
+      {"findings:\n  - id: F1\n    claim: c\n    checks:\n"
+       "      - greater: {batch: conf, statistic: points, a: {config: A}, b: {config: B}, "
+       "where: {config: A}}\n",
+       ":11:", "unknown key 'where' (allowed: batch, statistic, ignore_below, above, a, b)"},
       {"calibration:\n  - name: t\n    batch: nope\n    statistic: points\n    mean_in: [1, 2]\n",
        ":9:", "unknown batch 'nope' (batches: conf, sweep)"},
       {"calibration:\n  - name: t\n    batch: conf\n    where: {speed: slow}\n"
@@ -265,7 +277,7 @@ TEST_CASE("experiment files: errors name file:line and the key") {
        ":11:", "unknown check 'greatest'"},
       {"findings:\n  - id: F1\n    claim: c\n    checks:\n"
        "      - share_at_most: {batch: conf, statistic: points, value: 2}\n",
-       ":11:", "a share must be in 0..1"},
+       ":11:64:", "share_at_most.value: must be in [0, 1] (got 2)"},
       {"findings:\n  - id: F1\n    claim: c\n    checks:\n"
        "      - greater: {batch: conf, statistic: points, a: {config: A}, b: {config: A}}\n",
        ":11:", "'a' and 'b' select the same runs"},

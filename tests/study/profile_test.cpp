@@ -116,7 +116,24 @@ TEST_CASE("profiles: the scenario key, overrides, and keys that win over the pro
   e = error_of(dir, head + "profile: {jam_probability: 1.5}\n");
   CHECK(e.find("jam_probability") != std::string::npos);
   e = error_of(dir, head + "profile: {light: camera}\n");
-  CHECK(e.find("'camera' is not one of ground_truth, vision") != std::string::npos);
+  CHECK(e.find("unknown detection level 'camera' (expected one of: ground_truth, vision)") !=
+        std::string::npos);
+}
+
+TEST_CASE("profiles: an unknown key or a bad figure is reported at its file:line:column") {
+  const test::TempDir dir("llsf-profile");
+  const std::string head = "name: p\nduration_s: 10\nrobots: {count: 1}\n";
+  CHECK(error_of(dir, head + "profile: {name: ideal, max_sped_mps: 1}\n") ==
+        dir.file("s.yaml") +
+            ":4:38: profile.max_sped_mps: unknown key 'max_sped_mps' (did you mean "
+            "'max_speed_mps'?)");
+  CHECK(error_of(dir, head + "profile:\n  name: robotino-2013\n  align_s: 90\n") ==
+        dir.file("s.yaml") + ":6:12: profile.align_s: must be at most 60 (got 90)");
+  CHECK(error_of(dir, head + "profile:\n  jam_probability: 1.5\n") ==
+        dir.file("s.yaml") + ":5:20: profile.jam_probability: must be in [0, 1] (got 1.5)");
+  // A bound between two keys: at the key validate() names.
+  CHECK(error_of(dir, head + "profile:\n  backoff_min_s: 5\n  backoff_max_s: 4\n") ==
+        dir.file("s.yaml") + ":6:18: profile.backoff_max_s: must be >= backoff_min_s (got 4)");
 }
 
 TEST_CASE("profiles: the ideal profile leaves the game as it was") {

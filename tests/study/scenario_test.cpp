@@ -76,7 +76,8 @@ TEST_CASE("scenario errors name file, line and key") {
   CHECK(e.find("c.yaml:3:") != std::string::npos);
   CHECK(e.find("not found") != std::string::npos);
   e = error_of(scenario_file("d.yaml", "name: d\nlevels: {light: laser}\n"));
-  CHECK(e.find("'laser' is not one of ground_truth, vision") != std::string::npos);
+  CHECK(e.find("unknown detection level 'laser' (expected one of: ground_truth, vision)") !=
+        std::string::npos);
   e = error_of(scenario_file("e.yaml",
                              "name: e\nmatrix:\n  loss:\n    bad: {radio.loss: {model: lossy}}\n"));
   CHECK(e.find("e.yaml:4:") != std::string::npos);  // the override's line
@@ -88,6 +89,30 @@ TEST_CASE("scenario errors name file, line and key") {
   CHECK(error_of(scenario_file("h.yaml", "name: [\n")).find("YAML syntax error") !=
         std::string::npos);
   CHECK(error_of("/no/such/file.yaml").find("cannot read") != std::string::npos);
+}
+
+TEST_CASE("scenario: an unknown key is reported at its file:line:column with a hint") {
+  std::string p = scenario_file("k1.yaml", "name: k\ndurration_s: 5\n");
+  CHECK(error_of(p) ==
+        p + ":2:14: durration_s: unknown key 'durration_s' (did you mean 'duration_s'?)");
+  p = scenario_file("k2.yaml",
+                    "name: k\nrobots:\n  count: 1\n  each:\n    - {start: {x: 1, yy: 2}}\n");
+  CHECK(error_of(p) == p + ":5:26: robots.each[0].start.yy: unknown key 'yy' (did you mean 'y'?)");
+  // Before the count of conditions: the misspelt condition is the cause.
+  p = scenario_file("k3.yaml", "name: k\ntests:\n  - {point_at_least: 3}\n");
+  CHECK(error_of(p) == p + ":3:22: tests[0].point_at_least: unknown key 'point_at_least' (did you "
+                           "mean 'points_at_least'?)");
+  p = scenario_file("k4.yaml", "name: k\nseeds: {first: 3, count: 2, step: 1}\n");
+  CHECK(error_of(p) == p + ":2:35: seeds.step: unknown key 'step' (allowed: first, count)");
+  // In a matrix cell: the key of the override.
+  p = scenario_file("k5.yaml", "name: k\nmatrix:\n  r:\n    a: {rates.skil_hz: 5}\n");
+  CHECK(error_of(p) ==
+        p + ":4:24: rates.skil_hz: unknown key 'skil_hz' (did you mean 'skill_hz'?)");
+  // Bounds: at the value, with what was given.
+  p = scenario_file("k6.yaml", "name: k\nrates: {physics_hz: -5}\n");
+  CHECK(error_of(p) == p + ":2:21: rates.physics_hz: must be > 0 (got -5)");
+  p = scenario_file("k7.yaml", "name: k\nseeds: {count: 0}\n");
+  CHECK(error_of(p) == p + ":2:16: seeds.count: must be in [1, 100000] (got 0)");
 }
 
 TEST_CASE("jersey numbers: per robot in `each`, in the agent, the beacons and the recording") {

@@ -51,7 +51,8 @@ constexpr Bound port() { return {Bound::Kind::kPort, 0.0, 65535.0}; }
 /// ConfigNode::locate_errors).
 void require(std::string_view path, double v, const Bound& bound);
 
-/// Shortest text that reads back as `v` ("0.1", "1e-05", "3"), as messages print numbers.
+/// Shortest text that reads back as `v` ("0.1", "1e-05", "3"; whole numbers in full, "100000"),
+/// as messages print numbers.
 std::string number_text(double v);
 
 /// A node of a parsed YAML document with its source name, line/column and dotted path.
@@ -93,10 +94,6 @@ class ConfigNode {
   /// an asked-for key is close. A loader reads each key once, then calls this once per map.
   /// Does nothing for an undefined, null or non-map node.
   void no_other_keys() const;
-  /// Throws naming the first key of this map that is not in `allowed`. The older form of
-  /// no_other_keys() (keys listed twice); left only for the scenario, profile and experiment
-  /// loaders until their move to study/ is merged -- do not use in new code.
-  void check_keys(std::initializer_list<std::string_view> allowed) const;
   /// Throws if this node is defined and is not a map (a null node counts as an empty map).
   void require_map() const;
 
@@ -104,6 +101,10 @@ class ConfigNode {
   std::int64_t as_int() const;
   bool as_bool() const;
   std::string as_string() const;
+  /// As as_double() / as_int(), then fails at this node if the value violates `bound`
+  /// ("must be > 0 (got -1)"): for a value that is not simply stored by read().
+  double as_double(const Bound& bound) const;
+  std::int64_t as_int(const Bound& bound) const;
 
   /// If `key` is present, parses it into `out`; otherwise leaves `out` unchanged.
   void read(std::string_view key, double& out) const;
