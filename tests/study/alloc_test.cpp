@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "llsf/sim/agent_brain.h"
-#include "llsf/sim/game.h"
 #include "llsf/sim/driver.h"
+#include "llsf/sim/game.h"
 #include "llsf/study/scenario.h"
 
 // --- the counter -------------------------------------------------------------------------------
