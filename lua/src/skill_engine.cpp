@@ -59,13 +59,19 @@ void SkillEngineConfig::validate() const {
   }
 }
 
-SkillEngineConfig SkillEngineConfig::from_config(const core::ConfigNode& node) {
+SkillEngineConfig SkillEngineConfig::from_config(const core::ConfigNode& node,
+                                                 const std::string& base_dir) {
   node.require_map();
   SkillEngineConfig cfg;
   const core::ConfigNode dirs = node["skill_dirs"];
   if (dirs.defined()) {
     if (!dirs.is_sequence()) dirs.fail("expected a list of directories");
-    for (const core::ConfigNode& d : dirs.elements()) cfg.skill_dirs.push_back(d.as_string());
+    for (const core::ConfigNode& d : dirs.elements()) {
+      const fs::path dir(d.as_string());
+      cfg.skill_dirs.push_back(dir.is_absolute() || base_dir.empty()
+                                   ? dir.string()
+                                   : (fs::path(base_dir) / dir).lexically_normal().string());
+    }
   }
   node.read("rate_hz", cfg.rate_hz);
   node.read("instruction_budget", cfg.instruction_budget);

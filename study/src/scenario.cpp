@@ -287,8 +287,7 @@ Scenario read_scenario(const core::ConfigNode& root, const std::string& file) {
   s.duration = core::SimTime::from_seconds(duration);
   read_robots(root["robots"], dir, s);
   if (const core::ConfigNode n = root["skills"]; n.defined()) {
-    s.skills = lua::SkillEngineConfig::from_config(n);
-    for (std::string& d : s.skills.skill_dirs) d = resolve(dir, d);
+    s.skills = lua::SkillEngineConfig::from_config(n, dir);  // dirs relative to the file
     s.skills.profile = profile.name;
     s.skills.stuck_detection = profile.stuck_detection;
   }

@@ -23,8 +23,8 @@ TEST_CASE("batch_identity_hash: the scenario, its agent files and its skill file
   write("agent/a.clp", "(defrule a (time $?) => )\n");
   write("skills/my.lua", "-- a skill\n");
   write("notes.txt", "not loaded by any game\n");
-  write("s.yaml", "name: id\nrobots: {count: 1, agent: [agent]}\nskills: {skill_dirs: [" +
-                      (dir / "skills").string() + "]}\n");
+  // (skill_dirs relative to the scenario file, as agent entries are)
+  write("s.yaml", "name: id\nrobots: {count: 1, agent: [agent]}\nskills: {skill_dirs: [skills]}\n");
   const std::string scenario = (dir / "s.yaml").string();
   auto id = [&scenario] { return batch_identity_hash(scenario, load_scenario(scenario)); };
   const std::string first = id();

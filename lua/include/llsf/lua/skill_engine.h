@@ -49,8 +49,11 @@ struct SkillEngineConfig {
   /// Throws core::ConfigError naming the bad field.
   void validate() const;
   /// Reads `skill_dirs`, `rate_hz`, `instruction_budget`, `memory_limit_bytes`, `hot_reload`,
-  /// `random_seed` from a map node (unknown keys are errors); relative dirs stay as written.
-  static SkillEngineConfig from_config(const core::ConfigNode& node);
+  /// `random_seed` from a map node (unknown keys are errors). Relative dirs are taken relative
+  /// to `base_dir` (e.g. the scenario file's directory); with no `base_dir` they stay as written
+  /// (relative to the working directory).
+  static SkillEngineConfig from_config(const core::ConfigNode& node,
+                                       const std::string& base_dir = {});
 };
 
 /// Outcome of exec(): `ok`, or the reason the skill string was refused.
