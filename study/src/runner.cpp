@@ -330,7 +330,9 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
         RunIssue issue;
         issue.time_s = ch.time.seconds();
         issue.robot = ch.robot;
-        issue.kind = "skill-failure";
+        // A skill name the library does not have is the agent's mistake.
+        issue.kind = ch.error.find("unknown skill '") != std::string::npos ? "unknown-skill"
+                                                                           : "skill-failure";
         issue.text = ch.skill_string + ": " + ch.error;
         add_issue(std::move(issue));
       }
@@ -558,6 +560,19 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   r.result_hash = h;
   for (std::size_t i = 0; i < scenario.tests.size(); ++i) {
     if (!judged[i]) judge(i, s.points, deliveries_of(rb));
+  }
+  if (scenario.strict) {
+    // Strict (scenario key `strict`, `run --strict`): any agent mistake fails the run.
+    int mistakes = 0;
+    for (const RunIssue& i : r.issues) mistakes += i.is_mistake() ? 1 : 0;
+    TestVerdict v;
+    v.name = "strict: no agent mistakes";
+    v.passed = mistakes == 0 && r.issues_dropped == 0;
+    v.detail = std::to_string(mistakes) +
+               " mistakes (runtime errors, rule loops, locks held over 300 s, unknown skills; "
+               "the issue lines name them)";
+    v.at_s = r.game_time_s;
+    verdicts.push_back(std::move(v));
   }
   r.tests = std::move(verdicts);
   r.hackathon = game.hackathon_score();

@@ -266,6 +266,7 @@ Scenario read_scenario(const core::ConfigNode& root, const std::string& file) {
   read_levels(root["levels"], s.game.levels);
   read_rates(root["rates"], s.game);
   root.read("team", s.game.team);
+  root.read("strict", s.strict);
   if (const core::ConfigNode n = root["hackathon"]; n.defined()) {
     s.game.hackathon = sim::load_hackathon_config(n, s.game.world);
     s.start = StartMode::kNone;

@@ -31,5 +31,12 @@ TEST_CASE("run --strict fails on an agent's runtime error and names the rule and
   CHECK(has(lenient.out, "one.clp:2)"));
   const auto strict = llsfsim({"run", dir.file("s.yaml"), "--no-db", "--no-record", "--strict"});
   CHECK(strict.code == 1);
-  CHECK(has(strict.err, "--strict: the agents made mistakes"));
+  CHECK(has(strict.out, "test       FAIL  strict: no agent mistakes: 1 mistakes"));
+  CHECK_FALSE(has(lenient.out, "strict:"));
+  // The scenario key does the same.
+  std::ofstream(dir.file("k.yaml")) << "name: strict\nduration_s: 3\nstart: production\n"
+                                       "strict: true\nrobots: {count: 1, agent: [agent]}\n";
+  const auto keyed = llsfsim({"run", dir.file("k.yaml"), "--no-db", "--no-record"});
+  CHECK(keyed.code == 1);
+  CHECK(has(keyed.out, "FAIL  strict: no agent mistakes"));
 }

@@ -70,9 +70,12 @@ TEST_CASE(
       ++loops;
       CHECK(i.rule == "spin");
       CHECK(i.place.ends_with("mistakes.clp:6"));
+    } else if (i.kind == "unknown-skill") {
+      ++skills;
+      CHECK(i.text.find("unknown skill 'no_such_skill'") != std::string::npos);
+      CHECK(i.is_mistake());
     } else if (i.kind == "skill-failure") {
       ++skills;
-      CHECK(i.text.find("no_such_skill") != std::string::npos);
       CHECK_FALSE(i.is_mistake());
     }
   }

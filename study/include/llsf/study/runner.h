@@ -54,14 +54,16 @@ struct RunIssue {
   std::string robot;
   /// "runtime-error" (a rule's actions failed, incl. a work budget that stopped them),
   /// "rule-loop" (the firing limit of a cycle was reached), "skill-failure" (a skill string
-  /// ended FAILED: `text` is the skill string and its error), "lock-hold" (one robot held one
-  /// lock longer than RunIssue::kLongLockHold_s, not counting a jammed robot's).
+  /// ended FAILED: `text` is the skill string and its error), "unknown-skill" (it failed because
+  /// the library has no such skill), "lock-hold" (one robot held one lock longer than
+  /// RunIssue::kLongLockHold_s, not counting a jammed robot's).
   std::string kind;
   std::string rule;   ///< the CLIPS rule, if known
   std::string place;  ///< "file:line" of the rule, if known
   std::string text;
   static constexpr double kLongLockHold_s = 300.0;
-  /// "runtime-error", "rule-loop" and "lock-hold" are mistakes: `run --strict` fails on them.
+  /// All kinds but "skill-failure" are mistakes: a strict run (Scenario::strict, `run --strict`)
+  /// fails on them.
   bool is_mistake() const { return kind != "skill-failure"; }
 };
 

@@ -63,6 +63,9 @@ struct Scenario {
   std::vector<RobotSpec> robots;
   lua::SkillEngineConfig skills;  ///< skill_dirs empty: the library of the skill level
   std::vector<TestCase> tests;
+  /// Scenario key `strict` (or `run --strict`): an agent mistake (RunIssue::is_mistake) fails
+  /// the run through the test case "strict: no agent mistakes".
+  bool strict = false;
 };
 
 /// A scenario file: every variant of its matrix (one if it has none), in matrix order.
