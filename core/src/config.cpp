@@ -8,7 +8,10 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
+
+#include "llsf/core/text.h"
 
 namespace llsf::core {
 
@@ -82,21 +85,6 @@ namespace {
 std::string child_path(const std::string& parent, std::string_view key) {
   if (parent.empty()) return std::string(key);
   return parent + "." + std::string(key);
-}
-/// Edit distance (insert, delete, substitute), for "did you mean".
-int edit_distance(std::string_view a, std::string_view b) {
-  std::vector<int> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = static_cast<int>(j);
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    int diag = row[0];
-    row[0] = static_cast<int>(i);
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const int up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diag = up;
-    }
-  }
-  return row[b.size()];
 }
 std::string describe(const YAML::Node& n) {
   if (!n.IsDefined()) return "nothing";
@@ -212,16 +200,9 @@ void ConfigNode::no_other_keys() const {
     const std::string k = kv.first.Scalar();
     if (std::find(asked.begin(), asked.end(), k) != asked.end()) continue;
     // The closest asked-for key within a third of the name's length is a likely typo.
-    const std::string* best = nullptr;
-    int best_d = std::max(1, static_cast<int>(k.size()) / 3) + 1;
-    for (const std::string& a : asked) {
-      if (const int d = edit_distance(k, a); d < best_d) {
-        best = &a;
-        best_d = d;
-      }
-    }
+    const std::optional<std::string> best = closest_match(k, asked);
     std::string hint;
-    if (best != nullptr) {
+    if (best) {
       hint = " (did you mean '" + *best + "'?)";
     } else if (!asked.empty()) {
       std::string list;
