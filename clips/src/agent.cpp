@@ -116,11 +116,11 @@ struct AgentHost::Impl {
     state.config = std::move(config);
     state.io = std::move(io);
     if (state.io.broadcast) {  // the trace sees every broadcast (pb-broadcast, lock messages)
-      state.io.broadcast = [this, out = std::move(state.io.broadcast)](
-                               const google::protobuf::Message& m) {
-        if (tracer) tracer->message_out(m);
-        out(m);
-      };
+      state.io.broadcast =
+          [this, out = std::move(state.io.broadcast)](const google::protobuf::Message& m) {
+            if (tracer) tracer->message_out(m);
+            out(m);
+          };
     }
     state.log = [this](LogLevel level, std::string_view text) { emit(level, text); };
     env.set_output_handler(

@@ -192,7 +192,9 @@ struct RouterAccess {
 
 // The trace hooks (Environment::observe); registered only while an observer is installed.
 struct TraceHooks {
-  static Environment* self(void* env) { return static_cast<Environment*>(GetEnvironmentContext(env)); }
+  static Environment* self(void* env) {
+    return static_cast<Environment*>(GetEnvironmentContext(env));
+  }
   // Before each firing: the activation's rule and the facts of its partial match (the basis).
   static void before_fire(void* env, void* activation) {
     Environment* e = self(env);

@@ -207,9 +207,9 @@ class Environment {
   TraceObserver* observer_ = nullptr;
   bool observe_rules_ = false;
   bool observe_facts_ = false;
-  std::vector<std::int64_t> matched_;  // reused for on_fire
+  std::vector<std::int64_t> matched_;       // reused for on_fire
   mutable std::string* capture_ = nullptr;  // print_fact: where the capture router writes
-  std::string fact_buf_;                     // reused for on_fact
+  std::string fact_buf_;                    // reused for on_fact
 };
 
 }  // namespace llsf::clips::detail

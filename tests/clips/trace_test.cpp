@@ -62,7 +62,7 @@ TEST_CASE("a trace shows each firing with the facts that matched, and the fact c
   CHECK(t.has("[   0.10] robot1 ==> f-2 (machine (name M1) (mtype T1))"));
   CHECK(t.has("[   0.10] robot1 FIRE go  f-1 (state IDLE), f-2 (machine (name M1) (mtype T1))"));
   CHECK(t.has("[   0.10] robot1 <== f-1 (state IDLE)"));
-  CHECK(t.has("==> f-") );
+  CHECK(t.has("==> f-"));
   CHECK(t.has("(state GOTO M1)"));
   // The host's own rule retracts the time fact at the end of the run.
   CHECK(t.has("FIRE time-retract  f-"));
@@ -144,10 +144,12 @@ TEST_CASE("a trace shows messages in and out") {
   f.agent().receive(std::move(m), "robot2", 2, core::SimTime::from_ms(150));
   f.step();
   INFO(t.all());
-  CHECK(t.has("[   0.15] robot1 msg <- robot2 LockMessage {type: GET agent: \"robot2\" "
-              "resource: \"M1\"}"));
-  CHECK(t.has("[   0.20] robot1 msg -> LockMessage {type: ACCEPT agent: \"robot1\" resource: "
-              "\"M2\"}"));
+  CHECK(
+      t.has("[   0.15] robot1 msg <- robot2 LockMessage {type: GET agent: \"robot2\" "
+            "resource: \"M1\"}"));
+  CHECK(
+      t.has("[   0.20] robot1 msg -> LockMessage {type: ACCEPT agent: \"robot1\" resource: "
+            "\"M2\"}"));
   CHECK(f.sent().size() == 1);
 }
 
