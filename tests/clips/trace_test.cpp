@@ -85,7 +85,8 @@ TEST_CASE("fact_text and fact_texts print facts as CLIPS does") {
   CHECK(f.agent().fact_text(9999).empty());
   f.agent().assert_fact("(note \"a \\\"quoted\\\" string\")");
   f.agent().fact_texts(all);
-  CHECK(all.back().second == "(note \"a \\\"quoted\\\" string\")");
+  // As CLIPS 6.30 prints a fact: quotes inside a string are not escaped.
+  CHECK(all.back().second == "(note \"a \"quoted\" string\")");
 }
 
 TEST_CASE("a trace selects its kinds; without a sink nothing is traced") {
