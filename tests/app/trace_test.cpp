@@ -39,7 +39,7 @@ TEST_CASE("run --trace prints firings with matched facts, fact changes, skills a
       llsfsim({"run", dir.file("s.yaml"), "--no-db", "--no-record", "--trace", "robot1"});
   INFO(r.err);
   CHECK(r.code == 0);
-  CHECK(has(r.err, "[   0.00] robot1 ==> f-1 (state IDLE)"));
+  CHECK(has(r.err, "[   0.01] robot1 ==> f-1 (state IDLE)"));
   CHECK(has(r.err, "] robot1 FIRE go  f-1 (state IDLE), f-2 (machine (name M1) (mtype T1)), f-"));
   CHECK(has(r.err, "] robot1 <== f-1 (state IDLE)"));
   CHECK(has(r.err, "] robot1 log info going to M1"));
