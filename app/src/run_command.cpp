@@ -477,14 +477,18 @@ Action add_run_command(CLI::App& app) {
   app.add_flag("--no-record-agents", o->no_record_agents,
                "Record the game without the agents' facts and rule firings (the facts, fact and "
                "rules lines of docs/recording.md)");
-  app.add_option("--trace", o->trace,
-                 "Trace an agent: ROBOT[:KINDS] (repeatable; ROBOT a robot's name or all; KINDS "
-                 "a comma list of rules,facts,skills,msgs,log, default all). Prints rule firings "
-                 "with the facts that matched, fact assertions and retractions, skill calls and "
-                 "results, messages and log lines with simulated time stamps to stderr "
-                 "(docs/clips.md, \"Tracing\")")
-      ->type_name("ROBOT[:KINDS]");
-  app.add_option("--trace-file", o->trace_file, "Write the --trace lines to FILE, not stderr");
+  auto* trace =
+      app.add_option(
+             "--trace", o->trace,
+             "Trace an agent: ROBOT[:KINDS] (repeatable; ROBOT a robot's name or all; KINDS "
+             "a comma list of rules,facts,skills,msgs,log, default all). Prints rule firings "
+             "with the facts that matched, fact assertions and retractions, skill calls and "
+             "results, messages and log lines with simulated time stamps to stderr "
+             "(docs/clips.md, \"Tracing\")")
+          ->type_name("ROBOT[:KINDS]");
+  app.add_option("--trace-file", o->trace_file, "Write the --trace lines to FILE, not stderr")
+      ->type_name("FILE")
+      ->needs(trace);
   add_live_options(app, o->live,
                    "Serve the browser viewer with this game live (like `llsfsim serve`; best with "
                    "--speed or --realtime)");
