@@ -118,12 +118,14 @@ TEST_CASE("an agent's facts replay from the recording's snapshots and deltas") {
   CHECK(deltas > 10);
   CHECK(rules > 10);
   REQUIRE(seen.size() == probes.size());
-  for (const auto& [probe, at] : seen) {
-    INFO("t = ", at.first);
-    CHECK(at.second.size() > 20);
-    const Facts replayed = replay(lines, "robot1", at.first);
-    INFO(diff(replayed, at.second));
-    CHECK(replayed == at.second);
+  for (const auto& probe : seen) {
+    const double at = probe.second.first;
+    const Facts& facts = probe.second.second;
+    INFO("t = ", at);
+    CHECK(facts.size() > 20);
+    const Facts replayed = replay(lines, "robot1", at);
+    INFO(diff(replayed, facts));
+    CHECK(replayed == facts);
   }
   CHECK(replay(lines, "robot1", 70.0) == at_end);
   // The facts of the agent as AgentHost::facts() lists them, by index.
