@@ -49,8 +49,9 @@ struct RunOptions {
   bool no_db = false;
   std::string record;  ///< "" = default_recordings_dir(db)/recording_file_name(...)
   bool no_record = false;
-  bool strict = false;  ///< an agent mistake (RunIssue::is_mistake) fails the run
-  LiveOptions live;     ///< --speed, --realtime, --serve, --port, --serve-exit
+  bool no_reload = false;  // paced runs: do not reload changed CLIPS files
+  bool strict = false;     ///< an agent mistake (RunIssue::is_mistake) fails the run
+  LiveOptions live;        ///< --speed, --realtime, --serve, --port, --serve-exit
 };
 
 const study::Scenario* pick_variant(const study::ScenarioFile& f, const std::string& name,
@@ -210,6 +211,12 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
   if (o.live.pace() > 0.0) {
     hooks.tick = [pacer = Pacer(o.live.pace())](const sim::Game& g) {
       pacer.wait(g.time().seconds());
+    };
+    // Live editing: changed CLIPS files are reloaded (docs/llsfsim.md, "Editing while it plays").
+    hooks.reload_agents = !o.no_reload;
+    hooks.note = [&err](core::SimTime t, const std::string& robot, const std::string& text) {
+      err << fmt::format("[{:.1f} s] {}: {}\n", t.seconds(), robot, text);
+      err.flush();
     };
   }
   // --serve: the viewer's server on a background thread, fed every recording line.
@@ -448,6 +455,8 @@ Action add_run_command(CLI::App& app) {
                      "llsfsim-recordings/<scenario>[-<variant>]-seed<N>.jsonl.gz, beside the --db "
                      "file and named after it)");
   app.add_flag("--no-record", o->no_record, "Do not record the game")->excludes(record);
+  app.add_flag("--no-reload", o->no_reload,
+               "Paced runs: do not reload the agent's CLIPS files when they change");
   add_live_options(app, o->live,
                    "Serve the browser viewer with this game live (like `llsfsim serve`; best with "
                    "--speed or --realtime)");
