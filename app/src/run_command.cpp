@@ -49,6 +49,7 @@ struct RunOptions {
   bool no_db = false;
   std::string record;  ///< "" = default_recordings_dir(db)/recording_file_name(...)
   bool no_record = false;
+  bool no_reload = false;          // paced runs: do not reload changed CLIPS files
   bool strict = false;             ///< an agent mistake (RunIssue::is_mistake) fails the run
   std::vector<std::string> trace;  ///< --trace ROBOT[:KINDS], repeatable
   std::string trace_file;          ///< "" = stderr
@@ -234,6 +235,12 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
   if (o.live.pace() > 0.0) {
     hooks.tick = [pacer = Pacer(o.live.pace())](const sim::Game& g) {
       pacer.wait(g.time().seconds());
+    };
+    // Live editing: changed CLIPS files are reloaded (docs/llsfsim.md, "Editing while it plays").
+    hooks.reload_agents = !o.no_reload;
+    hooks.note = [&err](core::SimTime t, const std::string& robot, const std::string& text) {
+      err << fmt::format("[{:.1f} s] {}: {}\n", t.seconds(), robot, text);
+      err.flush();
     };
   }
   // --serve: the viewer's server on a background thread, fed every recording line.
@@ -474,6 +481,8 @@ Action add_run_command(CLI::App& app) {
                      "llsfsim-recordings/<scenario>[-<variant>]-seed<N>.jsonl.gz, beside the --db "
                      "file and named after it)");
   app.add_flag("--no-record", o->no_record, "Do not record the game")->excludes(record);
+  app.add_flag("--no-reload", o->no_reload,
+               "Paced runs: do not reload the agent's CLIPS files when they change");
   app.add_flag("--no-record-agents", o->no_record_agents,
                "Record the game without the agents' facts and rule firings (the facts, fact and "
                "rules lines of docs/recording.md)");

@@ -54,6 +54,7 @@ void AgentConfig::validate() const {
     throw std::invalid_argument("AgentConfig.max_steps_per_cycle must be > 0");
   if (!(max_cycle_wall_s > 0.0))
     throw std::invalid_argument("AgentConfig.max_cycle_wall_s must be > 0");
+  if (max_call_depth <= 0) throw std::invalid_argument("AgentConfig.max_call_depth must be > 0");
   if (locks) lock_config.validate();
 }
 
@@ -103,7 +104,8 @@ struct AgentHost::Impl {
   std::string werror;         // CLIPS error output not yet reported
   std::string lines[4];       // partial output lines per level
   std::string budget_reason;  // set when the work budget stopped the cycle
-  std::unordered_map<std::string, std::string> rule_places;  // defrule name -> "file:line"
+  std::unordered_map<std::string, std::string> rule_places;      // defrule name -> "file:line"
+  std::unordered_map<std::string, std::string> function_places;  // deffunction -> "file:line"
   std::int64_t max_steps_seen = 0;
   std::unique_ptr<detail::Tracer> tracer;  // set_trace()
 
@@ -208,8 +210,16 @@ struct AgentHost::Impl {
     return 1;
   }
 
-  // Where each defrule of `text` starts ("file:line"), for messages that name a rule.
+  // Where each defrule and deffunction (defgeneric, defmethod) of `text` starts ("file:line"),
+  // for messages that name one.
   void note_rule_places(const std::string& text, std::string_view source) {
+    const auto token_end = [&](std::size_t b) {
+      std::size_t e = b;
+      while (e < text.size() && std::isspace(static_cast<unsigned char>(text[e])) == 0 &&
+             text[e] != '(' && text[e] != ')' && text[e] != ';')
+        ++e;
+      return e;
+    };
     int line = 1;
     bool comment = false;
     for (std::size_t i = 0; i < text.size(); ++i) {
@@ -219,17 +229,43 @@ struct AgentHost::Impl {
         comment = false;
       } else if (c == ';') {
         comment = true;
-      } else if (!comment && c == '(' && text.compare(i + 1, 7, "defrule") == 0) {
-        std::size_t b = i + 8;
+      } else if (!comment && c == '(' && text.compare(i + 1, 3, "def") == 0) {
+        const std::size_t ke = token_end(i + 1);
+        const std::string_view keyword(text.data() + i + 1, ke - i - 1);
+        auto* places =
+            keyword == "defrule" ? &rule_places
+            : keyword == "deffunction" || keyword == "defgeneric" || keyword == "defmethod"
+                ? &function_places
+                : nullptr;
+        if (places == nullptr) continue;
+        std::size_t b = ke;
         while (b < text.size() && std::isspace(static_cast<unsigned char>(text[b])) != 0) ++b;
-        std::size_t e = b;
-        while (e < text.size() && std::isspace(static_cast<unsigned char>(text[e])) == 0 &&
-               text[e] != '(' && text[e] != ')' && text[e] != ';')
-          ++e;
-        if (e > b) {
-          rule_places[text.substr(b, e - b)] = std::string(source) + ":" + std::to_string(line);
-        }
+        const std::size_t e = token_end(b);
+        if (e > b)
+          (*places)[text.substr(b, e - b)] = std::string(source) + ":" + std::to_string(line);
       }
+    }
+  }
+
+  // Why the work budget stopped a cycle, for the runtime error it logs.
+  std::string budget_text() const {
+    using Hit = detail::Environment::BudgetHit;
+    switch (env.budget_hit()) {
+      case Hit::kDepth: {
+        const std::string& fn = env.budget_function();
+        const auto place = function_places.find(fn);
+        return "stopped at a call depth of " + std::to_string(state.config.max_call_depth) +
+               " in " + fn + (place != function_places.end() ? " (" + place->second + ")" : "") +
+               " (a recursion without end?); the game goes on";
+      }
+      case Hit::kWall:
+        return "stopped after " + core::number_text(state.config.max_cycle_wall_s) +
+               " s of wall time in one agent cycle (an endless loop in its actions?); the game "
+               "goes on";
+      default:
+        return "stopped after " + std::to_string(state.config.max_steps_per_cycle) +
+               " steps of work in one agent cycle (an endless loop in its actions?); the game "
+               "goes on";
     }
   }
 
@@ -255,7 +291,8 @@ struct AgentHost::Impl {
   }
 
   CycleResult cycle(core::SimTime now) {
-    env.start_budget(state.config.max_steps_per_cycle, state.config.max_cycle_wall_s);
+    env.start_budget(state.config.max_steps_per_cycle, state.config.max_cycle_wall_s,
+                     state.config.max_call_depth);
     if (!started) start(now);
     state.now = now;
     CycleResult result;
@@ -274,14 +311,7 @@ struct AgentHost::Impl {
       if (env.budget_hit() != detail::Environment::BudgetHit::kNone) {
         // The rule's actions were stopped by the work budget: the cycle ends here.
         result.budget_exceeded = true;
-        budget_reason =
-            env.budget_hit() == detail::Environment::BudgetHit::kSteps
-                ? "stopped after " + std::to_string(state.config.max_steps_per_cycle) +
-                      " steps of work in one agent cycle (an endless loop in its actions?); the "
-                      "game goes on"
-                : "stopped after " + core::number_text(state.config.max_cycle_wall_s) +
-                      " s of wall time in one agent cycle (an endless loop in its actions?); the "
-                      "game goes on";
+        budget_reason = budget_text();
         if (werror.find("[PRCCODE4]") == std::string::npos) {
           werror +=
               "[PRCCODE4] Execution halted during the actions of defrule " + env.next_rule() + ".";

@@ -326,6 +326,52 @@ int Template::slot_index(std::string_view slot) const {
   throw std::logic_error("deftemplate " + name + " has no slot " + std::string(slot));
 }
 
+// CLIPS evaluates a deffunction call (PCALL) and a generic function call (GCALL) through the
+// entity record registered for that type in this environment's PrimitivesArray. The guard puts a
+// copy of each record there whose evaluator counts the call as a budget step and the nesting
+// depth, then calls CLIPS' own evaluator. (A recursion never returns to CLIPS' periodic
+// callbacks, so without this a deffunction calling itself ends with the C stack: SIGSEGV.)
+struct Environment::CallGuard {
+  struct entityRecord pcall {};
+  struct entityRecord gcall {};
+  intBool (*pcall_eval)(void*, void*, DATA_OBJECT*) = nullptr;
+  intBool (*gcall_eval)(void*, void*, DATA_OBJECT*) = nullptr;
+
+  void install(void* clips_env) {
+    auto& prims = EvaluationData(clips_env)->PrimitivesArray;
+    if (prims[PCALL] != nullptr && prims[PCALL]->evaluateFunction != nullptr) {
+      pcall = *prims[PCALL];
+      pcall_eval = pcall.evaluateFunction;
+      pcall.evaluateFunction = &CallGuard::deffunction_call;
+      prims[PCALL] = &pcall;
+    }
+    if (prims[GCALL] != nullptr && prims[GCALL]->evaluateFunction != nullptr) {
+      gcall = *prims[GCALL];
+      gcall_eval = gcall.evaluateFunction;
+      gcall.evaluateFunction = &CallGuard::generic_call;
+      prims[GCALL] = &gcall;
+    }
+  }
+  static intBool call(void* clips_env, void* callee, DATA_OBJECT* result, bool generic) {
+    auto* self = static_cast<Environment*>(GetEnvironmentContext(clips_env));
+    if (!self->enter_call(callee, generic)) {
+      result->type = SYMBOL;
+      result->value = EnvFalseSymbol(clips_env);
+      return FALSE;
+    }
+    const auto eval = generic ? self->guard_->gcall_eval : self->guard_->pcall_eval;
+    const intBool ok = eval(clips_env, callee, result);
+    --self->call_depth_;
+    return ok;
+  }
+  static intBool deffunction_call(void* clips_env, void* callee, DATA_OBJECT* result) {
+    return call(clips_env, callee, result, false);
+  }
+  static intBool generic_call(void* clips_env, void* callee, DATA_OBJECT* result) {
+    return call(clips_env, callee, result, true);
+  }
+};
+
 // ---- Environment -----------------------------------------------------------------------------
 
 Environment::Environment() {
@@ -335,6 +381,25 @@ Environment::Environment() {
                           &RouterAccess::getc, &RouterAccess::ungetc, &RouterAccess::exit, this);
   SetEnvironmentContext(env_, this);
   EnvAddPeriodicFunction(env_, "llsf-budget", &Environment::periodic, 0);
+  guard_ = std::make_unique<CallGuard>();
+  guard_->install(env_);
+}
+
+bool Environment::enter_call(void* callee, bool generic) {
+  periodic(env_);  // a call is a step of the work budget
+  if (max_call_depth_ > 0 && call_depth_ >= max_call_depth_) {
+    if (budget_hit_ == BudgetHit::kNone || budget_hit_ == BudgetHit::kDepth) {
+      budget_hit_ = BudgetHit::kDepth;
+      const char* name =
+          generic ? EnvGetDefgenericName(env_, callee) : EnvGetDeffunctionName(env_, callee);
+      budget_function_ = name != nullptr ? name : "";
+    }
+    SetEvaluationError(env_, TRUE);
+    SetHaltExecution(env_, TRUE);
+    return false;
+  }
+  ++call_depth_;
+  return true;
 }
 
 void Environment::periodic(void* clips_env) {
@@ -354,8 +419,11 @@ void Environment::periodic(void* clips_env) {
   if (self->budget_hit_ != BudgetHit::kNone) SetHaltExecution(clips_env, TRUE);
 }
 
-void Environment::start_budget(std::int64_t max_steps, double max_wall_s) {
+void Environment::start_budget(std::int64_t max_steps, double max_wall_s, int max_call_depth) {
   steps_ = 0;
+  max_call_depth_ = max_call_depth;
+  call_depth_ = 0;
+  budget_function_.clear();
   max_steps_ = max_steps;
   max_wall_s_ = max_wall_s;
   budget_hit_ = BudgetHit::kNone;

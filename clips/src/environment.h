@@ -143,15 +143,19 @@ class Environment {
   std::int64_t run(std::int64_t limit);
 
   /// Why a budget stopped execution.
-  enum class BudgetHit : std::uint8_t { kNone, kSteps, kWall };
+  enum class BudgetHit : std::uint8_t { kNone, kSteps, kWall, kDepth };
   /// Starts a work budget for the following run()s: a step is one of CLIPS' periodic callbacks
   /// (about two per rule firing, one per iteration of while, loop-for-count, progn$, ...).
   /// Past `max_steps` steps, or (checked every 1,024 steps) past `max_wall_s` seconds of wall
   /// time, execution halts as on an error: the running rule's actions stop. Until the next
-  /// start_budget() every further step halts again.
-  void start_budget(std::int64_t max_steps, double max_wall_s);
+  /// start_budget() every further step halts again. A deffunction or generic function call is
+  /// also a step; nesting such calls deeper than `max_call_depth` halts too (kDepth), before the
+  /// C stack runs out: CLIPS 6.30 makes no periodic callback on the way down a recursion.
+  void start_budget(std::int64_t max_steps, double max_wall_s, int max_call_depth);
   BudgetHit budget_hit() const { return budget_hit_; }
   std::int64_t budget_steps() const { return steps_; }
+  /// With kDepth: the deffunction or generic function whose call went too deep.
+  const std::string& budget_function() const { return budget_function_; }
   /// The rule of the first activation on the agenda, or "" if it is empty.
   std::string next_rule() const;
   /// True if the current focus has activations left.
@@ -192,6 +196,10 @@ class Environment {
   void on_print(std::string_view logical_name, std::string_view text);
   static void periodic(void* clips_env);
   void print_fact(void* fact, std::string& out) const;
+  // The call guard: CLIPS' evaluators of deffunction (PCALL) and generic function (GCALL) calls,
+  // replaced in this environment by ones that count depth and steps (environment.cpp).
+  struct CallGuard;
+  bool enter_call(void* callee, bool generic);
 
   void* env_ = nullptr;
   OutputHandler output_;
@@ -214,6 +222,10 @@ class Environment {
   std::vector<std::int64_t> matched_;       // reused for on_fire
   mutable std::string* capture_ = nullptr;  // print_fact: where the capture router writes
   std::string fact_buf_;                    // reused for on_fact
+  int max_call_depth_ = 0;                  // 0: no limit
+  int call_depth_ = 0;
+  std::string budget_function_;
+  std::unique_ptr<CallGuard> guard_;
 };
 
 }  // namespace llsf::clips::detail

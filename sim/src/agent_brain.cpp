@@ -2,6 +2,7 @@
 #include "llsf/sim/agent_brain.h"
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -56,17 +57,26 @@ AgentBrain::AgentBrain(Game& game, int index, AgentBrainConfig config, clips::Lo
   io.broadcast = [radio](const google::protobuf::Message& m) { radio->broadcast(m); };
   io.log = std::move(log);
   io.lock_events = std::move(locks);
-  agent_ = std::make_unique<clips::AgentHost>(std::move(ac), std::move(io));
-  for (const std::string& f : agent_files(config.agent_files)) {
+  file_entries_ = std::move(config.agent_files);
+  locks_ = config.locks;
+  host_config_ = std::move(ac);
+  host_io_ = std::move(io);
+  loaded_ = stamp_files();
+  agent_ = make_host();
+}
+
+std::unique_ptr<clips::AgentHost> AgentBrain::make_host() const {
+  auto host = std::make_unique<clips::AgentHost>(host_config_, host_io_);
+  for (const std::string& f : agent_files(file_entries_)) {
     try {
-      agent_->load_file(f);
+      host->load_file(f);
     } catch (const clips::AgentLoadError& e) {
       // The lock template exists only with the lock protocol on: name the switch.
       const std::string what = e.what();
       std::ifstream in(f, std::ios::binary);
       const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-      if (!config.locks && (what.find("deftemplate lock") != std::string::npos ||
-                            text.find("(lock (") != std::string::npos)) {
+      if (!locks_ && (what.find("deftemplate lock") != std::string::npos ||
+                      text.find("(lock (") != std::string::npos)) {
         throw clips::AgentLoadError(
             what +
             "\nhint: the agent uses the host's lock facts, which exist only with the lock "
@@ -75,9 +85,62 @@ AgentBrain::AgentBrain(Game& game, int index, AgentBrainConfig config, clips::Lo
       throw;
     }
   }
+  return host;
+}
+
+std::vector<AgentBrain::FileStamp> AgentBrain::stamp_files() const {
+  std::vector<FileStamp> out;
+  for (const std::string& f : agent_files(file_entries_)) {
+    FileStamp s{f, -1, 0};
+    std::error_code ec;
+    const auto t = std::filesystem::last_write_time(f, ec);
+    if (!ec)
+      s.mtime_ns =
+          std::chrono::duration_cast<std::chrono::nanoseconds>(t.time_since_epoch()).count();
+    const auto size = std::filesystem::file_size(f, ec);
+    if (!ec) s.size = size;
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
+AgentBrain::Reload AgentBrain::reload_if_changed() {
+  Reload r;
+  std::vector<FileStamp> now = stamp_files();
+  if (now == loaded_) return r;
+  r.changed = true;
+  // Name the first file that differs (or the one that appeared or went).
+  std::string which;
+  for (std::size_t i = 0; i < std::max(now.size(), loaded_.size()) && which.empty(); ++i) {
+    if (i >= now.size())
+      which = loaded_[i].path + " removed";
+    else if (i >= loaded_.size())
+      which = now[i].path + " added";
+    else if (!(now[i] == loaded_[i]))
+      which = now[i].path + " changed";
+  }
+  loaded_ = std::move(now);  // a broken file is reported once, not at every check
+  try {
+    std::unique_ptr<clips::AgentHost> fresh = make_host();
+    skills_->engine().stop();
+    errors_before_reload_ += agent_->runtime_errors();
+    agent_ = std::move(fresh);
+    if (trace_sink_) agent_->set_trace(trace_options_, trace_sink_);
+    r.reloaded = true;
+    r.text = "agent reloaded (" + which + "); it restarts with its new rules";
+  } catch (const clips::AgentLoadError& e) {
+    r.text = "agent not reloaded (" + which + "), the old one goes on: " + e.what();
+  }
+  return r;
 }
 
 AgentBrain::~AgentBrain() = default;
+
+void AgentBrain::set_trace(clips::TraceOptions options, clips::TraceSink sink) {
+  trace_options_ = options;
+  trace_sink_ = sink;
+  agent_->set_trace(options, std::move(sink));
+}
 
 void AgentBrain::on_skill_cycle(lua::RobotApi& robot) { skills_->on_skill_cycle(robot); }
 

@@ -104,6 +104,7 @@ void strip_addresses(std::string& text) {
 
 /// One robot's agent trace being collected for the current cycle (Recorder::agent_trace).
 struct AgentFacts {
+  const clips::AgentHost* host = nullptr;  // a new host (a reloaded agent): a snapshot is due
   bool snapshot_written = false;
   core::SimTime next_snapshot;
   std::int64_t first_added = -1;      // the cycle's first asserted index (-1: none yet)
@@ -314,7 +315,9 @@ void Recorder::agent_trace(const clips::TraceEvent& e) {
       return;
   }
   // The end of a cycle: its rules line, its fact delta, a snapshot when due.
-  const bool snapshot = !a.snapshot_written || e.time >= a.next_snapshot;
+  const bool new_host = e.host != a.host;
+  a.host = e.host;
+  const bool snapshot = !a.snapshot_written || new_host || e.time >= a.next_snapshot;
   if (a.fired.empty() && a.first_added < 0 && a.removed.empty() && !snapshot) return;
   a.added.clear();
   if (a.first_added >= 0 && e.host != nullptr) e.host->fact_texts(a.added, a.first_added);
@@ -356,7 +359,7 @@ void Recorder::agent_trace(const clips::TraceEvent& e) {
     a.removed.clear();
   }
   if (snapshot && e.host != nullptr) {
-    if (!a.snapshot_written) a.next_snapshot = e.time;
+    if (!a.snapshot_written || new_host) a.next_snapshot = e.time;
     a.snapshot_written = true;
     while (a.next_snapshot <= e.time) a.next_snapshot += kFactSnapshotPeriod;
     e.host->fact_texts(a.all);

@@ -428,7 +428,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
         if (record_agent) recorder->agent_trace(e);
         if (trace && wants(*trace, e.kind)) hooks.trace_sink(clips::trace_line(e));
       };
-      brain.agent().set_trace(options, std::move(sink));
+      brain.set_trace(options, std::move(sink));
     }
     const bool trace_skills = trace && trace->skills;
     brain.skills().set_listener([&skill_failures, &hooks, &recorder, &streaks, &game, &add_issue, i,
@@ -492,7 +492,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
       case TestCase::Kind::kNoAgentErrors: {
         int errors = 0;
         for (int k = 0; k < game.robot_count(); ++k) {
-          if (const sim::AgentBrain* b = driver.agent(k)) errors += b->agent().runtime_errors();
+          if (const sim::AgentBrain* b = driver.agent(k)) errors += b->runtime_errors();
         }
         value = errors;
         d << errors << " agent runtime errors";
@@ -535,7 +535,20 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   int storage_min = pucks_in(game, storage);
   double storage_empty_s = storage_min == 0 ? 0.0 : -1.0;
   core::SimTime next_storage_sample = core::SimTime::from_sec(1);
+  core::SimTime next_reload_check = core::SimTime::from_sec(1);
   driver.run_until(end, [&](const sim::Game&) {
+    if (hooks.reload_agents && game.time() >= next_reload_check) {
+      next_reload_check += core::SimTime::from_sec(1);
+      for (int k = 0; k < game.robot_count(); ++k) {
+        sim::AgentBrain* b = driver.agent(k);
+        if (b == nullptr) continue;
+        const sim::AgentBrain::Reload re = b->reload_if_changed();
+        if (!re.changed) continue;
+        const std::string robot(game.robot(k).name());
+        if (recorder) recorder->note(game.time(), robot, re.text);
+        if (hooks.note) hooks.note(game.time(), robot, re.text);
+      }
+    }
     if (game.time() >= next_storage_sample) {
       next_storage_sample += core::SimTime::from_sec(1);
       const int n = pucks_in(game, storage);
@@ -631,8 +644,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   r.collisions = s.collisions_robot_robot + s.collisions_robot_wall + s.collisions_robot_device;
   r.skill_failures = skill_failures;
   for (int k = 0; k < game.robot_count(); ++k) {
-    if (const sim::AgentBrain* b = driver.agent(k))
-      r.agent_runtime_errors += b->agent().runtime_errors();
+    if (const sim::AgentBrain* b = driver.agent(k)) r.agent_runtime_errors += b->runtime_errors();
   }
   lock_waits.finish(game.time(), r);
   lock_hold_max_s = lock_holds.finish(game.time(), [&game](const std::string& robot) {

@@ -186,6 +186,58 @@ TEST_CASE("the work budget stops a runaway rule's actions, names it, and the gam
   CHECK_FALSE(f.step().budget_exceeded);
 }
 
+TEST_CASE("recursion without end in deffunctions stops at the call depth, names the function") {
+  AgentFixture f;
+  f.load(
+      "(deffunction down (?n) (+ 1 (down (+ ?n 1))))\n"
+      "(deffunction pong (?n))\n"
+      "(deffunction ping (?n) (pong ?n))\n"
+      "(deffunction pong (?n) (ping ?n))\n"
+      "(defgeneric spiral)\n"
+      "(defmethod spiral ((?n INTEGER)) (spiral (+ ?n 1)))\n"
+      "(deffunction depth (?n) (if (> ?n 0) then (+ 1 (depth (- ?n 1))) else 0))\n"
+      "(deffunction fib (?n) (if (< ?n 2) then ?n else (+ (fib (- ?n 1)) (fib (- ?n 2)))))\n"
+      "(defrule r-down (down) => (assert (got (down 0))))\n"
+      "(defrule r-ping (ping) => (ping 1))\n"
+      "(defrule r-spiral (spiral) => (spiral 1))\n"
+      "(defrule r-deep (deep) => (assert (deep-result (depth 1500))))\n"
+      "(defrule r-fib (fib) => (assert (fib-result (fib 40))))\n"
+      "(defrule alive (time $?) => (assert (alive)))\n",
+      "recurse.clp");
+  const int depth = AgentConfig{}.max_call_depth;
+  f.step();
+  f.assert_fact("(down)");
+  CycleResult r = f.step();
+  CHECK(r.budget_exceeded);
+  CHECK(r.runtime_errors == 1);
+  CHECK(f.logged("runtime error in rule r-down (recurse.clp:9): stopped at a call depth of " +
+                 std::to_string(depth) +
+                 " in down (recurse.clp:1) (a recursion without end?); the game goes on"));
+  // The game goes on: the next cycle runs normally.
+  r = f.step();
+  CHECK_FALSE(r.budget_exceeded);
+  CHECK(f.has("(alive)"));
+  // Mutual recursion and a generic function's method: the same.
+  f.assert_fact("(ping)");
+  CHECK(f.step().budget_exceeded);
+  CHECK(f.logged("runtime error in rule r-ping (recurse.clp:10): stopped at a call depth of"));
+  f.assert_fact("(spiral)");
+  CHECK(f.step().budget_exceeded);
+  CHECK(f.logged("in spiral (recurse.clp:6) (a recursion without end?)"));
+  // A deep but finite recursion within the limit works.
+  f.assert_fact("(deep)");
+  r = f.step();
+  CHECK_FALSE(r.budget_exceeded);
+  CHECK(f.has("(deep-result 1500)"));
+  // Shallow but exponential work: every call is a step of the work budget.
+  f.assert_fact("(fib)");
+  r = f.step();
+  CHECK(r.budget_exceeded);
+  CHECK(f.logged("runtime error in rule r-fib (recurse.clp:13): stopped after 1000000 steps"));
+  CHECK(f.agent().runtime_errors() == 4);
+  CHECK_FALSE(f.step().budget_exceeded);
+}
+
 TEST_CASE("printout and log functions reach the sink with the simulated time") {
   AgentFixture f;
   f.load(

@@ -5,7 +5,13 @@
 #include <doctest/doctest.h>
 #include <llsf_agent_msgs/LockMessage.pb.h>
 
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
 #include <string>
+#include <vector>
 
 #include "fixture.h"
 
@@ -20,6 +26,8 @@ AgentBrainConfig llsf2013_agent() {
                    LLSF_SOURCE_DIR "/clips/agents/llsf2013"};
   return c;
 }
+
+int reload_writes = 1;  // seconds added to each written file's modification time
 
 /// Counts its cycles; plugged by its owner.
 struct CountingBrain final : RobotBrain {
@@ -126,4 +134,61 @@ TEST_CASE("the radio's game side: robots by hub peer, inbox filled and cleared b
   CHECK(radio.inbox()[0].from_id == 2);
   radio.clear_inbox();
   CHECK(radio.inbox().empty());
+}
+
+TEST_CASE("AgentBrain::reload_if_changed: changed CLIPS files restart the agent; bad ones do not") {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("llsf-reload-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const auto write = [&](const std::string& text) {
+    std::ofstream(dir / "agent.clp") << text;
+    // A new modification time even on coarse file systems.
+    std::filesystem::last_write_time(dir / "agent.clp",
+                                     std::filesystem::last_write_time(dir / "agent.clp") +
+                                         std::chrono::seconds(reload_writes++));
+  };
+  write("(defrule first (time $?) (not (v1)) => (assert (v1)))\n");
+  GameDriver driver(test::small_game(1, 3));
+  AgentBrainConfig c;
+  c.agent_files = {dir.string()};
+  std::vector<std::string> errors;
+  AgentBrain& brain = driver.plug_agent(0, c, [&](const clips::LogRecord& r) {
+    if (r.level == clips::LogLevel::kError) errors.emplace_back(r.text);
+  });
+  driver.start(refbox::GamePhase::kExploration);
+  driver.run_until(core::SimTime::from_sec(1));
+  CHECK(brain.agent().facts("v1").size() == 1);
+  CHECK_FALSE(brain.reload_if_changed().changed);  // nothing changed
+
+  write("(defrule second (time $?) (not (v2)) => (assert (v2)) (eval \"(no-such-fn)\"))\n");
+  AgentBrain::Reload r = brain.reload_if_changed();
+  CHECK(r.changed);
+  CHECK(r.reloaded);
+  CHECK(r.text.find("agent reloaded (") == 0);
+  CHECK(r.text.find("agent.clp changed") != std::string::npos);
+  driver.run_until(core::SimTime::from_sec(2));
+  CHECK(brain.agent().facts("v1").empty());  // restarted: the old facts are gone
+  CHECK(brain.agent().facts("v2").size() == 1);
+  const int errors_after_second = brain.runtime_errors();
+  CHECK(errors_after_second == 1);
+
+  // A broken file: reported with file:line once, and the running agent goes on.
+  write("(defrule broken (time $?) => (assert (v3))\n");
+  r = brain.reload_if_changed();
+  CHECK(r.changed);
+  CHECK_FALSE(r.reloaded);
+  CHECK(r.text.find("agent not reloaded") == 0);
+  CHECK(r.text.find("agent.clp:") != std::string::npos);
+  CHECK_FALSE(brain.reload_if_changed().changed);
+  driver.run_until(core::SimTime::from_sec(3));
+  CHECK(brain.agent().facts("v2").size() == 1);
+
+  // Fixed again: reloaded; the runtime errors of the earlier agents still count.
+  write("(defrule third (time $?) (not (v3)) => (assert (v3)) (eval \"(no-such-fn)\"))\n");
+  CHECK(brain.reload_if_changed().reloaded);
+  driver.run_until(core::SimTime::from_sec(4));
+  CHECK(brain.agent().facts("v3").size() == 1);
+  CHECK(brain.runtime_errors() == errors_after_second + 1);
+  std::filesystem::remove_all(dir);
 }

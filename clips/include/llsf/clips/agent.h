@@ -82,6 +82,10 @@ struct AgentConfig {
   /// below both (measured: docs/clips.md); the wall time only cuts runaway work.
   std::int64_t max_steps_per_cycle = 1'000'000;
   double max_cycle_wall_s = 10.0;
+  /// Deffunction and generic-function calls nested deeper than this stop the rule's actions the
+  /// same way (a recursion without end would otherwise overflow the C stack). A level takes
+  /// 0.5-1 KB of stack (measured: docs/clips.md, "Budgets").
+  int max_call_depth = 2'000;
   ConfigEntries config;  ///< asserted as confval facts after (reset)
   /// Runs the resource-lock protocol (docs/locks.md): lock facts, lock messages consumed, the
   /// master's announcements. Off by default, so that agents without locks stay silent.

@@ -59,6 +59,25 @@ class AgentBrain final : public RobotBrain, private clips::SkillRunner {
 
   clips::AgentHost& agent() { return *agent_; }
   const clips::AgentHost& agent() const { return *agent_; }
+  /// Runtime errors of this robot's agent since the game started (over reloads).
+  int runtime_errors() const { return errors_before_reload_ + agent_->runtime_errors(); }
+
+  /// What reload_if_changed() did.
+  struct Reload {
+    bool changed = false;   ///< an agent file changed, appeared or disappeared
+    bool reloaded = false;  ///< the new files loaded: the agent restarted with them
+    std::string text;       ///< "agent reloaded (FILE changed)" or the load error (old agent kept)
+  };
+  /// Live editing (paced runs): if an agent file changed since it was loaded (modification time
+  /// or size; a directory's *.clp files are listed anew), loads the files into a new agent. If
+  /// they load, the robot's agent restarts with them at its next cycle (facts, locks and the
+  /// running skill are dropped; rules and confvals are the new files'); if not, the old agent
+  /// goes on and `text` has the error (file:line). Never called in unpaced games: a game's
+  /// result must not depend on the file system's timing.
+  Reload reload_if_changed();
+  /// Traces the agent (clips::AgentHost::set_trace), also after a reload: the new agent gets
+  /// the same trace.
+  void set_trace(clips::TraceOptions options, clips::TraceSink sink);
   SkillBrain& skills() { return *skills_; }
   const SkillBrain& skills() const { return *skills_; }
 
@@ -74,7 +93,26 @@ class AgentBrain final : public RobotBrain, private clips::SkillRunner {
   std::string skill_string() const override;
   std::string result() const override;
 
+  // A new host with the agent files loaded (throws clips::AgentLoadError).
+  std::unique_ptr<clips::AgentHost> make_host() const;
+  // The agent files (directories expanded) with their modification time and size.
+  struct FileStamp {
+    std::string path;
+    std::int64_t mtime_ns = 0;
+    std::uintmax_t size = 0;
+    bool operator==(const FileStamp&) const = default;
+  };
+  std::vector<FileStamp> stamp_files() const;
+
   std::unique_ptr<SkillBrain> skills_;
+  std::vector<std::string> file_entries_;  // as configured (files and directories)
+  bool locks_ = false;
+  clips::AgentConfig host_config_;
+  clips::AgentIo host_io_;
+  std::vector<FileStamp> loaded_;  // the files as last loaded
+  int errors_before_reload_ = 0;
+  clips::TraceOptions trace_options_;  // set_trace(), for reloaded agents
+  clips::TraceSink trace_sink_;
   std::unique_ptr<clips::AgentHost> agent_;
 };
 

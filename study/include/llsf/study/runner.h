@@ -179,6 +179,13 @@ struct RunHooks {
   /// core::UserError before anything is written.
   std::vector<TraceRequest> trace;
   std::function<void(std::string_view line)> trace_sink;
+  /// Live editing (paced runs only: `run --realtime`/`--speed`): every simulated second, each
+  /// robot's CLIPS files are checked and reloaded when they changed
+  /// (sim::AgentBrain::reload_if_changed); what happened goes to `note` and the recording
+  /// (a `note` line).
+  bool reload_agents = false;
+  /// Messages about the game for the user (agent reloads), with the robot they concern.
+  std::function<void(core::SimTime t, const std::string& robot, const std::string& text)> note;
 };
 
 /// Plays `scenario` with `seed`. Throws clips::AgentLoadError / core::ConfigError before the
