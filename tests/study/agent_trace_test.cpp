@@ -171,7 +171,7 @@ TEST_CASE("recordings with the agents stay byte-identical for one seed") {
   CHECK(runs[0] == runs[1]);
   CHECK(runs[0].find("\"e\":\"facts\",\"robot\":\"robot3\"") != std::string::npos);
   CHECK(runs[0].find("\"e\":\"rules\"") != std::string::npos);
-  // The header line is the same; llsfsim's version is in it.
+  // A delta of another robot, with assertions.
   CHECK(runs[0].find("\"e\":\"fact\",\"robot\":\"robot2\",\"a\":[[") != std::string::npos);
 }
 
