@@ -11,6 +11,7 @@
 
 #include "feature.h"
 #include "llsf/core/config.h"
+#include "sandbox.h"
 
 namespace llsf::clips {
 
@@ -131,6 +132,7 @@ struct AgentHost::Impl {
         continue;
       load(detail::kBuiltinCode[i].text, detail::kBuiltinCode[i].name);
     }
+    if (state.config.sandbox) detail::install_sandbox(env);
     for (auto& f : features) f->bind(env);
   }
 

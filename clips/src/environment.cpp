@@ -412,6 +412,36 @@ void Environment::define_function(const std::string& name, const std::string& re
     throw std::logic_error("CLIPS: cannot define function " + name);
 }
 
+namespace {
+
+// The parser of a forbidden function: the call is a parse error naming the function.
+struct expr* forbidden_parser(void* clips_env, struct expr* top, const char* /*logical_name*/) {
+  const auto* self = static_cast<const Environment*>(GetEnvironmentContext(clips_env));
+  const std::string name = ValueToString(ExpressionFunctionCallName(top));
+  std::string text = "[LLSF2] " + name + ": " + self->forbidden_reason(name) + "\n";
+  EnvPrintRouter(clips_env, WERROR, text.c_str());
+  ReturnExpression(clips_env, top);
+  return nullptr;
+}
+
+}  // namespace
+
+void Environment::forbid_function(const std::string& name, const std::string& message) {
+  if (FindFunction(env_, name.c_str()) == nullptr) return;
+  forbidden_[name] = message;
+  define_function(name, "", [this, name](Args&) {
+    error(name, forbidden_reason(name));
+    return Value{};
+  });
+  if (AddFunctionParser(env_, name.c_str(), &forbidden_parser) == 0)
+    throw std::logic_error("CLIPS: cannot forbid function " + name);
+}
+
+std::string Environment::forbidden_reason(std::string_view name) const {
+  const auto it = forbidden_.find(name);
+  return it != forbidden_.end() ? it->second : std::string("not available");
+}
+
 void Environment::error(std::string_view function, std::string_view message) {
   std::string text = "[LLSF1] ";
   text.append(function).append(": ").append(message).append("\n");

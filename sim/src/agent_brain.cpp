@@ -41,6 +41,7 @@ AgentBrain::AgentBrain(Game& game, int index, AgentBrainConfig config, clips::Lo
   core::RandomStream seed = game.rng().stream("clips/" + ac.robot_name);
   ac.seed = seed.next_u64();
   ac.max_rules_per_cycle = config.max_rules_per_cycle;
+  ac.sandbox = config.sandbox;
   ac.config = std::move(config.config);
   if (config.locks) {
     ac.locks = true;
