@@ -174,7 +174,7 @@ robots:
     - {config: {machines: [M8, M4, M3, M1, M5]}}
     - {config: {machines: [M9, M10, M7, M6, M2]}}
 tests:
-  - {name: machines explored and reported, exploration_points_at_least: 8}
+  - {name: most machines explored and reported, exploration_points_at_least: 30}
   - no_agent_errors: true
 )yaml";
 
