@@ -758,8 +758,8 @@ RuleTestFile RuleTestFile::load(const std::string& path, const comm::MessageRegi
     t.read("allow_runtime_errors", c.allow_runtime_errors);
     c.given = parse_steps(t["given"], true, registry);
     c.steps = parse_steps(t["steps"], false, registry);
-    if (c.steps.empty() && c.given.empty()) t.fail("a test case needs given facts or steps");
     t.no_other_keys();
+    if (c.steps.empty() && c.given.empty()) t.fail("a test case needs given facts or steps");
     impl->cases.push_back(std::move(c));
   }
   root.no_other_keys();

@@ -29,7 +29,7 @@ constexpr const char* kAgent = R"clp(
   (modify ?j (state RUNNING))
   (skill-call drive_to place ?p))
 (defrule job-done
-  ?j <- (job (state RUNNING))
+  ?j <- (job (place ?p) (state RUNNING))
   ?s <- (skill (name drive_to) (status FINAL))
   =>
   (retract ?s)
@@ -38,7 +38,7 @@ constexpr const char* kAgent = R"clp(
   (bind ?m (pb-create "llsf_agent_msgs.LockMessage"))
   (pb-set-field ?m "type" RELEASE)
   (pb-set-field ?m "agent" (str-cat ?*ROBOT-NAME*))
-  (pb-set-field ?m "resource" (str-cat (fact-slot-value ?j place)))
+  (pb-set-field ?m "resource" (str-cat ?p))
   (pb-broadcast ?m)
   (pb-destroy ?m))
 (defrule heard
@@ -201,7 +201,7 @@ TEST_CASE("rule tests: bad input") {
     CHECK(e.find("unknown key 'expct' (did you mean 'expect'?)") != std::string::npos);
   }
   SUBCASE("a misspelt case key") {
-    const Dir d("agent: agent.clp\ntests:\n  - name: x\n    stesp:\n      - step: 1\n");
+    const Dir d("agent: agent.clp\ntests:\n  - name: x\n    step:\n      - step: 1\n");
     CHECK(load_error(d).find("did you mean 'steps'?") != std::string::npos);
   }
   SUBCASE("two actions in one step") {
