@@ -196,7 +196,9 @@ std::vector<Fact> matching(const AgentHost& agent, const Pattern& p) {
       continue;
     }
     bool ok = true;
-    for (const auto& [name, values] : p.slots) {
+    for (const auto& slot : p.slots) {
+      const std::string& name = slot.first;
+      const std::vector<Value>& values = slot.second;
       const auto it = std::find_if(f.slots.begin(), f.slots.end(),
                                    [&](const auto& s) { return s.first == name; });
       if (it == f.slots.end()) {
@@ -934,7 +936,8 @@ class CaseRunner {
         }
         // Check the slot names before CLIPS sees them (a bad one is bad input, not a runtime
         // error of the agent).
-        for (const auto& [name, values] : s.pattern.slots) {
+        for (const auto& slot : s.pattern.slots) {
+          const std::string& name = slot.first;
           const auto& have = found[0].slots;
           if (std::any_of(have.begin(), have.end(), [&](const auto& x) { return x.first == name; }))
             continue;
