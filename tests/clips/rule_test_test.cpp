@@ -156,6 +156,27 @@ tests:
   CHECK(joined(r).find("(job (place M1) (state RUNNING))") != std::string::npos);
 }
 
+TEST_CASE("rule tests: a broadcast must have the given fields") {
+  const Dir d(R"yaml(agent: agent.clp
+tests:
+  - name: wrong resource
+    given: ["(job (place M1))"]
+    steps:
+      - step: 1
+      - skill: FINAL
+      - step: 1
+      - expect_sent: llsf_agent_msgs.LockMessage
+        fields: {resource: M2}
+)yaml");
+  const RuleTestResult r = RuleTestFile::load(d.file(), registry()).run(0);
+  CHECK_FALSE(r.passed);
+  REQUIRE_FALSE(r.failure.empty());
+  CHECK(r.failure[0].find(":9: test wrong resource: expected a broadcast "
+                          "llsf_agent_msgs.LockMessage {resource: \"M2\"} since the start of the "
+                          "case but none of the 1 of that type matches") != std::string::npos);
+  CHECK(joined(r).find("resource: \"M1\"") != std::string::npos);
+}
+
 TEST_CASE("rule tests: skill expectations look at the calls since the last step after one") {
   const Dir d(R"yaml(agent: agent.clp
 tests:
