@@ -1025,6 +1025,7 @@ class CaseRunner {
           if (s.message) {
             pb::util::MessageDifferencer d;
             d.set_scope(pb::util::MessageDifferencer::PARTIAL);
+            d.set_repeated_field_comparison(pb::util::MessageDifferencer::AS_SET);
             if (!d.Compare(*s.message, m)) continue;
           }
           ++n;
