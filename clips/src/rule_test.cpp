@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <map>
 #include <numbers>
@@ -602,6 +603,24 @@ void read_robot(const ConfigNode& n, RobotIdentity& r) {
   n.no_other_keys();
 }
 
+/// The line of the test file on which the text of `setup` starts: the line after a block scalar's
+/// `|` or `>`, else the value's line.
+int setup_first_line(const ConfigNode& setup, const std::string& path) {
+  const std::string loc = setup.location();
+  const auto c2 = loc.rfind(':');
+  const auto c1 = c2 == std::string::npos || c2 == 0 ? std::string::npos : loc.rfind(':', c2 - 1);
+  if (c1 == std::string::npos) return 1;
+  const int line = std::atoi(loc.c_str() + c1 + 1);
+  const int column = std::atoi(loc.c_str() + c2 + 1);
+  std::ifstream in(path);
+  std::string text;
+  for (int i = 0; i < line && std::getline(in, text); ++i) {
+  }
+  const auto at = static_cast<std::size_t>(std::max(column - 1, 0));
+  const bool block = at < text.size() && (text[at] == '|' || text[at] == '>');
+  return std::max(1, block ? line + 1 : line);
+}
+
 /// `over`'s entries replace `base`'s of the same path.
 ConfigEntries merge(ConfigEntries base, const ConfigEntries& over) {
   for (const ConfigEntry& e : over) {
@@ -684,7 +703,7 @@ struct RuleTestFile::Impl {
   /// Loads the agent into `f`; throws AgentLoadError.
   void load_agent(AgentFixture& f) const {
     for (const std::string& file : agent_files) f.load_file(file);
-    if (!setup.empty()) f.load(setup, path + " (setup)");
+    if (!setup.empty()) f.load(setup, path);
   }
 };
 
@@ -726,7 +745,11 @@ RuleTestFile RuleTestFile::load(const std::string& path, const comm::MessageRegi
   }
   impl->agent_files = expand_agent_files(entries);
   if (impl->agent_files.empty()) agent.fail("no *.clp files");
-  root.read("setup", impl->setup);
+  if (const ConfigNode setup = root["setup"]; setup.defined()) {
+    // Padded with empty lines, so that CLIPS' errors name the test file's lines.
+    impl->setup = std::string(static_cast<std::size_t>(setup_first_line(setup, path) - 1), '\n') +
+                  setup.as_string();
+  }
   std::string description;
   root.read("description", description);
 

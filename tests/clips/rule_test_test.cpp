@@ -264,6 +264,14 @@ TEST_CASE("rule tests: bad input") {
       CHECK(std::string(e.what()).find("bad.clp:") != std::string::npos);
     }
   }
+  SUBCASE("an error in the setup code names the test file's line") {
+    const Dir d(
+        "agent: agent.clp\nsetup: |\n  (deffunction ok () 1)\n  (defrule bad (a) => (foo))\n"
+        "tests:\n  - name: x\n    steps:\n      - step: 1\n");
+    const std::string e = load_error(d);
+    CHECK(e.find("the agent does not load") != std::string::npos);
+    CHECK(e.find(d.file() + ":4: ") != std::string::npos);
+  }
   SUBCASE("a slot the template does not have is bad input at run time") {
     const Dir d(
         "agent: agent.clp\ntests:\n  - name: x\n    given: ['(job (place M1))']\n"
