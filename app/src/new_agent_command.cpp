@@ -277,6 +277,10 @@ int new_agent(const NewAgentOptions& o, std::ostream& out, std::ostream& err) {
 Action add_new_command(CLI::App& app) {
   auto o = std::make_shared<NewAgentOptions>();
   app.require_subcommand(1);
+  app.footer(
+      "`llsfsim new agent DIR`: a minimal working two-robot CLIPS agent with a scenario and a "
+      "rule test (llsfsim new agent --help).\n"
+      "Exit code: 0 written, 2 bad input, 3 internal error (a bug: please report it).");
   CLI::App* agent = app.add_subcommand(
       "agent", "Write a minimal working two-robot CLIPS agent with a scenario and a rule test");
   agent->add_option("dir", o->dir, "Directory to write to (created; must be empty)")->required();
@@ -286,7 +290,8 @@ Action add_new_command(CLI::App& app) {
       "refbox and parks in production), DIR/scenario.yaml (two robots with the agent) and "
       "DIR/tests/agent_test.yaml (rule tests). Then: `llsfsim test-agent DIR`, `llsfsim run "
       "DIR/scenario.yaml`.\n"
-      "Exit code: 0 written, 2 DIR is not empty (without --force) or cannot be written.");
+      "Exit code: 0 written, 2 DIR is not empty (without --force) or cannot be written, 3 "
+      "internal error (a bug: please report it).");
   return [o](std::ostream& out, std::ostream& err) { return new_agent(*o, out, err); };
 }
 
