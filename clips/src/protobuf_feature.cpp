@@ -175,6 +175,7 @@ class ProtobufFeature final : public Feature {
     v.type = type;
     v.text.assign(text);
   }
+
   enum class Kind : std::uint8_t { kCreated, kReceived, kView };
   struct Entry {
     Kind kind;
