@@ -63,6 +63,16 @@ int run(std::span<const std::string> args, std::ostream& out, std::ostream& err)
   }
   {
     CLI::App* sub = app.add_subcommand(
+        "test-agent", "Run rule tests of CLIPS agents (YAML files) without the world");
+    commands.emplace_back(sub, add_test_agent_command(*sub));
+  }
+  {
+    CLI::App* sub = app.add_subcommand(
+        "new", "Write a starting point: `new agent DIR` (agent, scenario, test)");
+    commands.emplace_back(sub, add_new_command(*sub));
+  }
+  {
+    CLI::App* sub = app.add_subcommand(
         "skill", "Run skill strings on one robot in a fresh game; print status changes");
     commands.emplace_back(sub, add_skill_command(*sub));
   }

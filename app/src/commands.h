@@ -35,6 +35,10 @@ Action add_report_command(CLI::App& app);
 Action add_check_command(CLI::App& app);
 /// `llsfsim exercise`: a hackathon exercise (exercises/) played with the participant's skill.
 Action add_exercise_command(CLI::App& app);
+/// `llsfsim test-agent`: rule tests of CLIPS agents from YAML files (docs/agent-tests.md).
+Action add_test_agent_command(CLI::App& app);
+/// `llsfsim new agent`: a minimal working two-robot agent with a scenario and a rule test.
+Action add_new_command(CLI::App& app);
 /// `llsfsim serve`: the browser viewer's HTTP/WebSocket server (server.h) until SIGINT/SIGTERM.
 Action add_serve_command(CLI::App& app);
 

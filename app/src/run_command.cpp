@@ -432,6 +432,7 @@ int check(const std::vector<std::string>& files, std::ostream& out, std::ostream
           c.config = spec.config;
           c.skills = s.skills;
           c.locks = spec.locks;
+          c.sandbox = spec.sandbox;
           const sim::AgentBrain& brain = driver.plug_agent(i, c);
           for (const std::string& e : brain.skills().engine().load_errors()) {
             throw core::ConfigError("skill file error: " + e);

@@ -12,6 +12,7 @@
 #include "feature.h"
 #include "llsf/core/config.h"
 #include "tracer.h"
+#include "sandbox.h"
 
 namespace llsf::clips {
 
@@ -144,6 +145,7 @@ struct AgentHost::Impl {
         continue;
       load(detail::kBuiltinCode[i].text, detail::kBuiltinCode[i].name);
     }
+    if (state.config.sandbox) detail::install_sandbox(env);
     for (auto& f : features) f->bind(env);
   }
 

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <map>
 #include <memory>
 #include <span>
 #include <string>
@@ -116,6 +117,13 @@ class Environment {
   /// Defines (or replaces, e.g. `random`) a function. `restrictions` is CLIPS' argument
   /// restriction string ("22n": exactly two numbers, "1**": at least one of any type).
   void define_function(const std::string& name, const std::string& restrictions, Function fn);
+  /// Makes a function unavailable (the agents' sandbox): a call of `name` in code loaded later,
+  /// or parsed by eval/build, is an error "[LLSF2] name: message" (a load error with its line);
+  /// a call that needs no parsing (funcall) fails the same way at run time. A function this
+  /// CLIPS does not have is skipped.
+  void forbid_function(const std::string& name, const std::string& message);
+  /// Why `name` is forbidden (forbid_function).
+  std::string forbidden_reason(std::string_view name) const;
   /// Reports a bad call: prints "[LLSF1] name: message" to werror and sets CLIPS' evaluation
   /// error, which stops the rule's actions (the host then logs it as a runtime error).
   void error(std::string_view function, std::string_view message);
@@ -204,6 +212,7 @@ class Environment {
   void* env_ = nullptr;
   OutputHandler output_;
   std::deque<FunctionEntry> functions_;  // stable addresses: CLIPS holds pointers to them
+  std::map<std::string, std::string, std::less<>> forbidden_;  // forbid_function: name -> why
   // Error capture while loading: werror text and where each message started.
   bool loading_ = false;
   std::string load_errors_;

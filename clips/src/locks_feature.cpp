@@ -161,33 +161,48 @@ class LocksFeature final : public Feature {
   // until the next request, RELEASE_RVCD when a release is done.
   void sync(Environment& env) {
     set_role(env);
-    for (const std::string& r : mgr_->resources()) shown_.try_emplace(r);
-    for (auto& [r, sh] : shown_) {
-      const LockState st = mgr_->state(r);
-      if (st == sh.state) continue;
-      switch (st) {
-        case LockState::kAccepted:
-          env.retract(sh.refuse);
-          env.retract(sh.accept);
-          sh.accept = assert_lock(env, "ACCEPT", r, true);
-          break;
-        case LockState::kRefused:
-          env.retract(sh.accept);
-          env.retract(sh.refuse);
-          sh.refuse = assert_lock(env, "REFUSE", r, true);
-          break;
-        case LockState::kNone:
-          env.retract(sh.accept);
-          env.retract(sh.refuse);
-          if (sh.state == LockState::kReleasing) assert_lock(env, "RELEASE_RVCD", r, false);
-          break;
-        case LockState::kRequested:
-        case LockState::kReleasing:
-          env.retract(sh.accept);
-          break;
+    // One sorted walk over the manager's resources and shown_ (both ordered by name): shown_
+    // gains every resource with a state, and each entry is updated in name order, as a look-up
+    // per entry would.
+    auto it = shown_.begin();
+    mgr_->for_each_state([&](const std::string& r, LockState st) {
+      for (; it != shown_.end() && it->first < r; ++it)
+        update(env, it->first, it->second, LockState::kNone);
+      if (it == shown_.end() || it->first != r) {
+        if (st == LockState::kNone) return;
+        it = shown_.emplace_hint(it, r, Shown{});
       }
-      set_state(sh, r, st);
+      update(env, it->first, it->second, st);
+      ++it;
+    });
+    for (; it != shown_.end(); ++it) update(env, it->first, it->second, LockState::kNone);
+  }
+
+  // One shown entry follows the manager's state `st` (facts and lock events on a change).
+  void update(Environment& env, const std::string& r, Shown& sh, LockState st) {
+    if (st == sh.state) return;
+    switch (st) {
+      case LockState::kAccepted:
+        env.retract(sh.refuse);
+        env.retract(sh.accept);
+        sh.accept = assert_lock(env, "ACCEPT", r, true);
+        break;
+      case LockState::kRefused:
+        env.retract(sh.accept);
+        env.retract(sh.refuse);
+        sh.refuse = assert_lock(env, "REFUSE", r, true);
+        break;
+      case LockState::kNone:
+        env.retract(sh.accept);
+        env.retract(sh.refuse);
+        if (sh.state == LockState::kReleasing) assert_lock(env, "RELEASE_RVCD", r, false);
+        break;
+      case LockState::kRequested:
+      case LockState::kReleasing:
+        env.retract(sh.accept);
+        break;
     }
+    set_state(sh, r, st);
   }
 
   HostState& s_;

@@ -10,6 +10,8 @@
 #include <google/protobuf/descriptor.h>
 #include <google/protobuf/message.h>
 
+#include <array>
+#include <cstdint>
 #include <unordered_map>
 
 #include "feature.h"
@@ -120,22 +122,32 @@ class ProtobufFeature final : public Feature {
   }
 
   void before_run(Environment& env) override {
+    // The slot values are rewritten in place (their strings and lists keep their capacity): no
+    // allocation per message once the longest type name and peer name have been seen.
     for (auto& r : s_.inbox) {
       Message* m = r.message.get();
       add(std::move(r.message), Kind::kReceived, m);
-      for (auto& v : values_) v = Value{};
-      values_[static_cast<std::size_t>(slot_type_)] = Value::string(m->GetTypeName());
-      if (s_.io.messages != nullptr) {
-        if (auto key = s_.io.messages->key_of(*m)) {
-          values_[static_cast<std::size_t>(slot_comp_)] = Value::integer_value(key->component_id);
-          values_[static_cast<std::size_t>(slot_msg_type_)] = Value::integer_value(key->msg_type);
-        }
+      set_text(slot_type_, Value::Type::kString, m->GetDescriptor()->full_name());
+      std::optional<comm::MessageKey> key;
+      if (s_.io.messages != nullptr) key = s_.io.messages->key_of(*m);
+      Value& comp = values_[static_cast<std::size_t>(slot_comp_)];
+      Value& msg_type = values_[static_cast<std::size_t>(slot_msg_type_)];
+      comp.type = msg_type.type = key ? Value::Type::kInteger : Value::Type::kVoid;  // or default
+      if (key) {
+        comp.integer = key->component_id;
+        msg_type.integer = key->msg_type;
       }
-      values_[static_cast<std::size_t>(slot_from_)] =
-          Value::multifield({Value::string(std::move(r.from)), Value::integer_value(r.from_id)});
-      values_[static_cast<std::size_t>(slot_at_)] =
-          Value::multifield({Value::integer_value(r.at.ns() / kNsPerSec),
-                             Value::integer_value((r.at.ns() % kNsPerSec) / 1000)});
+      Value& from = values_[static_cast<std::size_t>(slot_from_)];
+      from.type = Value::Type::kMultifield;
+      from.items.resize(2);
+      from.items[0].type = Value::Type::kString;
+      from.items[0].text.assign(r.from);
+      from.items[1] = Value::integer_value(r.from_id);
+      Value& at = values_[static_cast<std::size_t>(slot_at_)];
+      at.type = Value::Type::kMultifield;
+      at.items.resize(2);
+      at.items[0] = Value::integer_value(r.at.ns() / kNsPerSec);
+      at.items[1] = Value::integer_value((r.at.ns() % kNsPerSec) / 1000);
       values_[static_cast<std::size_t>(slot_client_id_)] = Value::integer_value(r.from_id);
       values_[static_cast<std::size_t>(slot_ptr_)] = Value::external(m);
       facts_.push_back(env.assert_fact(msg_, values_));
@@ -157,6 +169,13 @@ class ProtobufFeature final : public Feature {
   }
 
  private:
+  // A text slot value, reusing the string's capacity.
+  void set_text(int slot, Value::Type type, const std::string& text) {
+    Value& v = values_[static_cast<std::size_t>(slot)];
+    v.type = type;
+    v.text.assign(text);
+  }
+
   enum class Kind : std::uint8_t { kCreated, kReceived, kView };
   struct Entry {
     Kind kind;
@@ -208,9 +227,23 @@ class ProtobufFeature final : public Feature {
       return nullptr;
     }
     m = e->message;
-    const FieldDescriptor* f = m->GetDescriptor()->FindFieldByName(std::string(name));
+    const FieldDescriptor* f = find_field(m->GetDescriptor(), name);
     if (f == nullptr)
       a.env().error(a.function(), m->GetTypeName() + " has no field " + std::string(name));
+    return f;
+  }
+
+  // FindFieldByName with a small cache: field names are CLIPS symbols whose text stays at one
+  // address while the rule that names them exists; a hit is checked against the field's name, so
+  // a reused address can never return the wrong field.
+  const FieldDescriptor* find_field(const Descriptor* d, std::string_view name) {
+    const auto key =
+        reinterpret_cast<std::uintptr_t>(d) ^ reinterpret_cast<std::uintptr_t>(name.data());
+    FieldCacheEntry& c = field_cache_[(key >> 3) % kFieldCacheSize];
+    if (c.descriptor == d && c.name == name.data() && c.field != nullptr && c.field->name() == name)
+      return c.field;
+    const FieldDescriptor* f = d->FindFieldByName(std::string(name));
+    if (f != nullptr) c = {d, name.data(), f};
     return f;
   }
 
@@ -405,6 +438,13 @@ class ProtobufFeature final : public Feature {
   std::vector<FactHandle> facts_;
   std::unordered_map<const void*, Entry> entries_;
   std::unordered_map<std::string, const Message*> by_name_;
+  struct FieldCacheEntry {
+    const Descriptor* descriptor = nullptr;
+    const char* name = nullptr;
+    const FieldDescriptor* field = nullptr;
+  };
+  static constexpr std::size_t kFieldCacheSize = 64;
+  std::array<FieldCacheEntry, kFieldCacheSize> field_cache_{};
   int nested_types_ = 0;  // entries of by_name_ that are not registry types
 };
 

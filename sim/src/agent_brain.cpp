@@ -8,24 +8,12 @@
 #include <iterator>
 #include <utility>
 
+#include "llsf/clips/rule_test.h"
+
 namespace llsf::sim {
 
 std::vector<std::string> agent_files(const std::vector<std::string>& entries) {
-  std::vector<std::string> out;
-  for (const std::string& e : entries) {
-    std::error_code ec;
-    if (!std::filesystem::is_directory(e, ec)) {
-      out.push_back(e);
-      continue;
-    }
-    std::vector<std::string> dir;
-    for (const auto& f : std::filesystem::directory_iterator(e, ec)) {
-      if (f.is_regular_file() && f.path().extension() == ".clp") dir.push_back(f.path().string());
-    }
-    std::sort(dir.begin(), dir.end());
-    out.insert(out.end(), dir.begin(), dir.end());
-  }
-  return out;
+  return clips::expand_agent_files(entries);
 }
 
 AgentBrain::AgentBrain(Game& game, int index, AgentBrainConfig config, clips::LogSink log,
@@ -41,6 +29,7 @@ AgentBrain::AgentBrain(Game& game, int index, AgentBrainConfig config, clips::Lo
   core::RandomStream seed = game.rng().stream("clips/" + ac.robot_name);
   ac.seed = seed.next_u64();
   ac.max_rules_per_cycle = config.max_rules_per_cycle;
+  ac.sandbox = config.sandbox;
   ac.config = std::move(config.config);
   if (config.locks) {
     ac.locks = true;

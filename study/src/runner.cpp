@@ -395,6 +395,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
     c.config = spec.config;
     c.skills = scenario.skills;
     c.locks = spec.locks;
+    c.sandbox = spec.sandbox;
     const std::string name(game.robot(i).name());
     // The agent's decisions (info and above) go into the recording; the team agent's role
     // changes are counted.

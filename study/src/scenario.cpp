@@ -143,6 +143,7 @@ void read_robots(const core::ConfigNode& n, const std::string& dir, Scenario& s)
   std::vector<std::string> agent;
   clips::ConfigEntries config;
   bool locks = false;
+  bool sandbox = true;
   core::ConfigNode each;
   if (n.defined()) {
     n.require_map();
@@ -160,11 +161,12 @@ void read_robots(const core::ConfigNode& n, const std::string& dir, Scenario& s)
       config = clips::config_from_node(c, "/clips-agent");
     }
     n.read("locks", locks);
+    n.read("sandbox", sandbox);
     each = n["each"];
     n.no_other_keys();
   }
   s.game.world.robots.resize(static_cast<std::size_t>(count));
-  s.robots.assign(static_cast<std::size_t>(count), RobotSpec{agent, config, locks});
+  s.robots.assign(static_cast<std::size_t>(count), RobotSpec{agent, config, locks, sandbox});
   if (!each.defined()) return;
   if (!each.is_sequence()) each.fail("expected a list with one entry per robot");
   if (each.size() > count) each.fail("more entries than robots (" + std::to_string(count) + ")");

@@ -83,13 +83,17 @@ TEST_CASE("a bug is an internal error: exit code 3 and a request to report it") 
 }
 
 TEST_CASE("every command's help names its exit codes") {
-  for (const char* command :
-       {"run", "check", "batch", "report", "experiment", "skill", "exercise", "serve"}) {
+  for (const char* command : {"run", "check", "batch", "report", "experiment", "skill", "exercise",
+                              "serve", "test-agent", "new"}) {
     CAPTURE(command);
     const Run r = llsfsim({command, "--help"});
     CHECK(r.code == llsf::app::kExitOk);
     CHECK(has(r.out, "Exit code: 0"));
     CHECK(has(r.out, "3 internal error"));
   }
+  const Run agent = llsfsim({"new", "agent", "--help"});
+  CHECK(agent.code == llsf::app::kExitOk);
+  CHECK(has(agent.out, "Exit code: 0"));
+  CHECK(has(agent.out, "3 internal error"));
   CHECK(has(llsfsim({"--help"}).out, "3 internal error"));
 }

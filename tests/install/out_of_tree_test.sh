@@ -34,6 +34,10 @@ mkdir "$tmp/empty"
 if LLSF_DATA_DIR=$tmp/empty "$bin" exercise --list 2>"$tmp/err"; then fail "LLSF_DATA_DIR ignored"; fi
 grep -q "no exercises in $tmp/empty/exercises" "$tmp/err" || fail "LLSF_DATA_DIR: $(cat "$tmp/err")"
 (cd "$tmp" && "$bin" check "$data/scenarios/default.yaml") || fail "llsfsim check"
+# The installed agents' rule tests, and a new agent's (its files name nothing outside its folder).
+(cd "$tmp" && "$bin" test-agent "$data/clips/agents" >/dev/null) || fail "llsfsim test-agent"
+(cd "$tmp" && "$bin" new agent "$tmp/new-agent" >/dev/null &&
+  "$bin" test-agent "$tmp/new-agent" >/dev/null) || fail "llsfsim new agent + test-agent"
 
 # A project of one's own: find_package(llsfsim), link llsf::sim, play.
 "$cmake" -S "$source/examples/out-of-tree" -B "$tmp/example" -DCMAKE_PREFIX_PATH="$prefix" \

@@ -87,6 +87,10 @@ struct AgentConfig {
   /// 0.5-1 KB of stack (measured: docs/clips.md, "Budgets").
   int max_call_depth = 2'000;
   ConfigEntries config;  ///< asserted as confval facts after (reset)
+  /// The sandbox (docs/security.md): files, I/O routers, load/save, dribble, system, exit, clear,
+  /// reset and construct removal are unavailable to the agent's code. Turn it off only for a
+  /// trusted local agent that needs files.
+  bool sandbox = true;
   /// Runs the resource-lock protocol (docs/locks.md): lock facts, lock messages consumed, the
   /// master's announcements. Off by default, so that agents without locks stay silent.
   bool locks = false;

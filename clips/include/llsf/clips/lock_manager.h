@@ -117,6 +117,12 @@ class LockManager {
   bool holds(std::string_view resource, core::SimTime now) const;
   /// Resources with a state other than NONE, sorted.
   std::vector<std::string> resources() const;
+  /// Calls `f(resource, state)` for every resource this robot has had a state for (NONE
+  /// included), sorted by name; without the copies of resources().
+  template <class F>
+  void for_each_state(F&& f) const {
+    for (const auto& [r, o] : own_) f(r, o.state);
+  }
   /// True while this robot claims mastership (announces itself).
   bool is_master() const { return endorsee_ == agent_; }
   /// True while this robot is master with a majority's endorsement (it may confirm locks).

@@ -35,6 +35,8 @@ struct AgentBrainConfig {
   /// The lock protocol over the radio (clips::AgentConfig::locks, docs/locks.md); also sets the
   /// confval /clips-agent/use-locks TRUE for the team agents.
   bool locks = false;
+  /// The agents' sandbox (clips::AgentConfig::sandbox, docs/security.md).
+  bool sandbox = true;
   /// Robots that take part in the lock protocol (the majority is counted of these); 0: every
   /// robot of the game.
   int lock_team_size = 0;

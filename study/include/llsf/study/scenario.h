@@ -22,6 +22,7 @@ struct RobotSpec {
   std::vector<std::string> agent;  ///< files or directories, resolved against the scenario's dir
   clips::ConfigEntries config;     ///< confval facts (under /clips-agent)
   bool locks = false;              ///< the lock protocol (robots.locks)
+  bool sandbox = true;             ///< the agents' sandbox (robots.sandbox, docs/security.md)
 };
 
 /// A pass/fail condition on a finished game.
