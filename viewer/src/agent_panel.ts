@@ -1,0 +1,234 @@
+// SPDX-License-Identifier: MIT
+// The agent browser of the replay and live pages: for the selected robot at the shown time its
+// facts (index and text, filterable by template and by text), its last rule firings (time, rule,
+// matched fact indices), its skill string and status, and its last output lines. Everything comes
+// from the recording's AgentTrace (agent_trace.ts) and the derived State; the DOM is rebuilt
+// only for the parts whose inputs changed, so playing a game with the panel open stays smooth.
+import {templateOf, type Fact} from "./agent_trace";
+import {kRobotColors} from "./field";
+import type {Recording, State} from "./recording";
+import {el} from "./report_view";
+
+/// m:ss.s of a game time in seconds.
+export function fmtTime(t: number): string {
+  const m = Math.floor(t / 60);
+  const s = t - m * 60;
+  return `${m}:${s.toFixed(1).padStart(4, "0")}`;
+}
+
+const kMaxFacts = 400;  // fact rows drawn at most (the count says how many match)
+const kFirings = 40;  // rule firings shown
+const kLogLines = 30;  // output lines shown
+
+/// What the list shows: the facts at the time and those the filters let through.
+export interface AgentView {
+  robot: string;
+  time: number;
+  recorded: boolean;
+  facts: Fact[];
+  shown: Fact[];
+}
+
+export class AgentPanel {
+  readonly root = el("div", {class: "agentpanel", "data-agent-panel": ""});
+  /// The selected robot ("" before the header is known).
+  robot = "";
+  private readonly robotSel = el("select", {"data-agent": "robot", title: "robot"});
+  private readonly skill = el("div", {class: "askill", "data-agent": "skill"});
+  private readonly count = el("span", {class: "acount", "data-agent": "count"});
+  private readonly templateSel = el("select", {"data-agent": "template", title: "template"});
+  private readonly filter = el("input", {
+    type: "search",
+    placeholder: "filter text",
+    "data-agent": "filter",
+    title: "show the facts that contain this text (case-insensitive)",
+  });
+  private readonly factList = el("div", {class: "alist facts", "data-agent": "facts"});
+  private readonly rules = el("div", {class: "alist rules", "data-agent": "rules"});
+  private readonly log = el("div", {class: "alist log", "data-agent": "log"});
+  private robotsKey = "";
+  private templatesKey = "";
+  private factsKey = "";
+  private rulesKey = "";
+  private logKey = "";
+  private skillKey = "";
+  private last: AgentView | null = null;
+
+  constructor(
+    private readonly rec: Recording,
+    onClose: () => void,
+    private readonly onSelect: (robot: string) => void,
+  ) {
+    const close = el("button", {class: "aclose", title: "close the agent browser", "data-agent": "close"}, "×");
+    close.onclick = onClose;
+    this.robotSel.onchange = () => this.select(this.robotSel.value);
+    this.templateSel.onchange = () => this.invalidate();
+    this.filter.oninput = () => this.invalidate();
+    this.root.append(
+      el("div", {class: "ahead"}, el("b", {}, "agent "), this.robotSel, close),
+      this.skill,
+      el("div", {class: "asec"}, el("b", {}, "facts "), this.count),
+      el("div", {class: "afilter"}, this.templateSel, this.filter),
+      this.factList,
+      el("div", {class: "asec"}, el("b", {}, "rules fired"), ` (last ${kFirings})`),
+      this.rules,
+      el("div", {class: "asec"}, el("b", {}, "log"), ` (last ${kLogLines})`),
+      this.log,
+    );
+  }
+
+  /// Selects `robot` (its facts, rules and log show at the next render).
+  select(robot: string): void {
+    if (robot === this.robot) return;
+    this.robot = robot;
+    this.robotSel.value = robot;
+    this.root.setAttribute("data-robot", robot);
+    this.invalidate();
+    this.onSelect(robot);
+  }
+
+  /// The last rendered view (for the test hook).
+  view(): AgentView | null {
+    return this.last;
+  }
+
+  private invalidate(): void {
+    this.templatesKey = this.factsKey = this.rulesKey = this.logKey = this.skillKey = "";
+  }
+
+  /// Shows the selected robot at `time` (`state`: the derived game state at that time).
+  render(time: number, state: State): void {
+    const h = this.rec.header;
+    if (!h) return;
+    const robotsKey = h.robots.join(" ");
+    if (robotsKey !== this.robotsKey) {
+      this.robotsKey = robotsKey;
+      this.robotSel.replaceChildren(
+        ...h.robots.map((r, i) =>
+          el("option", {value: r, style: `color:${kRobotColors[i % kRobotColors.length]}`}, r),
+        ),
+      );
+      if (!h.robots.includes(this.robot)) this.robot = h.robots[0] ?? "";
+      this.robotSel.value = this.robot;
+      this.root.setAttribute("data-robot", this.robot);
+    }
+    const name = this.robot;
+    const trace = this.rec.trace;
+
+    // Skill string and status, with the last result or error.
+    const rs = state.robots[name];
+    const skillKey = `${name}\n${rs?.skill}\n${rs?.status}\n${rs?.skillInfo}`;
+    if (skillKey !== this.skillKey) {
+      this.skillKey = skillKey;
+      const cls = rs?.status === "FAILED" ? "failed" : rs?.status === "FINAL" ? "final" : "";
+      this.skill.replaceChildren(
+        rs?.skill
+          ? el("span", {class: `sk ${cls}`}, `${rs.skill} `, el("b", {"data-status": rs.status}, rs.status))
+          : el("span", {class: "info"}, "no skill yet"),
+        rs?.skillInfo ? el("div", {class: "info"}, rs.skillInfo) : "",
+      );
+    }
+
+    // Facts: the templates present, then the list through the filters.
+    const at = trace.factsAt(name, time);
+    const template = this.templateSel.value;
+    const text = this.filter.value.trim().toLowerCase();
+    const factsKey = `${name}\n${at.version}\n${template}\n${text}`;
+    if (factsKey !== this.factsKey) {
+      this.factsKey = factsKey;
+      const counts = new Map<string, number>();
+      for (const [, f] of at.facts) {
+        const tpl = templateOf(f);
+        counts.set(tpl, (counts.get(tpl) ?? 0) + 1);
+      }
+      const names = [...counts.keys()].sort();
+      if (template !== "" && !counts.has(template)) names.push(template);
+      const templatesKey = names.map((n) => `${n}:${counts.get(n) ?? 0}`).join(" ");
+      if (templatesKey !== this.templatesKey) {
+        this.templatesKey = templatesKey;
+        this.templateSel.replaceChildren(
+          el("option", {value: ""}, `all templates (${counts.size})`),
+          ...names.map((n) => el("option", {value: n}, `${n} (${counts.get(n) ?? 0})`)),
+        );
+        this.templateSel.value = template;
+      }
+      const shown = at.facts.filter(
+        ([, f]) => (template === "" || templateOf(f) === template) && (text === "" || f.toLowerCase().includes(text)),
+      );
+      this.last = {robot: name, time, recorded: at.recorded, facts: at.facts, shown};
+      this.count.textContent = at.recorded
+        ? shown.length === at.facts.length
+          ? `${at.facts.length}`
+          : `${shown.length} of ${at.facts.length}`
+        : "";
+      this.factList.setAttribute("data-shown", String(shown.length));
+      this.factList.setAttribute("data-total", String(at.facts.length));
+      if (!at.recorded) {
+        this.factList.replaceChildren(
+          el(
+            "div",
+            {class: "info", "data-agent": "nofacts"},
+            trace.hasFacts ? `no facts of ${name} recorded yet` : "no agent facts recorded",
+          ),
+        );
+      } else {
+        const rows: Node[] = shown.slice(0, kMaxFacts).map(([i, f]) =>
+          el("div", {class: "fact", "data-index": String(i)}, el("span", {class: "fi"}, `f-${i}`), f),
+        );
+        if (shown.length > kMaxFacts) {
+          rows.push(el("div", {class: "info"}, `… ${shown.length - kMaxFacts} more: narrow the filter`));
+        } else if (shown.length === 0) {
+          rows.push(el("div", {class: "info"}, "no fact matches the filter"));
+        }
+        this.factList.replaceChildren(...rows);
+      }
+    } else if (this.last) {
+      this.last.time = time;
+    }
+
+    // The last rule firings up to the time.
+    const nFired = trace.firingCount(name, time);
+    const rulesKey = `${name}\n${nFired}`;
+    if (rulesKey !== this.rulesKey) {
+      this.rulesKey = rulesKey;
+      const fired = trace.firingsAt(name, time, kFirings);
+      const facts = new Map(at.facts);
+      this.rules.replaceChildren(
+        ...(fired.length === 0
+          ? [el("div", {class: "info"}, trace.hasRules ? "no rule fired yet" : "no rule firings recorded")]
+          : fired
+              .slice()
+              .reverse()
+              .map((f) =>
+                el(
+                  "div",
+                  {class: "firing", "data-rule": f.rule},
+                  el("span", {class: "at"}, fmtTime(f.t)),
+                  ` ${f.rule} `,
+                  ...f.facts.map((i) =>
+                    el("span", {class: "fi", title: facts.get(i) ?? "(not in the fact base now)"}, `f-${i} `),
+                  ),
+                ),
+              )),
+      );
+    }
+
+    // The last output lines up to the time.
+    const nLog = trace.logCount(name, time);
+    const logKey = `${name}\n${nLog}`;
+    if (logKey !== this.logKey) {
+      this.logKey = logKey;
+      const lines = trace.logAt(name, time, kLogLines);
+      this.log.replaceChildren(
+        ...(lines.length === 0
+          ? [el("div", {class: "info"}, "no output yet")]
+          : lines
+              .slice()
+              .reverse()
+              .map((l) =>
+                el("div", {class: `logline ${l.level}`}, el("span", {class: "at"}, fmtTime(l.t)), ` ${l.text}`),
+              )),
+      );
+    }
+  }
+}

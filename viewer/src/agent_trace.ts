@@ -1,0 +1,240 @@
+// SPDX-License-Identifier: MIT
+// The agents' trace of a recording (docs/recording.md: `facts`, `fact`, `rules`, `agent` lines),
+// per robot and indexed for seeking: the facts of a robot at time t are its last `facts`
+// snapshot at or before t with every later `fact` delta up to t applied. Besides the recorded
+// snapshots, one is kept every kSnapshotEvery deltas, so a seek costs one snapshot's copy plus at
+// most that many deltas, whatever the recording's snapshot period; moving forward a little (playback)
+// applies only the deltas in between. Recordings without these lines have an empty trace.
+
+/// A fact: its index in the agent's fact base and its text, `(state IDLE)`.
+export type Fact = [number, string];
+
+/// One rule firing of an agent cycle.
+export interface Firing {
+  t: number;
+  rule: string;
+  facts: number[];
+}
+
+/// One line of an agent's output (`agent` lines).
+export interface LogLine {
+  t: number;
+  level: string;
+  text: string;
+}
+
+/// The facts of a robot at a time (sorted by index) and what they were computed from.
+export interface FactsAt {
+  /// The facts, sorted by index; empty when `recorded` is false.
+  facts: Fact[];
+  /// Whether any fact of this robot at or before the time is recorded.
+  recorded: boolean;
+  /// The number of the robot's fact entries (snapshots and deltas) up to the time: a key that
+  /// changes whenever the facts may have.
+  version: number;
+}
+
+/// The template of a fact: the first symbol after "(" (`machine` for `(machine (name M1))`).
+export function templateOf(text: string): string {
+  const m = /^\s*\(\s*([^\s()]+)/.exec(text);
+  return m ? m[1] : text.trim();
+}
+
+const kSnapshotEvery = 200;  // fact entries between the trace's own snapshots
+
+/// The number of entries of the sorted array `ts` with t <= time.
+function upperBound(ts: number[], time: number): number {
+  let lo = 0;
+  let hi = ts.length;
+  while (lo < hi) {
+    const mid = (lo + hi) >>> 1;
+    if (ts[mid] <= time) lo = mid + 1;
+    else hi = mid;
+  }
+  return lo;
+}
+
+/// A robot's trace: fact entries in file order, snapshots of the fact base, rule firings, log.
+class RobotTrace {
+  /// Fact entries: a recorded snapshot (`full`) or a delta (`add`, `del`).
+  readonly entryT: number[] = [];
+  private readonly entries: {full?: Fact[]; add?: Fact[]; del?: number[]}[] = [];
+  /// Snapshots of the fact base after entry `index` (recorded, or kept every kSnapshotEvery).
+  private readonly snapshots: {index: number; facts: Fact[]}[] = [];
+  /// The fact base after the last entry (the builder of the snapshots).
+  private readonly current = new Map<number, string>();
+  readonly firingT: number[] = [];
+  readonly firings: Firing[] = [];
+  readonly logT: number[] = [];
+  readonly log: LogLine[] = [];
+  // The seek cursor: the fact base after `cursorIndex` entries.
+  private cursorFacts: Map<number, string> | null = null;
+  private cursorIndex = 0;
+  private cursorSorted: Fact[] | null = null;
+
+  addSnapshot(t: number, facts: Fact[]): void {
+    this.current.clear();
+    for (const [i, text] of facts) this.current.set(i, text);
+    this.entryT.push(t);
+    this.entries.push({full: facts});
+    this.snapshots.push({index: this.entries.length, facts: sortedFacts(this.current)});
+  }
+
+  addDelta(t: number, add: Fact[] | undefined, del: number[] | undefined): void {
+    applyDelta(this.current, add, del);
+    this.entryT.push(t);
+    this.entries.push({add, del});
+    const last = this.snapshots.length > 0 ? this.snapshots[this.snapshots.length - 1].index : 0;
+    if (this.entries.length - last >= kSnapshotEvery) {
+      this.snapshots.push({index: this.entries.length, facts: sortedFacts(this.current)});
+    }
+  }
+
+  /// The facts after the entries with t <= time.
+  factsAt(time: number): FactsAt {
+    const target = upperBound(this.entryT, time);
+    if (target === 0) return {facts: [], recorded: false, version: 0};
+    // Forward by a few entries from the cursor, else from the last snapshot at or before target.
+    if (!this.cursorFacts || target < this.cursorIndex || target - this.cursorIndex > kSnapshotEvery) {
+      const snap = this.snapshotAtOrBefore(target);
+      if (!this.cursorFacts || target < this.cursorIndex || snap.index > this.cursorIndex) {
+        this.cursorFacts = new Map(snap.facts);
+        this.cursorIndex = snap.index;
+        this.cursorSorted = null;
+      }
+    }
+    while (this.cursorIndex < target) {
+      const e = this.entries[this.cursorIndex++];
+      if (e.full) {
+        this.cursorFacts.clear();
+        for (const [i, text] of e.full) this.cursorFacts.set(i, text);
+      } else {
+        applyDelta(this.cursorFacts, e.add, e.del);
+      }
+      this.cursorSorted = null;
+    }
+    this.cursorSorted ??= sortedFacts(this.cursorFacts);
+    return {facts: this.cursorSorted, recorded: true, version: target};
+  }
+
+  private snapshotAtOrBefore(index: number): {index: number; facts: Fact[]} {
+    let lo = 0;
+    let hi = this.snapshots.length;
+    while (lo < hi) {
+      const mid = (lo + hi) >>> 1;
+      if (this.snapshots[mid].index <= index) lo = mid + 1;
+      else hi = mid;
+    }
+    return lo > 0 ? this.snapshots[lo - 1] : {index: 0, facts: []};
+  }
+}
+
+function applyDelta(facts: Map<number, string>, add: Fact[] | undefined, del: number[] | undefined): void {
+  if (del) for (const i of del) facts.delete(i);
+  if (add) for (const [i, text] of add) facts.set(i, text);
+}
+
+function sortedFacts(facts: Map<number, string>): Fact[] {
+  return [...facts.entries()].sort((a, b) => a[0] - b[0]);
+}
+
+/// A well-formed fact list ([[index, text], ...]); anything else is skipped.
+function factList(v: unknown): Fact[] | undefined {
+  if (!Array.isArray(v)) return undefined;
+  const out: Fact[] = [];
+  for (const f of v) {
+    if (Array.isArray(f) && typeof f[0] === "number") out.push([f[0], String(f[1] ?? "")]);
+  }
+  return out;
+}
+
+function indexList(v: unknown): number[] | undefined {
+  return Array.isArray(v) ? v.filter((x): x is number => typeof x === "number") : undefined;
+}
+
+/// The trace of every robot of a recording.
+export class AgentTrace {
+  private readonly robots = new Map<string, RobotTrace>();
+  /// Whether any `facts` or `fact` line was read (a recording with agents' facts).
+  hasFacts = false;
+  /// Whether any `rules` line was read.
+  hasRules = false;
+
+  private robot(name: string): RobotTrace {
+    let r = this.robots.get(name);
+    if (!r) {
+      r = new RobotTrace();
+      this.robots.set(name, r);
+    }
+    return r;
+  }
+
+  /// Takes a line if it belongs to the trace (`facts`, `fact`, `rules`; `agent` is read too but
+  /// left to the caller as well). Returns true when the line is the trace's only (no game state
+  /// depends on it).
+  // eslint-disable-next-line @typescript-eslint/no-explicit-any
+  take(line: {t: number; e?: string; [key: string]: any}): boolean {
+    const e = line.e;
+    if (e !== "facts" && e !== "fact" && e !== "rules" && e !== "agent") return false;
+    if (typeof line.robot !== "string") return e !== "agent";
+    const r = this.robot(line.robot);
+    switch (e) {
+      case "facts":
+        this.hasFacts = true;
+        r.addSnapshot(line.t, factList(line.facts) ?? []);
+        return true;
+      case "fact":
+        this.hasFacts = true;
+        r.addDelta(line.t, factList(line.a), indexList(line.r));
+        return true;
+      case "rules":
+        this.hasRules = true;
+        if (Array.isArray(line.fired)) {
+          for (const f of line.fired) {
+            if (!Array.isArray(f)) continue;
+            r.firingT.push(line.t);
+            r.firings.push({t: line.t, rule: String(f[0] ?? ""), facts: indexList(f[1]) ?? []});
+          }
+        }
+        return true;
+      default:
+        r.logT.push(line.t);
+        r.log.push({t: line.t, level: String(line.level ?? ""), text: String(line.text ?? "")});
+        return false;
+    }
+  }
+
+  /// The facts of `robot` at `time` (empty, `recorded` false, when none are recorded up to then).
+  factsAt(robot: string, time: number): FactsAt {
+    const r = this.robots.get(robot);
+    return r ? r.factsAt(time) : {facts: [], recorded: false, version: 0};
+  }
+
+  /// The last `n` rule firings of `robot` at or before `time`, oldest first.
+  firingsAt(robot: string, time: number, n: number): Firing[] {
+    const r = this.robots.get(robot);
+    if (!r) return [];
+    const end = upperBound(r.firingT, time);
+    return r.firings.slice(Math.max(0, end - n), end);
+  }
+
+  /// The number of rule firings of `robot` at or before `time`.
+  firingCount(robot: string, time: number): number {
+    const r = this.robots.get(robot);
+    return r ? upperBound(r.firingT, time) : 0;
+  }
+
+  /// The last `n` agent lines of `robot` at or before `time`, oldest first.
+  logAt(robot: string, time: number, n: number): LogLine[] {
+    const r = this.robots.get(robot);
+    if (!r) return [];
+    const end = upperBound(r.logT, time);
+    return r.log.slice(Math.max(0, end - n), end);
+  }
+
+  /// The number of agent lines of `robot` at or before `time`.
+  logCount(robot: string, time: number): number {
+    const r = this.robots.get(robot);
+    return r ? upperBound(r.logT, time) : 0;
+  }
+}
