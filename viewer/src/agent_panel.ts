@@ -46,6 +46,7 @@ export class AgentPanel {
   private readonly factList = el("div", {class: "alist facts", "data-agent": "facts"});
   private readonly rules = el("div", {class: "alist rules", "data-agent": "rules"});
   private readonly log = el("div", {class: "alist log", "data-agent": "log"});
+  private readonly debugBox = el("input", {type: "checkbox", "data-agent": "debug"});
   private robotsKey = "";
   private templatesKey = "";
   private factsKey = "";
@@ -64,6 +65,7 @@ export class AgentPanel {
     this.robotSel.onchange = () => this.select(this.robotSel.value);
     this.templateSel.onchange = () => this.invalidate();
     this.filter.oninput = () => this.invalidate();
+    this.debugBox.onchange = () => this.invalidate();
     this.root.append(
       el("div", {class: "ahead"}, el("b", {}, "agent "), this.robotSel, close),
       this.skill,
@@ -72,7 +74,13 @@ export class AgentPanel {
       this.factList,
       el("div", {class: "asec"}, el("b", {}, "rules fired"), ` (last ${kFirings})`),
       this.rules,
-      el("div", {class: "asec"}, el("b", {}, "log"), ` (last ${kLogLines})`),
+      el(
+        "div",
+        {class: "asec"},
+        el("b", {}, "log"),
+        ` (last ${kLogLines}) `,
+        el("label", {title: "with the debug lines (e.g. CLIPS' watch output)"}, this.debugBox, " debug"),
+      ),
       this.log,
     );
   }
@@ -214,11 +222,12 @@ export class AgentPanel {
     }
 
     // The last output lines up to the time.
-    const nLog = trace.logCount(name, time);
-    const logKey = `${name}\n${nLog}`;
+    const debug = this.debugBox.checked;
+    const nLog = trace.logCount(name, time, debug);
+    const logKey = `${name}\n${nLog}\n${debug}`;
     if (logKey !== this.logKey) {
       this.logKey = logKey;
-      const lines = trace.logAt(name, time, kLogLines);
+      const lines = trace.logAt(name, time, kLogLines, debug);
       this.log.replaceChildren(
         ...(lines.length === 0
           ? [el("div", {class: "info"}, "no output yet")]

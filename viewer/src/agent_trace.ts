@@ -67,6 +67,9 @@ class RobotTrace {
   readonly firings: Firing[] = [];
   readonly logT: number[] = [];
   readonly log: LogLine[] = [];
+  /// The lines above debug level.
+  readonly infoT: number[] = [];
+  readonly info: LogLine[] = [];
   // The seek cursor: the fact base after `cursorIndex` entries.
   private cursorFacts: Map<number, string> | null = null;
   private cursorIndex = 0;
@@ -197,10 +200,16 @@ export class AgentTrace {
           }
         }
         return true;
-      default:
+      default: {
+        const l = {t: line.t, level: String(line.level ?? ""), text: String(line.text ?? "")};
         r.logT.push(line.t);
-        r.log.push({t: line.t, level: String(line.level ?? ""), text: String(line.text ?? "")});
+        r.log.push(l);
+        if (l.level !== "debug") {
+          r.infoT.push(line.t);
+          r.info.push(l);
+        }
         return false;
+      }
     }
   }
 
@@ -224,17 +233,19 @@ export class AgentTrace {
     return r ? upperBound(r.firingT, time) : 0;
   }
 
-  /// The last `n` agent lines of `robot` at or before `time`, oldest first.
-  logAt(robot: string, time: number, n: number): LogLine[] {
+  /// The last `n` agent lines of `robot` at or before `time`, oldest first (`debug`: with the
+  /// debug lines).
+  logAt(robot: string, time: number, n: number, debug: boolean): LogLine[] {
     const r = this.robots.get(robot);
     if (!r) return [];
-    const end = upperBound(r.logT, time);
-    return r.log.slice(Math.max(0, end - n), end);
+    const [ts, lines] = debug ? [r.logT, r.log] : [r.infoT, r.info];
+    const end = upperBound(ts, time);
+    return lines.slice(Math.max(0, end - n), end);
   }
 
-  /// The number of agent lines of `robot` at or before `time`.
-  logCount(robot: string, time: number): number {
+  /// The number of agent lines of `robot` at or before `time` (`debug`: with the debug lines).
+  logCount(robot: string, time: number, debug: boolean): number {
     const r = this.robots.get(robot);
-    return r ? upperBound(r.logT, time) : 0;
+    return r ? upperBound(debug ? r.logT : r.infoT, time) : 0;
   }
 }

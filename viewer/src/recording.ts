@@ -261,7 +261,9 @@ function apply(s: State, header: Header, line: Line): void {
       break;
     case "agent": {
       const robot = robotOf(s, line.robot);
-      if (!robot) break;
+      // Debug lines (CLIPS' watch output, recorded with the agents' trace) are for the agent
+      // browser's log; the panel keeps the last decision.
+      if (!robot || line.level === "debug") break;
       const text = String(line.text ?? "");
       robot.agent = text;
       robot.agentLevel = line.level ?? "";

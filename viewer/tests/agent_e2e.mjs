@@ -125,7 +125,7 @@ function historyAt(lines, robot, time) {
     if (l.t > time) break;
     if (l.robot !== robot) continue;
     if (l.e === "rules") for (const [rule, idx] of l.fired ?? []) firings.push([l.t, rule, idx]);
-    if (l.e === "agent") log.push([l.t, l.text]);
+    if (l.e === "agent" && l.level !== "debug") log.push([l.t, l.text]);
   }
   return {firings, log};
 }
