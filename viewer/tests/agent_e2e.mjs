@@ -117,7 +117,8 @@ function factsAt(lines, robot, time) {
   return {facts, snapshotT, deltaAdds};
 }
 
-/// The rule firings ([t, rule, indices]) and agent lines ([t, text]) of `robot` up to `time`.
+/// The rule firings ([t, rule, indices]) and agent lines ([t, text], without the debug ones) of
+/// `robot` up to `time`.
 function historyAt(lines, robot, time) {
   const firings = [];
   const log = [];
