@@ -29,6 +29,7 @@ struct BatchCommandOptions {
   std::string db{study::StatsStore::kDefaultPath};
   std::string recordings;  ///< "" = default_recordings_dir(db)
   bool no_record = false;
+  bool record_agents = false;
   bool quiet = false;
 };
 
@@ -99,6 +100,7 @@ int batch(const BatchCommandOptions& o, std::ostream& out, std::ostream& err) {
     study::BatchOptions options;
     options.runs = o.runs;
     options.jobs = o.jobs.value_or(0);
+    options.record_agents = o.record_agents;
     if (!o.no_record)
       options.recordings_dir = o.recordings.empty() ? default_recordings_dir(o.db) : o.recordings;
     const study::BatchHooks hooks = progress.hooks();
@@ -139,7 +141,13 @@ Action add_batch_command(CLI::App& app) {
       "--recordings", o->recordings,
       "Directory for the games' recordings, one subdirectory per batch "
       "(default: <db name>-recordings beside the --db file, e.g. llsfsim-recordings)");
-  app.add_flag("--no-record", o->no_record, "Do not record the games")->excludes(rec);
+  auto* no_rec =
+      app.add_flag("--no-record", o->no_record, "Do not record the games")->excludes(rec);
+  app.add_flag("--record-agents", o->record_agents,
+               "Recordings also keep the agents' facts and rule firings (the facts, fact and rules "
+               "lines of docs/recording.md; off by default in batches: it costs time and space, "
+               "docs/benchmarks.md)")
+      ->excludes(no_rec);
   app.add_flag("-q,--quiet", o->quiet, "No progress and no summary, only the exit code");
   app.footer(
       "Plays every matrix variant x N seeds of each scenario on worker threads and stores every "

@@ -49,8 +49,11 @@ struct RunOptions {
   bool no_db = false;
   std::string record;  ///< "" = default_recordings_dir(db)/recording_file_name(...)
   bool no_record = false;
-  bool strict = false;  ///< an agent mistake (RunIssue::is_mistake) fails the run
-  LiveOptions live;     ///< --speed, --realtime, --serve, --port, --serve-exit
+  bool strict = false;             ///< an agent mistake (RunIssue::is_mistake) fails the run
+  std::vector<std::string> trace;  ///< --trace ROBOT[:KINDS], repeatable
+  std::string trace_file;          ///< "" = stderr
+  bool no_record_agents = false;   ///< no facts/fact/rules lines in the recording
+  LiveOptions live;                ///< --speed, --realtime, --serve, --port, --serve-exit
 };
 
 const study::Scenario* pick_variant(const study::ScenarioFile& f, const std::string& name,
@@ -191,6 +194,27 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
     }
   }
   study::RunHooks hooks;
+  // --trace: checked before anything is played or written.
+  std::unique_ptr<std::ofstream> trace_file;
+  try {
+    for (const std::string& t : o.trace) hooks.trace.push_back(study::parse_trace_request(t));
+    study::check_trace_requests(*s, hooks.trace);
+  } catch (const core::UserError& e) {
+    err << "llsfsim run: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  if (!hooks.trace.empty()) {
+    if (!o.trace_file.empty()) {
+      trace_file = std::make_unique<std::ofstream>(o.trace_file, std::ios::binary);
+      if (!*trace_file) {
+        err << "llsfsim run: --trace-file " << o.trace_file << ": cannot write the file\n";
+        return kExitBadInput;
+      }
+    }
+    std::ostream* trace_out = trace_file ? trace_file.get() : &err;
+    hooks.trace_sink = [trace_out](std::string_view line) { *trace_out << line << '\n'; };
+  }
+  hooks.record_agents = !o.no_record_agents;
   if (!o.no_record) {
     hooks.record_path = o.record;
     if (hooks.record_path.empty()) {
@@ -226,7 +250,9 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
     return kExitBadInput;
   }
   if (server) hooks.record_sink = [&feed](std::string_view line) { feed.publish(line); };
-  const bool tty = isatty(STDERR_FILENO) != 0 && !o.quiet && !o.json;
+  // (No progress line between trace lines on stderr.)
+  const bool tty = isatty(STDERR_FILENO) != 0 && !o.quiet && !o.json &&
+                   (hooks.trace.empty() || trace_file != nullptr);
   if (tty) {
     hooks.progress_every = core::SimTime::from_sec(10);
     hooks.progress = [&](const sim::Game& g) {
@@ -448,6 +474,17 @@ Action add_run_command(CLI::App& app) {
                      "llsfsim-recordings/<scenario>[-<variant>]-seed<N>.jsonl.gz, beside the --db "
                      "file and named after it)");
   app.add_flag("--no-record", o->no_record, "Do not record the game")->excludes(record);
+  app.add_flag("--no-record-agents", o->no_record_agents,
+               "Record the game without the agents' facts and rule firings (the facts, fact and "
+               "rules lines of docs/recording.md)");
+  app.add_option("--trace", o->trace,
+                 "Trace an agent: ROBOT[:KINDS] (repeatable; ROBOT a robot's name or all; KINDS "
+                 "a comma list of rules,facts,skills,msgs,log, default all). Prints rule firings "
+                 "with the facts that matched, fact assertions and retractions, skill calls and "
+                 "results, messages and log lines with simulated time stamps to stderr "
+                 "(docs/clips.md, \"Tracing\")")
+      ->type_name("ROBOT[:KINDS]");
+  app.add_option("--trace-file", o->trace_file, "Write the --trace lines to FILE, not stderr");
   add_live_options(app, o->live,
                    "Serve the browser viewer with this game live (like `llsfsim serve`; best with "
                    "--speed or --realtime)");

@@ -11,6 +11,7 @@
 
 #include "feature.h"
 #include "llsf/core/config.h"
+#include "tracer.h"
 
 namespace llsf::clips {
 
@@ -104,11 +105,23 @@ struct AgentHost::Impl {
   std::string budget_reason;  // set when the work budget stopped the cycle
   std::unordered_map<std::string, std::string> rule_places;  // defrule name -> "file:line"
   std::int64_t max_steps_seen = 0;
+  std::unique_ptr<detail::Tracer> tracer;  // set_trace()
+
+  ~Impl() { env.observe(nullptr, false, false); }
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
 
   Impl(AgentConfig config, AgentIo io) {
     config.validate();
     state.config = std::move(config);
     state.io = std::move(io);
+    if (state.io.broadcast) {  // the trace sees every broadcast (pb-broadcast, lock messages)
+      state.io.broadcast =
+          [this, out = std::move(state.io.broadcast)](const google::protobuf::Message& m) {
+            if (tracer) tracer->message_out(m);
+            out(m);
+          };
+    }
     state.log = [this](LogLevel level, std::string_view text) { emit(level, text); };
     env.set_output_handler(
         [this](std::string_view name, std::string_view text) { on_output(name, text); });
@@ -133,6 +146,7 @@ struct AgentHost::Impl {
   }
 
   void emit(LogLevel level, std::string_view text) {
+    if (tracer) tracer->log(level, text);
     if (!state.io.log) return;
     state.io.log(LogRecord{state.now, level, state.config.robot_name, text});
   }
@@ -296,6 +310,7 @@ struct AgentHost::Impl {
     flush_output();
     rules_fired += result.rules_fired;
     result.runtime_errors = runtime_errors - errors_before;
+    if (tracer) tracer->cycle_end();
     return result;
   }
 };
@@ -303,8 +318,15 @@ struct AgentHost::Impl {
 AgentHost::AgentHost(AgentConfig config, AgentIo io)
     : impl_(std::make_unique<Impl>(std::move(config), std::move(io))) {}
 AgentHost::~AgentHost() = default;
-AgentHost::AgentHost(AgentHost&&) noexcept = default;
-AgentHost& AgentHost::operator=(AgentHost&&) noexcept = default;
+// The tracer's events point at the host: a move takes it along.
+AgentHost::AgentHost(AgentHost&& other) noexcept : impl_(std::move(other.impl_)) {
+  if (impl_ && impl_->tracer) impl_->tracer->set_host(*this);
+}
+AgentHost& AgentHost::operator=(AgentHost&& other) noexcept {
+  impl_ = std::move(other.impl_);
+  if (impl_ && impl_->tracer) impl_->tracer->set_host(*this);
+  return *this;
+}
 
 void AgentHost::load_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -332,6 +354,7 @@ void AgentHost::set_pose(const core::Pose2D& pose) {
 void AgentHost::receive(std::unique_ptr<google::protobuf::Message> message, std::string_view from,
                         int from_id, core::SimTime at) {
   if (!message) return;
+  if (impl_->tracer) impl_->tracer->message_in(*message, from, at);
   impl_->state.inbox.push_back({std::move(message), std::string(from), from_id, at});
 }
 
@@ -375,6 +398,20 @@ Value AgentHost::eval(std::string_view expression) {
   impl_->flush_output();
   impl_->env.clear_halt();
   return v;
+}
+
+void AgentHost::set_trace(TraceOptions options, TraceSink sink) {
+  impl_->env.observe(nullptr, false, false);
+  impl_->tracer.reset();
+  if (!sink) return;
+  impl_->tracer = std::make_unique<detail::Tracer>(impl_->state, *this, options, std::move(sink));
+  impl_->env.observe(impl_->tracer.get(), options.rules, options.facts);
+}
+
+std::string AgentHost::fact_text(std::int64_t index) const { return impl_->env.fact_text(index); }
+
+void AgentHost::fact_texts(std::vector<std::pair<std::int64_t, std::string>>& out) const {
+  impl_->env.fact_texts(out);
 }
 
 int AgentHost::runtime_errors() const { return impl_->runtime_errors; }

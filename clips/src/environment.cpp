@@ -17,6 +17,8 @@ namespace {
 
 constexpr const char* kRouterName = "llsf-output";
 constexpr const char* kLoadSource = "llsf-load";
+constexpr const char* kCaptureName = "llsf-capture";  // print_fact(): text into a std::string
+constexpr const char* kTraceHook = "llsf-trace";
 
 // Logical names our router takes (CLIPS' own and Fawkes' log levels); string routers used by
 // (format nil ...) and our load source are left alone.
@@ -149,9 +151,15 @@ void to_data_object(void* env, const Value& v, DATA_OBJECT& out) {
 
 // The router callbacks reach the Environment through the router context.
 struct RouterAccess {
-  static int query(void*, const char* name) { return is_output_name(name) ? TRUE : FALSE; }
+  static int query(void*, const char* name) {
+    return is_output_name(name) || std::string_view(name) == kCaptureName ? TRUE : FALSE;
+  }
   static int print(void* env, const char* name, const char* text) {
     auto* self = static_cast<Environment*>(GetEnvironmentRouterContext(env));
+    if (std::string_view(name) == kCaptureName) {
+      if (self->capture_ != nullptr) self->capture_->append(text);
+      return TRUE;
+    }
     try {
       self->on_print(name, text);
     } catch (...) {  // never through CLIPS' C frames (a throwing log sink loses the line)
@@ -180,6 +188,46 @@ struct RouterAccess {
     }
     to_data_object(env, result, *rv);
   }
+};
+
+// The trace hooks (Environment::observe); registered only while an observer is installed.
+struct TraceHooks {
+  static Environment* self(void* env) {
+    return static_cast<Environment*>(GetEnvironmentContext(env));
+  }
+  // Before each firing: the activation's rule and the facts of its partial match (the basis).
+  static void before_fire(void* env, void* activation) {
+    Environment* e = self(env);
+    if (e == nullptr || e->observer_ == nullptr) return;
+    e->matched_.clear();
+    const struct partialMatch* basis = EnvGetActivationBasis(env, activation);
+    if (basis != nullptr) {
+      for (unsigned i = 0; i < basis->bcount; ++i) {
+        const struct alphaMatch* m = basis->binds[i].gm.theMatch;
+        if (m == nullptr || m->matchingItem == nullptr ||
+            m->matchingItem->theInfo != &FactData(env)->FactInfo)
+          continue;  // a not/exists pattern (or an instance)
+        e->matched_.push_back(reinterpret_cast<const struct fact*>(m->matchingItem)->factIndex);
+      }
+    }
+    const char* name = EnvGetActivationName(env, activation);
+    try {
+      e->observer_->on_fire(name != nullptr ? name : "", e->matched_);
+    } catch (...) {  // never through CLIPS' C frames
+    }
+  }
+  static void changed(void* env, void* f, bool asserted) {
+    Environment* e = self(env);
+    if (e == nullptr || e->observer_ == nullptr) return;
+    e->fact_buf_.clear();
+    e->print_fact(f, e->fact_buf_);
+    try {
+      e->observer_->on_fact(asserted, static_cast<struct fact*>(f)->factIndex, e->fact_buf_);
+    } catch (...) {
+    }
+  }
+  static void asserted(void* env, void* f) { changed(env, f, true); }
+  static void retracted(void* env, void* f) { changed(env, f, false); }
 };
 
 // ---- Args ----------------------------------------------------------------------------------
@@ -547,6 +595,48 @@ std::vector<FactCopy> Environment::facts(std::string_view template_name) const {
     out.push_back(std::move(copy));
   }
   return out;
+}
+
+void Environment::observe(TraceObserver* observer, bool rules, bool facts) {
+  if (observe_rules_) EnvRemoveBeforeRunFunction(env_, kTraceHook);
+  if (observe_facts_) {
+    EnvRemoveAssertFunction(env_, kTraceHook);
+    EnvRemoveRetractFunction(env_, kTraceHook);
+  }
+  observer_ = observer;
+  observe_rules_ = observer != nullptr && rules;
+  observe_facts_ = observer != nullptr && facts;
+  if (observe_rules_) EnvAddBeforeRunFunction(env_, kTraceHook, &TraceHooks::before_fire, 0);
+  if (observe_facts_) {
+    EnvAddAssertFunction(env_, kTraceHook, &TraceHooks::asserted, 0);
+    EnvAddRetractFunction(env_, kTraceHook, &TraceHooks::retracted, 0);
+  }
+}
+
+void Environment::print_fact(void* fact, std::string& out) const {
+  std::string* before = capture_;
+  capture_ = &out;
+  PrintFact(env_, kCaptureName, static_cast<struct fact*>(fact), FALSE, FALSE);
+  capture_ = before;
+}
+
+std::string Environment::fact_text(std::int64_t index) const {
+  std::string out;
+  for (void* f = EnvGetNextFact(env_, nullptr); f != nullptr; f = EnvGetNextFact(env_, f)) {
+    if (EnvFactIndex(env_, f) == index) {
+      print_fact(f, out);
+      break;
+    }
+  }
+  return out;
+}
+
+void Environment::fact_texts(std::vector<std::pair<std::int64_t, std::string>>& out) const {
+  out.clear();
+  for (void* f = EnvGetNextFact(env_, nullptr); f != nullptr; f = EnvGetNextFact(env_, f)) {
+    out.emplace_back(EnvFactIndex(env_, f), std::string());
+    print_fact(f, out.back().second);
+  }
 }
 
 }  // namespace llsf::clips::detail

@@ -84,6 +84,19 @@ struct LoadError {
   std::string message;  ///< e.g. "[PRNTUTIL2] Syntax Error: ... (in defrule MAIN::foo)"
 };
 
+/// Receives an environment's rule firings and fact changes (AgentHost's trace). Called from
+/// inside CLIPS: implementations must not throw.
+class TraceObserver {
+ public:
+  virtual ~TraceObserver() = default;
+  /// A rule is about to fire; `facts` are the indices of the facts that matched its patterns in
+  /// order (not and exists patterns match no fact and are left out).
+  virtual void on_fire(std::string_view rule, std::span<const std::int64_t> facts) = 0;
+  /// A fact was asserted (`asserted`) or is about to be retracted; `text` as CLIPS prints it,
+  /// "(machine (name M1) (mtype T1))".
+  virtual void on_fact(bool asserted, std::int64_t index, std::string_view text) = 0;
+};
+
 /// One CLIPS environment. Not copyable or movable (CLIPS keeps pointers to it). Not thread-safe.
 class Environment {
  public:
@@ -156,6 +169,14 @@ class Environment {
   /// All facts of `template_name` (all facts if empty), in fact-list order.
   std::vector<FactCopy> facts(std::string_view template_name) const;
 
+  /// Installs `observer` (borrowed; nullptr removes it) for rule firings (`rules`) and fact
+  /// changes (`facts`). Without an observer no hook is registered with CLIPS: nothing is spent.
+  void observe(TraceObserver* observer, bool rules, bool facts);
+  /// The fact with `index` as CLIPS prints it ("(state IDLE)"); "" if there is none.
+  std::string fact_text(std::int64_t index) const;
+  /// Every fact as (index, text), in fact-list order; `out` is cleared first.
+  void fact_texts(std::vector<std::pair<std::int64_t, std::string>>& out) const;
+
  private:
   struct FunctionEntry {
     Environment* self;
@@ -164,8 +185,10 @@ class Environment {
     Function fn;
   };
   friend struct RouterAccess;
+  friend struct TraceHooks;
   void on_print(std::string_view logical_name, std::string_view text);
   static void periodic(void* clips_env);
+  void print_fact(void* fact, std::string& out) const;
 
   void* env_ = nullptr;
   OutputHandler output_;
@@ -180,6 +203,13 @@ class Environment {
   double max_wall_s_ = 0.0;
   std::chrono::steady_clock::time_point budget_start_;
   BudgetHit budget_hit_ = BudgetHit::kNone;
+  // The trace (observe()).
+  TraceObserver* observer_ = nullptr;
+  bool observe_rules_ = false;
+  bool observe_facts_ = false;
+  std::vector<std::int64_t> matched_;       // reused for on_fire
+  mutable std::string* capture_ = nullptr;  // print_fact: where the capture router writes
+  std::string fact_buf_;                    // reused for on_fact
 };
 
 }  // namespace llsf::clips::detail

@@ -190,6 +190,7 @@ BatchResult run_batch(const ScenarioFile& file, const std::string& scenario_hash
           if (j >= jobs.size()) break;
           try {
             RunHooks run_hooks;
+            run_hooks.record_agents = options.record_agents;
             if (!record_dir.empty()) {
               run_hooks.record_path = (std::filesystem::path(record_dir) /
                                        recording_file_name(jobs[j].scenario->name,

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
@@ -49,6 +50,56 @@ const char* collision_kind(kinematic::CollisionKind k) {
   return "?";
 }
 
+/// Appends `s` as a JSON string; text that is not plain ASCII goes through nlohmann (invalid
+/// UTF-8 becomes U+FFFD, as in every other line).
+void append_json_string(std::string& out, std::string_view s) {
+  const bool ascii =
+      std::all_of(s.begin(), s.end(), [](char c) { return static_cast<unsigned char>(c) < 0x80; });
+  if (!ascii) {
+    out += Json(std::string(s)).dump(-1, ' ', false, Json::error_handler_t::replace);
+    return;
+  }
+  out += '"';
+  for (const char c : s) {
+    switch (c) {
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(c));
+          out += buf;
+        } else {
+          out += c;
+        }
+    }
+  }
+  out += '"';
+}
+
+/// One robot's agent trace being collected for the current cycle (Recorder::agent_trace).
+struct AgentFacts {
+  bool snapshot_written = false;
+  core::SimTime next_snapshot;
+  std::vector<std::pair<std::int64_t, std::string>> added;  // asserted in the cycle, still there
+  std::vector<std::int64_t> removed;  // retracted in the cycle, existed before it
+  std::string fired;                  // the cycle's firings: ["rule",[i,j]],...
+  std::vector<std::pair<std::int64_t, std::string>> all;  // snapshot buffer
+};
+
 }  // namespace
 
 struct Recorder::Impl {
@@ -77,11 +128,16 @@ struct Recorder::Impl {
   sim::HackathonScore score;                   // hackathon: as last written
   bool score_known = false;
   LineSink sink;
+  std::map<std::string, AgentFacts, std::less<>> agent_facts;  // per robot (agent_trace)
 
   void write(const Json& j) {
     if (file == nullptr && !sink) return;
     // Invalid UTF-8 (a robot's or a skill's text) becomes U+FFFD instead of an exception.
     line = j.dump(-1, ' ', false, Json::error_handler_t::replace);
+    write_line();
+  }
+  /// Writes `line` as it is (built by hand: the agent lines, many per game).
+  void write_line() {
     if (file != nullptr && (gzwrite(file, line.data(), static_cast<unsigned>(line.size())) !=
                                 static_cast<int>(line.size()) ||
                             gzputc(file, '\n') < 0)) {
@@ -201,6 +257,109 @@ void Recorder::skill(const sim::SkillStatusChange& c) {
   if (!c.result.empty()) j["result"] = c.result;
   if (!c.error.empty()) j["error"] = c.error;
   impl_->write(j);
+}
+
+void Recorder::agent_trace(const clips::TraceEvent& e) {
+  using Kind = clips::TraceEvent::Kind;
+  Impl& m = *impl_;
+  if (m.file == nullptr && !m.sink) return;
+  if (e.kind == Kind::kLog) {
+    // Info and above come through the agent's log sink (agent()); CLIPS' watch output and
+    // debug lines only through the trace.
+    if (e.level == clips::LogLevel::kDebug)
+      agent(clips::LogRecord{e.time, e.level, e.agent, e.text});
+    return;
+  }
+  auto it = m.agent_facts.find(e.agent);
+  if (it == m.agent_facts.end())
+    it = m.agent_facts.emplace(std::string(e.agent), AgentFacts{}).first;
+  AgentFacts& a = it->second;
+  switch (e.kind) {
+    case Kind::kAssert:
+      a.added.emplace_back(e.fact, std::string(e.text));
+      return;
+    case Kind::kRetract: {
+      // Asserted and retracted in the same cycle: neither.
+      auto added = std::find_if(a.added.begin(), a.added.end(),
+                                [&e](const auto& f) { return f.first == e.fact; });
+      if (added != a.added.end()) {
+        a.added.erase(added);
+      } else {
+        a.removed.push_back(e.fact);
+      }
+      return;
+    }
+    case Kind::kFire: {
+      if (!a.fired.empty()) a.fired += ',';
+      a.fired += '[';
+      append_json_string(a.fired, e.name);
+      a.fired += ",[";
+      for (std::size_t i = 0; i < e.facts.size(); ++i) {
+        if (i > 0) a.fired += ',';
+        a.fired += std::to_string(e.facts[i]);
+      }
+      a.fired += "]]";
+      return;
+    }
+    case Kind::kCycleEnd:
+      break;
+    default:
+      return;
+  }
+  // The end of a cycle: its rules line, its fact delta, a snapshot when due.
+  const bool snapshot = !a.snapshot_written || e.time >= a.next_snapshot;
+  if (a.fired.empty() && a.added.empty() && a.removed.empty() && !snapshot) return;
+  std::string head = "{\"t\":";
+  head += Json(fixed(e.time.seconds(), 2)).dump();
+  std::string robot;
+  append_json_string(robot, e.agent);
+  if (!a.fired.empty()) {
+    m.line = head + ",\"e\":\"rules\",\"robot\":" + robot + ",\"fired\":[" + a.fired + "]}";
+    m.write_line();
+    a.fired.clear();
+  }
+  if (!a.added.empty() || !a.removed.empty()) {
+    m.line = head + ",\"e\":\"fact\",\"robot\":" + robot;
+    if (!a.added.empty()) {
+      m.line += ",\"a\":[";
+      for (std::size_t i = 0; i < a.added.size(); ++i) {
+        m.line += i > 0 ? ",[" : "[";
+        m.line += std::to_string(a.added[i].first);
+        m.line += ',';
+        append_json_string(m.line, a.added[i].second);
+        m.line += ']';
+      }
+      m.line += ']';
+    }
+    if (!a.removed.empty()) {
+      m.line += ",\"r\":[";
+      for (std::size_t i = 0; i < a.removed.size(); ++i) {
+        if (i > 0) m.line += ',';
+        m.line += std::to_string(a.removed[i]);
+      }
+      m.line += ']';
+    }
+    m.line += '}';
+    m.write_line();
+    a.added.clear();
+    a.removed.clear();
+  }
+  if (snapshot && e.host != nullptr) {
+    if (!a.snapshot_written) a.next_snapshot = e.time;
+    a.snapshot_written = true;
+    while (a.next_snapshot <= e.time) a.next_snapshot += kFactSnapshotPeriod;
+    e.host->fact_texts(a.all);
+    m.line = head + ",\"e\":\"facts\",\"robot\":" + robot + ",\"facts\":[";
+    for (std::size_t i = 0; i < a.all.size(); ++i) {
+      m.line += i > 0 ? ",[" : "[";
+      m.line += std::to_string(a.all[i].first);
+      m.line += ',';
+      append_json_string(m.line, a.all[i].second);
+      m.line += ']';
+    }
+    m.line += "]}";
+    m.write_line();
+  }
 }
 
 std::string recording_file_name(const std::string& scenario, const std::string& variant,

@@ -258,7 +258,78 @@ std::optional<RunIssue> issue_of(const clips::LogRecord& rec) {
   return std::nullopt;
 }
 
+/// The trace request for robot `name` (all requests that name it or "all", merged); nullopt if
+/// none does.
+std::optional<TraceRequest> trace_for(const std::vector<TraceRequest>& requests,
+                                      std::string_view name) {
+  std::optional<TraceRequest> out;
+  for (const TraceRequest& r : requests) {
+    if (r.robot != name && r.robot != "all") continue;
+    if (!out) {
+      out = r;
+      continue;
+    }
+    out->rules = out->rules || r.rules;
+    out->facts = out->facts || r.facts;
+    out->skills = out->skills || r.skills;
+    out->messages = out->messages || r.messages;
+    out->log = out->log || r.log;
+  }
+  return out;
+}
+
 }  // namespace
+
+TraceRequest parse_trace_request(std::string_view arg) {
+  TraceRequest r;
+  const std::size_t colon = arg.find(':');
+  r.robot = std::string(arg.substr(0, colon));
+  const std::string kinds_list = "rules, facts, skills, msgs, log";
+  if (r.robot.empty()) {
+    throw core::UserError("--trace " + std::string(arg) +
+                          ": name a robot (robot1, ...) or all, optionally with kinds: "
+                          "ROBOT[:KIND,...], kinds " +
+                          kinds_list);
+  }
+  if (colon == std::string_view::npos) return r;
+  r.rules = r.facts = r.skills = r.messages = r.log = false;
+  std::string_view rest = arg.substr(colon + 1);
+  while (true) {
+    const std::size_t comma = rest.find(',');
+    const std::string_view kind = rest.substr(0, comma);
+    if (kind == "rules") {
+      r.rules = true;
+    } else if (kind == "facts") {
+      r.facts = true;
+    } else if (kind == "skills") {
+      r.skills = true;
+    } else if (kind == "msgs") {
+      r.messages = true;
+    } else if (kind == "log") {
+      r.log = true;
+    } else {
+      throw core::UserError("--trace " + std::string(arg) + ": unknown kind '" + std::string(kind) +
+                            "' (kinds: " + kinds_list + ")");
+    }
+    if (comma == std::string_view::npos) break;
+    rest = rest.substr(comma + 1);
+  }
+  return r;
+}
+
+void check_trace_requests(const Scenario& scenario, const std::vector<TraceRequest>& requests) {
+  std::string names;
+  for (const auto& robot : scenario.game.world.robots) names += robot.name + ", ";
+  for (const TraceRequest& r : requests) {
+    if (r.robot == "all") continue;
+    bool known = false;
+    for (const auto& robot : scenario.game.world.robots) known = known || robot.name == r.robot;
+    if (!known) {
+      throw core::UserError("--trace " + r.robot + ": the scenario has no robot '" + r.robot +
+                            "' (its robots: " + names + "or all)");
+    }
+  }
+}
 
 bool RunResult::passed() const {
   for (const TestVerdict& t : tests) {
@@ -286,6 +357,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
       ++issues_dropped;
     }
   };
+  check_trace_requests(scenario, hooks.trace);
   std::unique_ptr<Recorder> recorder;
   sim::GameDriver driver(config);
   sim::Game& game = driver.game();
@@ -321,9 +393,42 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
       if (recorder) recorder->lock(name, e);
     };
     sim::AgentBrain& brain = driver.plug_agent(i, c, std::move(log), std::move(locks));
-    brain.skills().set_listener([&skill_failures, &hooks, &recorder, &streaks, &game, &add_issue,
-                                 i](const sim::SkillStatusChange& ch) {
+    // The agent's trace: --trace lines and the agent's facts and firings in the recording.
+    const std::optional<TraceRequest> trace =
+        hooks.trace_sink ? trace_for(hooks.trace, name) : std::nullopt;
+    const bool record_agent = recorder != nullptr && hooks.record_agents;
+    if (trace || record_agent) {
+      clips::TraceOptions options;
+      options.rules = record_agent || trace->rules;
+      options.facts = record_agent || trace->facts;
+      options.messages = trace && trace->messages;
+      options.log = record_agent || trace->log;
+      brain.agent().set_trace(options,
+                              [&recorder, &hooks, trace, record_agent](const clips::TraceEvent& e) {
+                                if (record_agent) recorder->agent_trace(e);
+                                if (!trace) return;
+                                using Kind = clips::TraceEvent::Kind;
+                                const bool wanted = e.kind == Kind::kFire      ? trace->rules
+                                                    : e.kind == Kind::kAssert  ? trace->facts
+                                                    : e.kind == Kind::kRetract ? trace->facts
+                                                    : e.kind == Kind::kMsgIn   ? trace->messages
+                                                    : e.kind == Kind::kMsgOut  ? trace->messages
+                                                    : e.kind == Kind::kLog     ? trace->log
+                                                                               : false;
+                                if (wanted) hooks.trace_sink(clips::trace_line(e));
+                              });
+    }
+    const bool trace_skills = trace && trace->skills;
+    brain.skills().set_listener([&skill_failures, &hooks, &recorder, &streaks, &game, &add_issue, i,
+                                 trace_skills](const sim::SkillStatusChange& ch) {
       if (recorder) recorder->skill(ch);
+      if (trace_skills) {
+        std::string line = clips::trace_prefix(ch.time, ch.robot) + "skill " + ch.skill_string +
+                           " -> " + std::string(lua::to_string(ch.status));
+        if (!ch.result.empty()) line += " result " + ch.result;
+        if (!ch.error.empty()) line += " error " + ch.error;
+        hooks.trace_sink(line);
+      }
       if (hooks.skill) hooks.skill(ch);
       if (ch.status == lua::SkillStatus::kFailed) {
         ++skill_failures;

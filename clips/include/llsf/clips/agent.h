@@ -17,6 +17,7 @@
 #include "llsf/clips/config_values.h"
 #include "llsf/clips/lock_manager.h"
 #include "llsf/clips/skill_runner.h"
+#include "llsf/clips/trace.h"
 #include "llsf/clips/value.h"
 #include "llsf/core/error.h"
 #include "llsf/core/geometry.h"
@@ -170,6 +171,17 @@ class AgentHost {
   void assert_fact(std::string_view fact);
   /// Evaluates an expression, e.g. "(now)" or "(+ 1 2)" (void on error).
   Value eval(std::string_view expression);
+
+  // ---- tracing (docs/clips.md, "Tracing") ----
+  /// Sends the events `options` selects to `sink` (called on the caller's thread, during
+  /// cycle(), receive() and the other calls; it must not call back into this host except for
+  /// the const inspection functions). An empty sink stops tracing; untraced, the host registers
+  /// no hook with CLIPS.
+  void set_trace(TraceOptions options, TraceSink sink);
+  /// The fact with `index` as CLIPS prints it, "(state IDLE)"; "" if there is none.
+  std::string fact_text(std::int64_t index) const;
+  /// Every fact as (index, text), in fact-list order (`out` is cleared first).
+  void fact_texts(std::vector<std::pair<std::int64_t, std::string>>& out) const;
 
   /// The most CLIPS steps one cycle took so far (the measure of max_steps_per_cycle).
   std::int64_t max_cycle_steps() const;

@@ -27,6 +27,8 @@ struct BatchOptions {
   /// If set, every game is recorded to <recordings_dir>/batch<ID>/recording_file_name(...)
   /// (the directory is created) and the store keeps the path with the run.
   std::string recordings_dir;
+  /// Recordings also keep the agents' facts and rule firings (RunHooks::record_agents).
+  bool record_agents = false;
 };
 
 /// The seeds a batch plays for `s`. Throws core::ConfigError if `runs` < 1 or exceeds a seed

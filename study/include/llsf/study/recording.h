@@ -56,6 +56,14 @@ class Recorder {
   void agent(const clips::LogRecord& record);
   /// A change of a robot's lock state (grants, refusals, releases).
   void lock(const std::string& robot, const clips::LockEvent& event);
+  /// An event of an agent's trace (clips::AgentHost::set_trace with rules and facts on): the
+  /// agent's facts and rule firings become `facts` snapshots (at its first cycle and every
+  /// kFactSnapshotPeriod), `fact` deltas and `rules` lines, one of each per cycle at most
+  /// (docs/recording.md); kLog events at debug level (e.g. (watch facts) output) become `agent`
+  /// lines. Other events are ignored.
+  void agent_trace(const clips::TraceEvent& event);
+  /// Simulated time between two `facts` snapshots of one robot.
+  static constexpr core::SimTime kFactSnapshotPeriod = core::SimTime::from_sec(30);
   /// A free-form event from an agent or tool ({"t":..,"e":"note","robot":..,"text":..}).
   void note(core::SimTime t, const std::string& robot, const std::string& text);
   /// Flushes and closes the file (idempotent).

@@ -137,6 +137,25 @@ struct RunResult {
   bool passed() const;
 };
 
+/// What `run --trace ROBOT[:KINDS]` asks for (docs/llsfsim.md): a robot's name or "all", and
+/// which kinds of trace lines.
+struct TraceRequest {
+  std::string robot = "all";
+  bool rules = true;     ///< "FIRE rule  f-3 (fact), ..."
+  bool facts = true;     ///< "==> f-18 (fact)", "<== f-17 (fact)"
+  bool skills = true;    ///< "skill drive_to{place=\"M1\"} -> RUNNING"
+  bool messages = true;  ///< "msg <- robot2 LockMessage {...}", "msg -> BeaconSignal {...}"
+  bool log = true;       ///< "log info text": printout, log-*, (watch ...) output
+};
+/// The kinds `--trace` knows, in order: rules, facts, skills, msgs, log.
+inline constexpr const char* kTraceKinds[] = {"rules", "facts", "skills", "msgs", "log"};
+/// Parses "ROBOT[:KIND,KIND...]" (no kinds: all). Throws core::UserError naming the valid kinds
+/// for an unknown one or an empty robot.
+TraceRequest parse_trace_request(std::string_view arg);
+/// Throws core::UserError if a request names a robot `scenario` does not have (naming its
+/// robots).
+void check_trace_requests(const Scenario& scenario, const std::vector<TraceRequest>& requests);
+
 /// Called every `progress_every` of game time with the game (for a progress line).
 struct RunHooks {
   std::function<void(const sim::Game&)> progress;
@@ -152,6 +171,14 @@ struct RunHooks {
   std::function<void(std::string_view line)> record_sink;
   /// Measure where the tick's time goes (RunResult::time_split).
   bool profile = false;
+  /// Record the agents' facts and rule firings (`facts`, `fact`, `rules` lines and the debug
+  /// log, docs/recording.md) when the game is recorded.
+  bool record_agents = false;
+  /// Agents to trace (`run --trace`); every trace line (without newline) goes to trace_sink,
+  /// on the game's thread. Requests for a robot the scenario lacks make run_game throw
+  /// core::UserError before anything is written.
+  std::vector<TraceRequest> trace;
+  std::function<void(std::string_view line)> trace_sink;
 };
 
 /// Plays `scenario` with `seed`. Throws clips::AgentLoadError / core::ConfigError before the
