@@ -58,7 +58,8 @@ export class AgentPanel {
   constructor(
     private readonly rec: Recording,
     onClose: () => void,
-    private readonly onSelect: (robot: string) => void,
+    /// Called when the selection or a filter changed (the owner draws the panel again).
+    private readonly onChange: () => void,
   ) {
     const close = el("button", {class: "aclose", title: "close the agent browser", "data-agent": "close"}, "×");
     close.onclick = onClose;
@@ -92,7 +93,6 @@ export class AgentPanel {
     this.robotSel.value = robot;
     this.root.setAttribute("data-robot", robot);
     this.invalidate();
-    this.onSelect(robot);
   }
 
   /// The last rendered view (for the test hook).
@@ -102,6 +102,7 @@ export class AgentPanel {
 
   private invalidate(): void {
     this.templatesKey = this.factsKey = this.rulesKey = this.logKey = this.skillKey = "";
+    this.onChange();
   }
 
   /// Shows the selected robot at `time` (`state`: the derived game state at that time).
