@@ -51,7 +51,11 @@ export class AgentPanel {
   private templatesKey = "";
   private factsKey = "";
   private rulesKey = "";
+  private rulesCount = 0;
   private logKey = "";
+  private logCount = 0;
+  /// The rows of the facts shown, by index (reused while the fact is shown with the same text).
+  private readonly factRows = new Map<number, {text: string; row: HTMLElement}>();
   private skillKey = "";
   private last: AgentView | null = null;
 
@@ -173,6 +177,7 @@ export class AgentPanel {
       this.factList.setAttribute("data-shown", String(shown.length));
       this.factList.setAttribute("data-total", String(at.facts.length));
       if (!at.recorded) {
+        this.factRows.clear();
         this.factList.replaceChildren(
           el(
             "div",
@@ -181,15 +186,14 @@ export class AgentPanel {
           ),
         );
       } else {
-        const rows: Node[] = shown.slice(0, kMaxFacts).map(([i, f]) =>
-          el("div", {class: "fact", "data-index": String(i)}, el("span", {class: "fi"}, `f-${i}`), f),
+        this.showFacts(
+          shown.slice(0, kMaxFacts),
+          shown.length > kMaxFacts
+            ? el("div", {class: "info"}, `… ${shown.length - kMaxFacts} more: narrow the filter`)
+            : shown.length === 0
+              ? el("div", {class: "info"}, "no fact matches the filter")
+              : null,
         );
-        if (shown.length > kMaxFacts) {
-          rows.push(el("div", {class: "info"}, `… ${shown.length - kMaxFacts} more: narrow the filter`));
-        } else if (shown.length === 0) {
-          rows.push(el("div", {class: "info"}, "no fact matches the filter"));
-        }
-        this.factList.replaceChildren(...rows);
       }
     } else if (this.last) {
       this.last.time = time;
@@ -197,48 +201,93 @@ export class AgentPanel {
 
     // The last rule firings up to the time.
     const nFired = trace.firingCount(name, time);
-    const rulesKey = `${name}\n${nFired}`;
-    if (rulesKey !== this.rulesKey) {
-      this.rulesKey = rulesKey;
-      const fired = trace.firingsAt(name, time, kFirings);
-      const facts = new Map(at.facts);
-      this.rules.replaceChildren(
-        ...(fired.length === 0
-          ? [el("div", {class: "info"}, trace.hasRules ? "no rule fired yet" : "no rule firings recorded")]
-          : fired
-              .slice()
-              .reverse()
-              .map((f) =>
-                el(
-                  "div",
-                  {class: "firing", "data-rule": f.rule},
-                  el("span", {class: "at"}, fmtTime(f.t)),
-                  ` ${f.rule} `,
-                  ...f.facts.map((i) =>
-                    el("span", {class: "fi", title: facts.get(i) ?? "(not in the fact base now)"}, `f-${i} `),
-                  ),
-                ),
-              )),
+    const rulesKey = `${name}`;
+    if (rulesKey !== this.rulesKey || nFired !== this.rulesCount) {
+      let facts: Map<number, string> | null = null;
+      newestFirst(
+        this.rules,
+        rulesKey === this.rulesKey ? this.rulesCount : -1,
+        nFired,
+        kFirings,
+        (n) => trace.firingsAt(name, time, n),
+        (f) => {
+          facts ??= new Map(at.facts);
+          return el(
+            "div",
+            {class: "firing", "data-rule": f.rule},
+            el("span", {class: "at"}, fmtTime(f.t)),
+            ` ${f.rule} `,
+            ...f.facts.map((i) =>
+              el("span", {class: "fi", title: facts!.get(i) ?? "(retracted since)"}, `f-${i} `),
+            ),
+          );
+        },
+        trace.hasRules ? "no rule fired yet" : "no rule firings recorded",
       );
+      this.rulesKey = rulesKey;
+      this.rulesCount = nFired;
     }
 
     // The last output lines up to the time.
     const debug = this.debugBox.checked;
     const nLog = trace.logCount(name, time, debug);
-    const logKey = `${name}\n${nLog}\n${debug}`;
-    if (logKey !== this.logKey) {
-      this.logKey = logKey;
-      const lines = trace.logAt(name, time, kLogLines, debug);
-      this.log.replaceChildren(
-        ...(lines.length === 0
-          ? [el("div", {class: "info"}, "no output yet")]
-          : lines
-              .slice()
-              .reverse()
-              .map((l) =>
-                el("div", {class: `logline ${l.level}`}, el("span", {class: "at"}, fmtTime(l.t)), ` ${l.text}`),
-              )),
+    const logKey = `${name}\n${debug}`;
+    if (logKey !== this.logKey || nLog !== this.logCount) {
+      newestFirst(
+        this.log,
+        logKey === this.logKey ? this.logCount : -1,
+        nLog,
+        kLogLines,
+        (n) => trace.logAt(name, time, n, debug),
+        (l) => el("div", {class: `logline ${l.level}`}, el("span", {class: "at"}, fmtTime(l.t)), ` ${l.text}`),
+        "no output yet",
       );
+      this.logKey = logKey;
+      this.logCount = nLog;
     }
   }
+
+  /// Shows `facts` (sorted by index) and `tail` after them, keeping the rows of facts that are
+  /// still shown (a step of the game changes a few facts of a few hundred).
+  private showFacts(facts: Fact[], tail: HTMLElement | null): void {
+    const keep = new Set<Node>();
+    const rows = facts.map(([i, f]) => {
+      let c = this.factRows.get(i);
+      if (!c || c.text !== f) {
+        c = {text: f, row: el("div", {class: "fact", "data-index": String(i)}, el("span", {class: "fi"}, `f-${i}`), f)};
+        this.factRows.set(i, c);
+      }
+      keep.add(c.row);
+      return c.row;
+    });
+    for (const child of [...this.factList.children]) if (!keep.has(child)) child.remove();
+    for (const [i, c] of this.factRows) if (!keep.has(c.row)) this.factRows.delete(i);
+    let at = this.factList.firstChild;
+    for (const r of rows) {
+      if (at === r) at = at.nextSibling;
+      else this.factList.insertBefore(r, at);
+    }
+    if (tail) this.factList.append(tail);
+  }
+}
+
+/// Shows the last `max` of `count` items in `list`, newest first. When the list showed the first
+/// `before` of the same items (-1: other items) and a few more came, only those are added on top.
+function newestFirst<T>(
+  list: HTMLElement,
+  before: number,
+  count: number,
+  max: number,
+  last: (n: number) => T[],
+  row: (item: T) => HTMLElement,
+  empty: string,
+): void {
+  const added = count - before;
+  if (before > 0 && added > 0 && added < max) {
+    for (const item of last(added)) list.prepend(row(item));
+    while (list.children.length > max) list.lastElementChild!.remove();
+    return;
+  }
+  const items = last(max);
+  list.replaceChildren(...(items.length === 0 ? [el("div", {class: "info"}, empty)] : items.reverse().map(row)));
 }
