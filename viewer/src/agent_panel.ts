@@ -169,10 +169,11 @@ export class AgentPanel {
         ([, f]) => (template === "" || templateOf(f) === template) && (text === "" || f.toLowerCase().includes(text)),
       );
       this.last = {robot: name, time, recorded: at.recorded, facts: at.facts, shown};
+      const last = at.latest.added.length + at.latest.removed > 0
+        ? ` · last change ${fmtTime(at.latest.t)}: +${at.latest.added.length} −${at.latest.removed}`
+        : "";
       this.count.textContent = at.recorded
-        ? shown.length === at.facts.length
-          ? `${at.facts.length}`
-          : `${shown.length} of ${at.facts.length}`
+        ? (shown.length === at.facts.length ? `${at.facts.length}` : `${shown.length} of ${at.facts.length}`) + last
         : "";
       this.factList.setAttribute("data-shown", String(shown.length));
       this.factList.setAttribute("data-total", String(at.facts.length));
@@ -188,6 +189,7 @@ export class AgentPanel {
       } else {
         this.showFacts(
           shown.slice(0, kMaxFacts),
+          new Set(at.latest.added),
           shown.length > kMaxFacts
             ? el("div", {class: "info"}, `… ${shown.length - kMaxFacts} more: narrow the filter`)
             : shown.length === 0
@@ -249,7 +251,8 @@ export class AgentPanel {
 
   /// Shows `facts` (sorted by index) and `tail` after them, keeping the rows of facts that are
   /// still shown (a step of the game changes a few facts of a few hundred).
-  private showFacts(facts: Fact[], tail: HTMLElement | null): void {
+  /// `latest`: the indices asserted by the last delta (marked).
+  private showFacts(facts: Fact[], latest: Set<number>, tail: HTMLElement | null): void {
     const keep = new Set<Node>();
     const rows = facts.map(([i, f]) => {
       let c = this.factRows.get(i);
@@ -257,6 +260,7 @@ export class AgentPanel {
         c = {text: f, row: el("div", {class: "fact", "data-index": String(i)}, el("span", {class: "fi"}, `f-${i}`), f)};
         this.factRows.set(i, c);
       }
+      c.row.classList.toggle("new", latest.has(i));
       keep.add(c.row);
       return c.row;
     });

@@ -32,6 +32,9 @@ export interface FactsAt {
   /// The number of the robot's fact entries (snapshots and deltas) up to the time: a key that
   /// changes whenever the facts may have.
   version: number;
+  /// The robot's last delta at or before the time: its time, the indices it asserted, the number
+  /// it retracted.
+  latest: {t: number; added: number[]; removed: number};
 }
 
 /// The template of a fact: the first symbol after "(" (`machine` for `(machine (name M1))`).
@@ -96,7 +99,7 @@ class RobotTrace {
   /// The facts after the entries with t <= time.
   factsAt(time: number): FactsAt {
     const target = upperBound(this.entryT, time);
-    if (target === 0) return {facts: [], recorded: false, version: 0};
+    if (target === 0) return {facts: [], recorded: false, version: 0, latest: {t: 0, added: [], removed: 0}};
     // Forward by a few entries from the cursor, else from the last snapshot at or before target.
     if (!this.cursorFacts || target < this.cursorIndex || target - this.cursorIndex > kSnapshotEvery) {
       const snap = this.snapshotAtOrBefore(target);
@@ -117,7 +120,17 @@ class RobotTrace {
       this.cursorSorted = null;
     }
     this.cursorSorted ??= sortedFacts(this.cursorFacts);
-    return {facts: this.cursorSorted, recorded: true, version: target};
+    // The last delta (a snapshot of the same cycle may follow it).
+    let latest = {t: 0, added: [] as number[], removed: 0};
+    for (let k = target - 1; k >= 0; k--) {
+      const e = this.entries[k];
+      if (!e.full) {
+        latest = {t: this.entryT[k], added: (e.add ?? []).map((f) => f[0]), removed: e.del?.length ?? 0};
+        break;
+      }
+      if (k === 0 || this.entryT[k - 1] !== this.entryT[k]) break;
+    }
+    return {facts: this.cursorSorted, recorded: true, version: target, latest};
   }
 
   private snapshotAtOrBefore(index: number): {index: number; facts: Fact[]} {
@@ -216,7 +229,7 @@ export class AgentTrace {
   /// The facts of `robot` at `time` (empty, `recorded` false, when none are recorded up to then).
   factsAt(robot: string, time: number): FactsAt {
     const r = this.robots.get(robot);
-    return r ? r.factsAt(time) : {facts: [], recorded: false, version: 0};
+    return r ? r.factsAt(time) : {facts: [], recorded: false, version: 0, latest: {t: 0, added: [], removed: 0}};
   }
 
   /// The last `n` rule firings of `robot` at or before `time`, oldest first.
