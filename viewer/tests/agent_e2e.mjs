@@ -9,7 +9,8 @@
 //   2. drags the timeline to about 60 % of the game and compares the listed facts (index and
 //      text) with the facts reconstructed here from the .jsonl.gz itself (docs/recording.md: the
 //      last `facts` snapshot of the robot at or before t, then its `fact` deltas up to t); an
-//      expected fact (one asserted by a delta after that snapshot where there is one) is listed;
+//      expected fact (one asserted by a delta after that snapshot where there is one) is listed,
+//      the last delta's facts are marked, and (recorded trace) every device has a machine fact;
 //   3. the template filter narrows the list to that template's facts, the text filter to the
 //      expected fact; the rule firings and output lines end with the recording's last ones up to t;
 //   4. the same game without the agents' lines shows "no agent facts recorded";
@@ -289,6 +290,16 @@ try {
   const expectText = want.facts.get(expectIndex);
   check(rows.some(([i, text]) => i === expectIndex && text === expectText),
         `the agent browser does not list f-${expectIndex} ${expectText} at ${time} s`);
+  // The facts of the last delta up to the time are marked.
+  const lastDelta = lines.slice(1).filter((l) => l.e === "fact" && l.robot === robot && l.t <= time).pop();
+  const marked = await page.$$eval('[data-agent="facts"] .fact.new', (r) => r.map((x) => Number(x.getAttribute("data-index"))));
+  const wantMarked = (lastDelta?.a ?? []).map(([i]) => i).filter((i) => want.facts.has(i)).sort((x, y) => x - y);
+  check(JSON.stringify(marked) === JSON.stringify(wantMarked),
+        `marked as the last change: ${JSON.stringify(marked)}, the recording's last delta: ${JSON.stringify(wantMarked)}`);
+  // The 2013 agent knows every device as a machine fact.
+  const machines = rows.filter(([, text]) => templateOf(text) === "machine").length;
+  check(!real || machines === header.devices.length,
+        `${machines} machine facts listed, the field has ${header.devices.length} devices`);
   await page.screenshot({path: join(artifacts, "agent-facts.png")});
 
   // 3. The template filter: only that template's facts; the text filter: the expected fact.
