@@ -65,7 +65,11 @@ export class AgentPanel {
     /// Called when the selection or a filter changed (the owner draws the panel again).
     private readonly onChange: () => void,
   ) {
-    const close = el("button", {class: "aclose", title: "close the agent browser", "data-agent": "close"}, "×");
+    const close = el(
+      "button",
+      {class: "aclose", title: "close the agent browser", "data-agent": "close"},
+      "×",
+    );
     close.onclick = onClose;
     this.robotSel.onchange = () => this.select(this.robotSel.value);
     this.templateSel.onchange = () => this.invalidate();
@@ -166,15 +170,17 @@ export class AgentPanel {
         this.templateSel.value = template;
       }
       const shown = at.facts.filter(
-        ([, f]) => (template === "" || templateOf(f) === template) && (text === "" || f.toLowerCase().includes(text)),
+        ([, f]) =>
+          (template === "" || templateOf(f) === template) &&
+          (text === "" || f.toLowerCase().includes(text)),
       );
       this.last = {robot: name, time, recorded: at.recorded, facts: at.facts, shown};
       const last = at.latest.added.length + at.latest.removed > 0
         ? ` · last change ${fmtTime(at.latest.t)}: +${at.latest.added.length} −${at.latest.removed}`
         : "";
-      this.count.textContent = at.recorded
-        ? (shown.length === at.facts.length ? `${at.facts.length}` : `${shown.length} of ${at.facts.length}`) + last
-        : "";
+      const total = at.facts.length;
+      const n = shown.length === total ? `${total}` : `${shown.length} of ${total}`;
+      this.count.textContent = at.recorded ? n + last : "";
       this.factList.setAttribute("data-shown", String(shown.length));
       this.factList.setAttribute("data-total", String(at.facts.length));
       if (!at.recorded) {
@@ -241,7 +247,8 @@ export class AgentPanel {
         nLog,
         kLogLines,
         (n) => trace.logAt(name, time, n, debug),
-        (l) => el("div", {class: `logline ${l.level}`}, el("span", {class: "at"}, fmtTime(l.t)), ` ${l.text}`),
+        (l) =>
+          el("div", {class: `logline ${l.level}`}, el("span", {class: "at"}, fmtTime(l.t)), ` ${l.text}`),
         "no output yet",
       );
       this.logKey = logKey;
@@ -257,7 +264,9 @@ export class AgentPanel {
     const rows = facts.map(([i, f]) => {
       let c = this.factRows.get(i);
       if (!c || c.text !== f) {
-        c = {text: f, row: el("div", {class: "fact", "data-index": String(i)}, el("span", {class: "fi"}, `f-${i}`), f)};
+        const index = el("span", {class: "fi"}, `f-${i}`);
+        const row = el("div", {class: "fact", "data-index": String(i)}, index, f);
+        c = {text: f, row};
         this.factRows.set(i, c);
       }
       c.row.classList.toggle("new", latest.has(i));
@@ -293,5 +302,7 @@ function newestFirst<T>(
     return;
   }
   const items = last(max);
-  list.replaceChildren(...(items.length === 0 ? [el("div", {class: "info"}, empty)] : items.reverse().map(row)));
+  list.replaceChildren(
+    ...(items.length === 0 ? [el("div", {class: "info"}, empty)] : items.reverse().map(row)),
+  );
 }

@@ -43,6 +43,13 @@ export function templateOf(text: string): string {
   return m ? m[1] : text.trim();
 }
 
+const noFacts = (): FactsAt => ({
+  facts: [],
+  recorded: false,
+  version: 0,
+  latest: {t: 0, added: [], removed: 0},
+});
+
 const kSnapshotEvery = 200;  // fact entries between the trace's own snapshots
 
 /// The number of entries of the sorted array `ts` with t <= time.
@@ -99,7 +106,7 @@ class RobotTrace {
   /// The facts after the entries with t <= time.
   factsAt(time: number): FactsAt {
     const target = upperBound(this.entryT, time);
-    if (target === 0) return {facts: [], recorded: false, version: 0, latest: {t: 0, added: [], removed: 0}};
+    if (target === 0) return noFacts();
     // Forward by a few entries from the cursor, else from the last snapshot at or before target.
     if (!this.cursorFacts || target < this.cursorIndex || target - this.cursorIndex > kSnapshotEvery) {
       const snap = this.snapshotAtOrBefore(target);
@@ -229,7 +236,7 @@ export class AgentTrace {
   /// The facts of `robot` at `time` (empty, `recorded` false, when none are recorded up to then).
   factsAt(robot: string, time: number): FactsAt {
     const r = this.robots.get(robot);
-    return r ? r.factsAt(time) : {facts: [], recorded: false, version: 0, latest: {t: 0, added: [], removed: 0}};
+    return r ? r.factsAt(time) : noFacts();
   }
 
   /// The last `n` rule firings of `robot` at or before `time`, oldest first.
