@@ -27,7 +27,8 @@ import {gunzipSync, gzipSync} from "node:zlib";
 import {check, launch, prerequisites, sourceDir, viewerDir} from "./e2e_lib.mjs";
 
 const kName = "agent_e2e";
-const {llsfsim, artifacts, chromium} = await prerequisites(kName, "agent_e2e.mjs", ["index.html", "viewer.js"]);
+const {llsfsim, artifacts, chromium} =
+  await prerequisites(kName, "agent_e2e.mjs", ["index.html", "viewer.js"]);
 
 // A short game: 30 s exploration + 60 s production, two robots with the 2013 team agent.
 const agents = join(sourceDir, "clips", "agents");
@@ -83,7 +84,11 @@ function startServer(args, cwd) {
 // The recording, read here independently of the viewer's code.
 
 const readLines = (file) =>
-  gunzipSync(readFileSync(file)).toString("utf8").split("\n").filter((l) => l.trim() !== "").map((l) => JSON.parse(l));
+  gunzipSync(readFileSync(file))
+    .toString("utf8")
+    .split("\n")
+    .filter((l) => l.trim() !== "")
+    .map((l) => JSON.parse(l));
 const writeLines = (file, lines) =>
   writeFileSync(file, gzipSync(lines.map((l) => JSON.stringify(l)).join("\n") + "\n"));
 const kTraceEvents = new Set(["facts", "fact", "rules"]);
@@ -168,7 +173,8 @@ function synthesize(lines) {
         const e = events[ei];
         if (e.e === "skill") {
           put("state", `(state ${e.status === "RUNNING" ? "SKILL-EXECUTION" : "IDLE"})`, "skill-state");
-          put("skill", `(skill (name ${JSON.stringify(e.string ?? "")}) (status ${e.status}))`, "skill-update");
+          const name = JSON.stringify(e.string ?? "");
+          put("skill", `(skill (name ${name}) (status ${e.status}))`, "skill-update");
         } else {
           const i = next++;
           const text = `(decision ${JSON.stringify(e.text ?? "")})`;
@@ -292,10 +298,13 @@ try {
         `the agent browser does not list f-${expectIndex} ${expectText} at ${time} s`);
   // The facts of the last delta up to the time are marked.
   const lastDelta = lines.slice(1).filter((l) => l.e === "fact" && l.robot === robot && l.t <= time).pop();
-  const marked = await page.$$eval('[data-agent="facts"] .fact.new', (r) => r.map((x) => Number(x.getAttribute("data-index"))));
-  const wantMarked = (lastDelta?.a ?? []).map(([i]) => i).filter((i) => want.facts.has(i)).sort((x, y) => x - y);
+  const marked = await page.$$eval('[data-agent="facts"] .fact.new',
+                                   (r) => r.map((x) => Number(x.getAttribute("data-index"))));
+  const wantMarked =
+    (lastDelta?.a ?? []).map(([i]) => i).filter((i) => want.facts.has(i)).sort((x, y) => x - y);
   check(JSON.stringify(marked) === JSON.stringify(wantMarked),
-        `marked as the last change: ${JSON.stringify(marked)}, the recording's last delta: ${JSON.stringify(wantMarked)}`);
+        `marked as the last change: ${JSON.stringify(marked)}, ` +
+          `the recording's last delta: ${JSON.stringify(wantMarked)}`);
   // The 2013 agent knows every device as a machine fact.
   const machines = rows.filter(([, text]) => templateOf(text) === "machine").length;
   check(!real || machines === header.devices.length,
@@ -307,7 +316,8 @@ try {
   const options = await page.$$eval('select[data-agent="template"] option', (os) => os.map((o) => o.value));
   const templates = new Set(wantRows.map(([, text]) => templateOf(text)));
   check(JSON.stringify(options.filter((o) => o !== "")) === JSON.stringify([...templates].sort()),
-        `the template choices ${JSON.stringify(options)} are not the templates present ${JSON.stringify([...templates])}`);
+        `the template choices ${JSON.stringify(options)} are not the templates present ` +
+          JSON.stringify([...templates]));
   await page.selectOption('select[data-agent="template"]', template);
   await page.waitForTimeout(300);
   const narrowed = await listed();
@@ -327,14 +337,16 @@ try {
   await page.fill('input[data-agent="filter"]', "");
   // The rule firings and output lines: the newest shown first, the recording's last up to t.
   const hist = historyAt(lines, robot, time);
-  const firstFiring = await page.$eval('[data-agent="rules"]', (e) => e.firstElementChild?.getAttribute("data-rule") ?? null);
+  const firstFiring = await page.$eval('[data-agent="rules"]',
+                                       (e) => e.firstElementChild?.getAttribute("data-rule") ?? null);
   const lastFiring = hist.firings[hist.firings.length - 1];
   check(lastFiring !== undefined && firstFiring === lastFiring[1],
         `the newest rule firing shown is ${firstFiring}, the recording's is ${JSON.stringify(lastFiring)}`);
   if (hist.log.length > 0) {
     const firstLog = await page.$eval('[data-agent="log"]', (e) => e.firstElementChild?.textContent ?? "");
     const lastLog = hist.log[hist.log.length - 1][1];
-    check(firstLog.endsWith(lastLog), `the newest log line shown is "${firstLog}", the recording's "${lastLog}"`);
+    check(firstLog.endsWith(lastLog),
+          `the newest log line shown is "${firstLog}", the recording's "${lastLog}"`);
   }
   const skill = await page.textContent('[data-agent="skill"]');
   check(skill && skill.length > 0, "the agent browser shows no skill");
@@ -351,12 +363,14 @@ try {
   let liveFacts = -1;
   if (real) {
     const live = await startServer(
-      ["run", "live.yaml", "--no-db", "--no-record", "--speed", "20", "--serve", "--serve-exit", "--port", "0"],
+      ["run", "live.yaml", "--no-db", "--no-record", "--speed", "20", "--serve", "--serve-exit",
+       "--port", "0"],
       tmp);
     await page.goto(`${live.url}#/live`);
     await readyOrError("#/live");
     await page.evaluate((r) => window.llsfViewer.selectRobot(r), robot);
-    await page.waitForFunction(() => (window.llsfViewer.agent()?.facts.length ?? 0) > 0, null, {timeout: 15_000});
+    await page.waitForFunction(() => (window.llsfViewer.agent()?.facts.length ?? 0) > 0, null,
+                               {timeout: 15_000});
     await page.waitForTimeout(500);
     liveFacts = await page.locator('[data-agent="facts"] .fact').count();
     await page.screenshot({path: join(artifacts, "agent-live.png")});
@@ -369,7 +383,8 @@ try {
     `${kName}: ok: ${real ? "recorded" : "synthetic"} agent trace; ${robot} at ${time.toFixed(2)} s: ` +
       `${rows.length} facts as in the recording (snapshot at ${want.snapshotT} s), f-${expectIndex} ` +
       `${expectText}; template ${template}: ${narrowed.length}; ` +
-      (real ? `live: ${liveFacts} facts` : "live: skipped (no trace recorded)") + `; screenshots in ${artifacts}`,
+      (real ? `live: ${liveFacts} facts` : "live: skipped (no trace recorded)") +
+      `; screenshots in ${artifacts}`,
   );
 } catch (e) {
   const output = e.stderr ? `\n${e.stderr}` : "";
