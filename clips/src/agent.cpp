@@ -405,13 +405,14 @@ void AgentHost::set_trace(TraceOptions options, TraceSink sink) {
   impl_->tracer.reset();
   if (!sink) return;
   impl_->tracer = std::make_unique<detail::Tracer>(impl_->state, *this, options, std::move(sink));
-  impl_->env.observe(impl_->tracer.get(), options.rules, options.facts);
+  impl_->env.observe(impl_->tracer.get(), options.rules, options.facts, options.fact_texts);
 }
 
 std::string AgentHost::fact_text(std::int64_t index) const { return impl_->env.fact_text(index); }
 
-void AgentHost::fact_texts(std::vector<std::pair<std::int64_t, std::string>>& out) const {
-  impl_->env.fact_texts(out);
+void AgentHost::fact_texts(std::vector<std::pair<std::int64_t, std::string>>& out,
+                           std::int64_t from_index) const {
+  impl_->env.fact_texts(out, from_index);
 }
 
 int AgentHost::runtime_errors() const { return impl_->runtime_errors; }

@@ -152,11 +152,13 @@ void to_data_object(void* env, const Value& v, DATA_OBJECT& out) {
 // The router callbacks reach the Environment through the router context.
 struct RouterAccess {
   static int query(void*, const char* name) {
+    // print_fact() passes kCaptureName itself: a pointer compare first (many calls per fact).
+    if (name == kCaptureName) return TRUE;
     return is_output_name(name) || std::string_view(name) == kCaptureName ? TRUE : FALSE;
   }
   static int print(void* env, const char* name, const char* text) {
     auto* self = static_cast<Environment*>(GetEnvironmentRouterContext(env));
-    if (std::string_view(name) == kCaptureName) {
+    if (name == kCaptureName || std::string_view(name) == kCaptureName) {
       if (self->capture_ != nullptr) self->capture_->append(text);
       return TRUE;
     }
@@ -220,7 +222,7 @@ struct TraceHooks {
     Environment* e = self(env);
     if (e == nullptr || e->observer_ == nullptr) return;
     e->fact_buf_.clear();
-    e->print_fact(f, e->fact_buf_);
+    if (e->fact_texts_) e->print_fact(f, e->fact_buf_);
     try {
       e->observer_->on_fact(asserted, static_cast<struct fact*>(f)->factIndex, e->fact_buf_);
     } catch (...) {
@@ -597,7 +599,7 @@ std::vector<FactCopy> Environment::facts(std::string_view template_name) const {
   return out;
 }
 
-void Environment::observe(TraceObserver* observer, bool rules, bool facts) {
+void Environment::observe(TraceObserver* observer, bool rules, bool facts, bool fact_texts) {
   if (observe_rules_) EnvRemoveBeforeRunFunction(env_, kTraceHook);
   if (observe_facts_) {
     EnvRemoveAssertFunction(env_, kTraceHook);
@@ -606,6 +608,7 @@ void Environment::observe(TraceObserver* observer, bool rules, bool facts) {
   observer_ = observer;
   observe_rules_ = observer != nullptr && rules;
   observe_facts_ = observer != nullptr && facts;
+  fact_texts_ = fact_texts;
   if (observe_rules_) EnvAddBeforeRunFunction(env_, kTraceHook, &TraceHooks::before_fire, 0);
   if (observe_facts_) {
     EnvAddAssertFunction(env_, kTraceHook, &TraceHooks::asserted, 0);
@@ -631,10 +634,16 @@ std::string Environment::fact_text(std::int64_t index) const {
   return out;
 }
 
-void Environment::fact_texts(std::vector<std::pair<std::int64_t, std::string>>& out) const {
+void Environment::fact_texts(std::vector<std::pair<std::int64_t, std::string>>& out,
+                             std::int64_t from_index) const {
   out.clear();
-  for (void* f = EnvGetNextFact(env_, nullptr); f != nullptr; f = EnvGetNextFact(env_, f)) {
-    out.emplace_back(EnvFactIndex(env_, f), std::string());
+  // Facts are appended to the list with increasing indices (a reset restarts both).
+  struct fact* first = FactData(env_)->LastFact;
+  if (first == nullptr || first->factIndex < from_index) return;
+  while (first->previousFact != nullptr && first->previousFact->factIndex >= from_index)
+    first = first->previousFact;
+  for (struct fact* f = first; f != nullptr; f = f->nextFact) {
+    out.emplace_back(f->factIndex, std::string());
     print_fact(f, out.back().second);
   }
 }

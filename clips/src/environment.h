@@ -171,11 +171,14 @@ class Environment {
 
   /// Installs `observer` (borrowed; nullptr removes it) for rule firings (`rules`) and fact
   /// changes (`facts`). Without an observer no hook is registered with CLIPS: nothing is spent.
-  void observe(TraceObserver* observer, bool rules, bool facts);
+  /// `fact_texts` false: on_fact gets an empty text.
+  void observe(TraceObserver* observer, bool rules, bool facts, bool fact_texts = true);
   /// The fact with `index` as CLIPS prints it ("(state IDLE)"); "" if there is none.
   std::string fact_text(std::int64_t index) const;
-  /// Every fact as (index, text), in fact-list order; `out` is cleared first.
-  void fact_texts(std::vector<std::pair<std::int64_t, std::string>>& out) const;
+  /// Every fact with an index >= `from_index` as (index, text), in fact-list order (= index
+  /// order); `out` is cleared first. Walks from the end: cheap for the newest facts.
+  void fact_texts(std::vector<std::pair<std::int64_t, std::string>>& out,
+                  std::int64_t from_index = 0) const;
 
  private:
   struct FunctionEntry {
@@ -207,6 +210,7 @@ class Environment {
   TraceObserver* observer_ = nullptr;
   bool observe_rules_ = false;
   bool observe_facts_ = false;
+  bool fact_texts_ = true;
   std::vector<std::int64_t> matched_;       // reused for on_fire
   mutable std::string* capture_ = nullptr;  // print_fact: where the capture router writes
   std::string fact_buf_;                    // reused for on_fact

@@ -90,14 +90,27 @@ void append_json_string(std::string& out, std::string_view s) {
   out += '"';
 }
 
+/// Drops the address from CLIPS' "<Pointer-C-0x55d0c2a1e2b0>" (an external address, e.g. a
+/// protobuf message kept in a fact): addresses differ from run to run, recordings must not.
+void strip_addresses(std::string& text) {
+  static constexpr std::string_view kPointer = "<Pointer-C-";
+  for (std::size_t p = text.find(kPointer); p != std::string::npos;
+       p = text.find(kPointer, p + 1)) {
+    const std::size_t end = text.find('>', p);
+    if (end == std::string::npos) return;
+    text.replace(p, end - p + 1, "<Pointer-C>");
+  }
+}
+
 /// One robot's agent trace being collected for the current cycle (Recorder::agent_trace).
 struct AgentFacts {
   bool snapshot_written = false;
   core::SimTime next_snapshot;
-  std::vector<std::pair<std::int64_t, std::string>> added;  // asserted in the cycle, still there
+  std::int64_t first_added = -1;      // the cycle's first asserted index (-1: none yet)
   std::vector<std::int64_t> removed;  // retracted in the cycle, existed before it
   std::string fired;                  // the cycle's firings: ["rule",[i,j]],...
-  std::vector<std::pair<std::int64_t, std::string>> all;  // snapshot buffer
+  std::vector<std::pair<std::int64_t, std::string>> added;  // buffer: the cycle's new facts
+  std::vector<std::pair<std::int64_t, std::string>> all;    // buffer: a snapshot
 };
 
 }  // namespace
@@ -276,19 +289,13 @@ void Recorder::agent_trace(const clips::TraceEvent& e) {
   AgentFacts& a = it->second;
   switch (e.kind) {
     case Kind::kAssert:
-      a.added.emplace_back(e.fact, std::string(e.text));
+      // Indices grow: the facts of the cycle still there at its end are those from the first.
+      if (a.first_added < 0) a.first_added = e.fact;
       return;
-    case Kind::kRetract: {
+    case Kind::kRetract:
       // Asserted and retracted in the same cycle: neither.
-      auto added = std::find_if(a.added.begin(), a.added.end(),
-                                [&e](const auto& f) { return f.first == e.fact; });
-      if (added != a.added.end()) {
-        a.added.erase(added);
-      } else {
-        a.removed.push_back(e.fact);
-      }
+      if (a.first_added < 0 || e.fact < a.first_added) a.removed.push_back(e.fact);
       return;
-    }
     case Kind::kFire: {
       if (!a.fired.empty()) a.fired += ',';
       a.fired += '[';
@@ -308,7 +315,11 @@ void Recorder::agent_trace(const clips::TraceEvent& e) {
   }
   // The end of a cycle: its rules line, its fact delta, a snapshot when due.
   const bool snapshot = !a.snapshot_written || e.time >= a.next_snapshot;
-  if (a.fired.empty() && a.added.empty() && a.removed.empty() && !snapshot) return;
+  if (a.fired.empty() && a.first_added < 0 && a.removed.empty() && !snapshot) return;
+  a.added.clear();
+  if (a.first_added >= 0 && e.host != nullptr) e.host->fact_texts(a.added, a.first_added);
+  for (auto& f : a.added) strip_addresses(f.second);
+  a.first_added = -1;
   std::string head = "{\"t\":";
   head += Json(fixed(e.time.seconds(), 2)).dump();
   std::string robot;
@@ -349,6 +360,7 @@ void Recorder::agent_trace(const clips::TraceEvent& e) {
     a.snapshot_written = true;
     while (a.next_snapshot <= e.time) a.next_snapshot += kFactSnapshotPeriod;
     e.host->fact_texts(a.all);
+    for (auto& f : a.all) strip_addresses(f.second);
     m.line = head + ",\"e\":\"facts\",\"robot\":" + robot + ",\"facts\":[";
     for (std::size_t i = 0; i < a.all.size(); ++i) {
       m.line += i > 0 ? ",[" : "[";

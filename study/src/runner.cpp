@@ -403,6 +403,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
       options.facts = record_agent || trace->facts;
       options.messages = trace && trace->messages;
       options.log = record_agent || trace->log;
+      options.fact_texts = trace && trace->facts;  // the recorder prints what is left at the end
       brain.agent().set_trace(options,
                               [&recorder, &hooks, trace, record_agent](const clips::TraceEvent& e) {
                                 if (record_agent) recorder->agent_trace(e);

@@ -36,8 +36,7 @@ using Facts = std::map<std::int64_t, std::string>;
 Facts replay(const std::vector<RecordingLine>& lines, const std::string& robot, double t) {
   std::size_t start = lines.size();
   for (std::size_t i = 0; i < lines.size(); ++i) {
-    if (lines[i].kind == "facts" && lines[i].t <= t &&
-        Json::parse(lines[i].json)["robot"] == robot)
+    if (lines[i].kind == "facts" && lines[i].t <= t && Json::parse(lines[i].json)["robot"] == robot)
       start = i;
   }
   REQUIRE(start < lines.size());

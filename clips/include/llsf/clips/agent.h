@@ -180,8 +180,10 @@ class AgentHost {
   void set_trace(TraceOptions options, TraceSink sink);
   /// The fact with `index` as CLIPS prints it, "(state IDLE)"; "" if there is none.
   std::string fact_text(std::int64_t index) const;
-  /// Every fact as (index, text), in fact-list order (`out` is cleared first).
-  void fact_texts(std::vector<std::pair<std::int64_t, std::string>>& out) const;
+  /// Every fact with an index >= `from_index` as (index, text), in fact-list order, which is
+  /// index order (`out` is cleared first; cheap for the newest facts).
+  void fact_texts(std::vector<std::pair<std::int64_t, std::string>>& out,
+                  std::int64_t from_index = 0) const;
 
   /// The most CLIPS steps one cycle took so far (the measure of max_steps_per_cycle).
   std::int64_t max_cycle_steps() const;

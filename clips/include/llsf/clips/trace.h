@@ -50,6 +50,9 @@ struct TraceOptions {
   bool facts = false;     ///< kAssert, kRetract
   bool messages = false;  ///< kMsgIn, kMsgOut
   bool log = false;       ///< kLog, all levels (the run's log sink sees info and above only)
+  /// kAssert and kRetract events carry the fact's text; false: an empty text (a recorder that
+  /// takes the texts of the facts still there at the end of the cycle saves the printing).
+  bool fact_texts = true;
 };
 
 /// "[  12.30] robot1 " : the simulated time in seconds (%7.2f) and the robot, the prefix of every
