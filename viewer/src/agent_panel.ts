@@ -41,7 +41,7 @@ export class AgentPanel {
     type: "search",
     placeholder: "filter text",
     "data-agent": "filter",
-    title: "show the facts that contain this text (case-insensitive)",
+    title: "show the facts that contain this text (case-insensitive; f-12 followed by a space: fact 12)",
   });
   private readonly factList = el("div", {class: "alist facts", "data-agent": "facts"});
   private readonly rules = el("div", {class: "alist rules", "data-agent": "rules"});
@@ -100,6 +100,13 @@ export class AgentPanel {
     this.robot = robot;
     this.robotSel.value = robot;
     this.root.setAttribute("data-robot", robot);
+    this.invalidate();
+  }
+
+  /// Filters the list to fact `index` (a click on it in a rule firing).
+  private showFact(index: number): void {
+    this.templateSel.value = "";
+    this.filter.value = `f-${index} `;
     this.invalidate();
   }
 
@@ -170,9 +177,9 @@ export class AgentPanel {
         this.templateSel.value = template;
       }
       const shown = at.facts.filter(
-        ([, f]) =>
+        ([i, f]) =>
           (template === "" || templateOf(f) === template) &&
-          (text === "" || f.toLowerCase().includes(text)),
+          (text === "" || `f-${i} ${f.toLowerCase()}`.includes(text)),
       );
       this.last = {robot: name, time, recorded: at.recorded, facts: at.facts, shown};
       const last = at.latest.added.length + at.latest.removed > 0
@@ -225,9 +232,11 @@ export class AgentPanel {
             {class: "firing", "data-rule": f.rule},
             el("span", {class: "at"}, fmtTime(f.t)),
             ` ${f.rule} `,
-            ...f.facts.map((i) =>
-              el("span", {class: "fi", title: facts!.get(i) ?? "(retracted since)"}, `f-${i} `),
-            ),
+            ...f.facts.map((i) => {
+              const e = el("span", {class: "fi", title: facts!.get(i) ?? "(retracted since)"}, `f-${i} `);
+              e.onclick = () => this.showFact(i);
+              return e;
+            }),
           );
         },
         trace.hasRules ? "no rule fired yet" : "no rule firings recorded",

@@ -13,6 +13,7 @@
 //      the last delta's facts are marked, and (recorded trace) every device has a machine fact;
 //   3. the template filter narrows the list to that template's facts, the text filter to the
 //      expected fact; the rule firings and output lines end with the recording's last ones up to t;
+//      a click on a fact index in a firing filters the list to that fact;
 //   4. the same game without the agents' lines shows "no agent facts recorded";
 //   5. a live game (`llsfsim run --serve`): the agent browser lists the selected robot's facts.
 // When the recording has no `facts` lines (an llsfsim before the agents' trace), the test writes
@@ -347,6 +348,18 @@ try {
     const lastLog = hist.log[hist.log.length - 1][1];
     check(firstLog.endsWith(lastLog),
           `the newest log line shown is "${firstLog}", the recording's "${lastLog}"`);
+  }
+  // A click on a matched fact's index in a firing filters the list to that fact.
+  const clickable = await page.$$eval('[data-agent="rules"] .firing .fi',
+                                      (r) => r.map((x) => Number(x.textContent.slice(2))));
+  const k = clickable.findIndex((i) => want.facts.has(i));
+  if (k >= 0) {
+    await page.locator('[data-agent="rules"] .firing .fi').nth(k).click();
+    await page.waitForTimeout(300);
+    const one = await listed();
+    check(JSON.stringify(one) === JSON.stringify([[clickable[k], want.facts.get(clickable[k])]]),
+          `a click on f-${clickable[k]} in a firing lists ${JSON.stringify(one)}`);
+    await page.fill('input[data-agent="filter"]', "");
   }
   const skill = await page.textContent('[data-agent="skill"]');
   check(skill && skill.length > 0, "the agent browser shows no skill");
