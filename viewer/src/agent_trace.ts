@@ -73,8 +73,13 @@ class RobotTrace {
   private readonly snapshots: {index: number; facts: Fact[]}[] = [];
   /// The fact base after the last entry (the builder of the snapshots).
   private readonly current = new Map<number, string>();
-  readonly firingT: number[] = [];
-  readonly firings: Firing[] = [];
+  /// The `rules` lines: their times, their `fired` lists as read (checked when shown), and the
+  /// number of firings before each (the firings are made objects only when shown: a game has
+  /// tens of thousands).
+  readonly rulesT: number[] = [];
+  readonly rulesFired: unknown[][] = [];
+  readonly firingsBefore: number[] = [];
+  firings = 0;
   readonly logT: number[] = [];
   readonly log: LogLine[] = [];
   /// The lines above debug level.
@@ -161,18 +166,19 @@ function sortedFacts(facts: Map<number, string>): Fact[] {
   return [...facts.entries()].sort((a, b) => a[0] - b[0]);
 }
 
-/// A well-formed fact list ([[index, text], ...]); anything else is skipped.
+/// A fact list ([[index, text], ...]) as read, when its entries are well-formed (checked on the
+/// first: the writer writes them all alike); otherwise the well-formed entries.
 function factList(v: unknown): Fact[] | undefined {
   if (!Array.isArray(v)) return undefined;
-  const out: Fact[] = [];
-  for (const f of v) {
-    if (Array.isArray(f) && typeof f[0] === "number") out.push([f[0], String(f[1] ?? "")]);
-  }
-  return out;
+  const ok = (f: unknown) => Array.isArray(f) && typeof f[0] === "number" && typeof f[1] === "string";
+  if (v.length === 0 || (ok(v[0]) && ok(v[v.length - 1]))) return v as Fact[];
+  return v.filter(ok) as Fact[];
 }
 
 function indexList(v: unknown): number[] | undefined {
-  return Array.isArray(v) ? v.filter((x): x is number => typeof x === "number") : undefined;
+  if (!Array.isArray(v)) return undefined;
+  const isIndex = (x: unknown): x is number => typeof x === "number";
+  return v.every(isIndex) ? (v as number[]) : v.filter(isIndex);
 }
 
 /// The trace of every robot of a recording.
@@ -212,12 +218,11 @@ export class AgentTrace {
         return true;
       case "rules":
         this.hasRules = true;
-        if (Array.isArray(line.fired)) {
-          for (const f of line.fired) {
-            if (!Array.isArray(f)) continue;
-            r.firingT.push(line.t);
-            r.firings.push({t: line.t, rule: String(f[0] ?? ""), facts: indexList(f[1]) ?? []});
-          }
+        if (Array.isArray(line.fired) && line.fired.length > 0) {
+          r.rulesT.push(line.t);
+          r.rulesFired.push(line.fired);
+          r.firingsBefore.push(r.firings);
+          r.firings += line.fired.length;
         }
         return true;
       default: {
@@ -243,14 +248,24 @@ export class AgentTrace {
   firingsAt(robot: string, time: number, n: number): Firing[] {
     const r = this.robots.get(robot);
     if (!r) return [];
-    const end = upperBound(r.firingT, time);
-    return r.firings.slice(Math.max(0, end - n), end);
+    const out: Firing[] = [];
+    for (let k = upperBound(r.rulesT, time) - 1; k >= 0 && out.length < n; k--) {
+      const fired = r.rulesFired[k];
+      for (let j = fired.length - 1; j >= 0 && out.length < n; j--) {
+        const f = fired[j];
+        if (!Array.isArray(f)) continue;
+        out.push({t: r.rulesT[k], rule: String(f[0] ?? ""), facts: indexList(f[1]) ?? []});
+      }
+    }
+    return out.reverse();
   }
 
   /// The number of rule firings of `robot` at or before `time`.
   firingCount(robot: string, time: number): number {
     const r = this.robots.get(robot);
-    return r ? upperBound(r.firingT, time) : 0;
+    if (!r) return 0;
+    const k = upperBound(r.rulesT, time);
+    return k === 0 ? 0 : r.firingsBefore[k - 1] + r.rulesFired[k - 1].length;
   }
 
   /// The last `n` agent lines of `robot` at or before `time`, oldest first (`debug`: with the
