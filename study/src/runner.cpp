@@ -278,6 +278,26 @@ std::optional<TraceRequest> trace_for(const std::vector<TraceRequest>& requests,
   return out;
 }
 
+/// Whether `request` shows events of `kind` (skills come from the skill engine, not the agent).
+bool wants(const TraceRequest& request, clips::TraceEvent::Kind kind) {
+  using Kind = clips::TraceEvent::Kind;
+  switch (kind) {
+    case Kind::kFire:
+      return request.rules;
+    case Kind::kAssert:
+    case Kind::kRetract:
+      return request.facts;
+    case Kind::kMsgIn:
+    case Kind::kMsgOut:
+      return request.messages;
+    case Kind::kLog:
+      return request.log;
+    case Kind::kCycleEnd:
+      break;
+  }
+  return false;
+}
+
 }  // namespace
 
 TraceRequest parse_trace_request(std::string_view arg) {
@@ -404,20 +424,11 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
       options.messages = trace && trace->messages;
       options.log = record_agent || trace->log;
       options.fact_texts = trace && trace->facts;  // the recorder prints what is left at the end
-      brain.agent().set_trace(options,
-                              [&recorder, &hooks, trace, record_agent](const clips::TraceEvent& e) {
-                                if (record_agent) recorder->agent_trace(e);
-                                if (!trace) return;
-                                using Kind = clips::TraceEvent::Kind;
-                                const bool wanted = e.kind == Kind::kFire      ? trace->rules
-                                                    : e.kind == Kind::kAssert  ? trace->facts
-                                                    : e.kind == Kind::kRetract ? trace->facts
-                                                    : e.kind == Kind::kMsgIn   ? trace->messages
-                                                    : e.kind == Kind::kMsgOut  ? trace->messages
-                                                    : e.kind == Kind::kLog     ? trace->log
-                                                                               : false;
-                                if (wanted) hooks.trace_sink(clips::trace_line(e));
-                              });
+      auto sink = [&recorder, &hooks, trace, record_agent](const clips::TraceEvent& e) {
+        if (record_agent) recorder->agent_trace(e);
+        if (trace && wants(*trace, e.kind)) hooks.trace_sink(clips::trace_line(e));
+      };
+      brain.agent().set_trace(options, std::move(sink));
     }
     const bool trace_skills = trace && trace->skills;
     brain.skills().set_listener([&skill_failures, &hooks, &recorder, &streaks, &game, &add_issue, i,
