@@ -362,7 +362,7 @@ class Replay {
         const st = this.cursor.at(this.time);
         return st ? {...st.rescue, pucks: [...st.rescue.pucks]} : null;
       },
-      selectRobot: (robot: string | null) => this.showAgent(robot === null ? null : robot),
+      selectRobot: (robot: string | null) => this.showAgent(robot),
       agent: () => {
         if (!this.agentOpen) return null;
         const v = this.agentPanel.view();
