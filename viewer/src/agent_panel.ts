@@ -198,6 +198,15 @@ export class AgentPanel {
             {class: "info", "data-agent": "nofacts"},
             trace.hasFacts ? `no facts of ${name} recorded yet` : "no agent facts recorded",
           ),
+          ...(trace.hasFacts
+            ? []
+            : [
+                el(
+                  "div",
+                  {class: "info"},
+                  "(`llsfsim run` records them unless --no-record-agents; `batch` with --record-agents)",
+                ),
+              ]),
         );
       } else {
         this.showFacts(
