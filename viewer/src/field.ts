@@ -95,12 +95,24 @@ function lit(m: number, t: number): boolean {
   return m === 1 || (m === 2 && Math.floor(t * 4) % 2 === 0);
 }
 
+/// Where the field is drawn on a canvas of cssW x cssH CSS pixels: pixels per metre `s` and the
+/// offset of the field's corner; the field point (x, y) is at (ox + x s, oy + (height - y) s).
+export function fieldScale(cssW: number, cssH: number, header: Header): {s: number; ox: number; oy: number} {
+  const fw = header.field.width;
+  const fh = header.field.height;
+  const margin = 14;
+  const s = Math.max(1, Math.min((cssW - 2 * margin) / fw, (cssH - 2 * margin) / fh));
+  return {s, ox: (cssW - fw * s) / 2, oy: (cssH - fh * s) / 2};
+}
+
+/// Draws the field at `time`; `selected` (a robot's name) gets a ring (the agent browser's robot).
 export function drawField(
   canvas: HTMLCanvasElement,
   header: Header,
   state: State,
   poses: number[][],
   time: number,
+  selected = "",
 ): DrawStats {
   const dpr = window.devicePixelRatio || 1;
   const cssW = canvas.clientWidth;
@@ -114,10 +126,7 @@ export function drawField(
   ctx.clearRect(0, 0, cssW, cssH);
   const fw = header.field.width;
   const fh = header.field.height;
-  const margin = 14;
-  const s = Math.max(1, Math.min((cssW - 2 * margin) / fw, (cssH - 2 * margin) / fh));
-  const ox = (cssW - fw * s) / 2;
-  const oy = (cssH - fh * s) / 2;
+  const {s, ox, oy} = fieldScale(cssW, cssH, header);
   const X = (x: number) => ox + x * s;
   const Y = (y: number) => oy + (fh - y) * s;
   const stats: DrawStats = {devices: 0, robots: 0, pucks: 0, obstacles: 0};
@@ -335,6 +344,16 @@ export function drawField(
       ctx.arc(X(bx), Y(by), rr, 0, 2 * Math.PI);
       ctx.moveTo(X(bx), Y(by));
       ctx.lineTo(X(bx) + Math.cos(bth) * rr, Y(by) - Math.sin(bth) * rr);
+      ctx.stroke();
+      ctx.restore();
+    }
+    if (name === selected) {
+      ctx.save();
+      ctx.globalAlpha = 0.35;
+      ctx.strokeStyle = color;
+      ctx.lineWidth = 5;
+      ctx.beginPath();
+      ctx.arc(X(x), Y(y), rr + 6, 0, 2 * Math.PI);
       ctx.stroke();
       ctx.restore();
     }

@@ -3,7 +3,9 @@
 // (a download in chunks, or a live game's WebSocket), frames are indexed by time for binary
 // search, and the derived state of the game (pucks, lamps, skills, locks, orders, points, ...) is
 // rebuilt incrementally with snapshots every few seconds, so seeking anywhere costs at most one
-// snapshot's copy plus a few seconds of lines.
+// snapshot's copy plus a few seconds of lines. The agents' trace (`facts`, `fact`, `rules` lines)
+// is kept apart, per robot, in an AgentTrace (agent_trace.ts): no game state depends on it.
+import {AgentTrace} from "./agent_trace";
 
 export interface DeviceInfo {
   name: string;
@@ -259,7 +261,9 @@ function apply(s: State, header: Header, line: Line): void {
       break;
     case "agent": {
       const robot = robotOf(s, line.robot);
-      if (!robot) break;
+      // Debug lines (CLIPS' watch output, recorded with the agents' trace) are for the agent
+      // browser's log; the panel keeps the last decision.
+      if (!robot || line.level === "debug") break;
       const text = String(line.text ?? "");
       robot.agent = text;
       robot.agentLevel = line.level ?? "";
@@ -325,12 +329,19 @@ export class Recording {
   readonly phaseStarts: {t: number; phase: string}[] = [];
   /// The hackathon score after each `rescue` event (for the timeline).
   readonly rescueSteps: {t: number; points: number}[] = [];
+  /// The agents' facts, rule firings and output lines, per robot.
+  readonly trace = new AgentTrace();
   /// Incremented whenever lines were appended (the views redraw what depends on them).
   version = 0;
   private builder: State | null = null;
   private snapshots: {index: number; state: State}[] = [];
   private lastPhase = "";
   private lineCount = 0;
+
+  /// The number of lines read, the header included.
+  get lineTotal(): number {
+    return this.lineCount;
+  }
 
   get endTime(): number {
     return this.lineT.length > 0 ? this.lineT[this.lineT.length - 1] : 0;
@@ -364,6 +375,11 @@ export class Recording {
   private append(line: Line): void {
     const header = this.header!;
     const builder = this.builder!;
+    // The agents' trace goes to the trace only (`agent` lines to both).
+    if (this.trace.take(line)) {
+      this.version++;
+      return;
+    }
     const index = this.lines.length;
     // A snapshot of the state before this line, every few seconds.
     const last = this.snapshots[this.snapshots.length - 1];

@@ -6,7 +6,8 @@
 //   #/file/PATH   replay of /api/recordings/PATH
 //   #/live        the live game (WebSocket /api/live)
 // Test hook: window.llsfViewer (see Replay.hook); #app carries data-page and data-ready.
-import {colourCss, drawField, kPuckColors, kRobotColors} from "./field";
+import {AgentPanel, fmtTime, type AgentView} from "./agent_panel";
+import {colourCss, drawField, fieldScale, kPuckColors, kRobotColors} from "./field";
 import {Cursor, Recording, type State} from "./recording";
 import {el, renderReport, table, type Child, type ReportData} from "./report_view";
 
@@ -49,6 +50,11 @@ interface ViewerHook {
   obstaclesDrawn(): number;
   /// The hackathon score at the shown time (null outside the variant).
   rescue(): {points: number; rescued: number; decoys: number; pucks: number[]} | null;
+  /// Opens the agent browser on `robot` (null closes it); the panel is drawn at once.
+  selectRobot(robot: string | null): void;
+  /// The agent browser's robot and facts at the shown time (all, and those the filters show);
+  /// null while it is closed.
+  agent(): AgentView | null;
 }
 
 declare global {
@@ -82,12 +88,6 @@ function showError(target: HTMLElement, e: unknown): void {
   const msg = e instanceof Error ? e.message : String(e);
   target.append(el("p", {class: "error"}, msg));
   app.setAttribute("data-error", msg);
-}
-
-function fmtTime(t: number): string {
-  const m = Math.floor(t / 60);
-  const s = t - m * 60;
-  return `${m}:${s.toFixed(1).padStart(4, "0")}`;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -190,6 +190,13 @@ class Replay {
   private readonly speedSel = el("select", {title: "speed", "data-control": "speed"});
   private readonly timeLabel = el("span", {class: "time", "data-time": "0"});
   private readonly followBox = el("input", {type: "checkbox", "data-control": "follow"});
+  private readonly agentBtn = el(
+    "button",
+    {title: "the agent browser: a robot's facts, rule firings, skill and log", "data-control": "agent"},
+    "agent",
+  );
+  private readonly agentPanel: AgentPanel;
+  private agentOpen = false;
 
   constructor(private readonly live: boolean) {
     for (const s of kSpeeds) {
@@ -206,6 +213,10 @@ class Replay {
     const followLabel = el("label", {class: "follow"}, this.followBox, " follow live");
     this.followBox.onchange = () => (this.follow = this.followBox.checked);
     if (!live) followLabel.style.display = "none";
+    this.agentPanel = new AgentPanel(this.rec, () => this.showAgent(null), () => this.redraw());
+    this.agentPanel.root.style.display = "none";
+    this.agentBtn.onclick = () => this.showAgent(this.agentOpen ? null : this.agentPanel.robot);
+    this.canvas.addEventListener("click", (ev) => this.clickField(ev));
     const controls = el(
       "div",
       {class: "controls"},
@@ -215,6 +226,7 @@ class Replay {
       this.speedSel,
       this.timeLabel,
       followLabel,
+      this.agentBtn,
       this.status,
     );
     this.root = el(
@@ -226,6 +238,7 @@ class Replay {
         {class: "main"},
         el("div", {class: "fieldbox"}, this.canvas),
         this.panel,
+        this.agentPanel.root,
       ),
       controls,
       el("div", {class: "timelinebox"}, this.timeline, this.tip),
@@ -247,6 +260,39 @@ class Replay {
     this.setStatus("");
     this.root.append(el("p", {class: "error"}, this.error));
     app.setAttribute("data-error", this.error);
+  }
+
+  /// Opens the agent browser on `robot` ("" = the one selected before), or closes it (null).
+  showAgent(robot: string | null): void {
+    this.agentOpen = robot !== null;
+    if (robot) this.agentPanel.select(robot);
+    this.agentPanel.root.style.display = this.agentOpen ? "" : "none";
+    this.agentBtn.classList.toggle("on", this.agentOpen);
+    this.redraw();
+  }
+
+  /// Draws everything now (after a change of the selection or a seek by the test hook).
+  private redraw(): void {
+    this.render(performance.now(), true);
+  }
+
+  /// A click on a robot of the field opens the agent browser on it.
+  private clickField(ev: MouseEvent): void {
+    const h = this.rec.header;
+    if (!h) return;
+    const {s, ox, oy} = fieldScale(this.canvas.clientWidth, this.canvas.clientHeight, h);
+    const x = (ev.offsetX - ox) / s;
+    const y = h.field.height - (ev.offsetY - oy) / s;
+    let best = -1;
+    let bestD = h.robot_radius * 1.5;
+    this.rec.posesAt(this.time).forEach((p, i) => {
+      const d = Math.hypot(p[0] - x, p[1] - y);
+      if (d < bestD) {
+        bestD = d;
+        best = i;
+      }
+    });
+    if (best >= 0 && h.robots[best]) this.showAgent(h.robots[best]);
   }
 
   setFollow(on: boolean): void {
@@ -316,6 +362,12 @@ class Replay {
         const st = this.cursor.at(this.time);
         return st ? {...st.rescue, pucks: [...st.rescue.pucks]} : null;
       },
+      selectRobot: (robot: string | null) => this.showAgent(robot),
+      agent: () => {
+        if (!this.agentOpen) return null;
+        const v = this.agentPanel.view();
+        return v ? {...v, facts: [...v.facts], shown: [...v.shown]} : null;
+      },
     };
     // eslint-disable-next-line @typescript-eslint/no-this-alias
     const replay = this;
@@ -366,7 +418,8 @@ class Replay {
     const state = this.cursor.at(this.time);
     if (!state) return;
     const poses = this.rec.posesAt(this.time);
-    this.lastStats = drawField(this.canvas, h, state, poses, this.time);
+    this.lastStats = drawField(
+      this.canvas, h, state, poses, this.time, this.agentOpen ? this.agentPanel.robot : "");
     ++this.framesDrawn;
     this.canvas.setAttribute("data-devices", String(this.lastStats.devices));
     this.canvas.setAttribute("data-robots", String(this.lastStats.robots));
@@ -379,6 +432,7 @@ class Replay {
       this.lastPanel = now;
       this.panelVersion = key;
       this.renderPanel(state);
+      if (this.agentOpen) this.agentPanel.render(this.time, state);
     }
     this.drawTimeline();
   }
@@ -406,7 +460,7 @@ class Replay {
       return el(
         "div",
         {class: "robot", "data-robot": name},
-        el("div", {class: "rname", style: `color:${color}`}, name, r?.role ? ` · ${r.role}` : ""),
+        this.robotName(name, color, r?.role ?? ""),
         el("div", {class: "skill"}, r?.skill ? `${r.skill} ${r.status}` : "–"),
         r?.skillInfo ? el("div", {class: "info"}, r.skillInfo) : "",
         el(
@@ -526,6 +580,18 @@ class Replay {
       ...robotRows,
       legend,
     );
+  }
+
+  /// A robot's name in the panel: a click opens the agent browser on it.
+  private robotName(name: string, color: string, role: string): HTMLElement {
+    const e = el(
+      "div",
+      {class: "rname", style: `color:${color}`, title: `${name}'s agent: facts, rule firings, log`},
+      name,
+      role ? ` · ${role}` : "",
+    );
+    e.onclick = () => this.showAgent(name);
+    return e;
   }
 
   // --- timeline ---
@@ -690,7 +756,7 @@ async function loadInto(replay: Replay, url: string, signal: AbortSignal): Promi
   if (!started) replay.start();
   const h = replay.rec.header;
   replay.setStatus(
-    `${replay.rec.lines.length + 1} lines · ${h.robots.length} robots · seed ${h.seed}`,
+    `${replay.rec.lineTotal} lines · ${h.robots.length} robots · seed ${h.seed}`,
   );
   replay.ready = true;
   app.setAttribute("data-ready", "true");
@@ -767,7 +833,7 @@ function livePage(signal: AbortSignal): () => void {
         replay.ready = true;
         app.setAttribute("data-ready", "true");
       }
-      replay.setStatus(`live${over ? " · game over" : ""} · ${replay.rec.lines.length + 1} lines`);
+      replay.setStatus(`live${over ? " · game over" : ""} · ${replay.rec.lineTotal} lines`);
     };
     // The server keeps the socket open after the game; its status says when the game is over.
     let over = false;
@@ -777,7 +843,7 @@ function livePage(signal: AbortSignal): () => void {
         const st = await fetchJson<{live: boolean; running?: boolean}>("/api/live/status", signal);
         if (st.running === false) {
           over = true;
-          replay.setStatus(`live · game over · ${replay.rec.lines.length + 1} lines`);
+          replay.setStatus(`live · game over · ${replay.rec.lineTotal} lines`);
           return;
         }
       } catch {
@@ -788,7 +854,7 @@ function livePage(signal: AbortSignal): () => void {
     };
     retry = window.setTimeout(poll, 2000);
     ws.onclose = () => {
-      if (!closed) replay.setStatus(`live game ended · ${replay.rec.lines.length + 1} lines`);
+      if (!closed) replay.setStatus(`live game ended · ${replay.rec.lineTotal} lines`);
     };
     ws.onerror = () => {
       if (!closed) replay.setStatus("live connection failed");

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// What the browser tests (report_e2e.mjs, viewer_e2e.mjs) and bench/viewer_replay.mjs share:
+// What the browser tests (report_e2e.mjs, viewer_e2e.mjs, agent_e2e.mjs) and bench/viewer_replay.mjs share:
 // the paths, the prerequisites with the command that provides each, and Chromium's launch.
 import {existsSync} from "node:fs";
 import {dirname, join, resolve} from "node:path";
