@@ -198,14 +198,14 @@ export class AgentTrace {
     return r;
   }
 
-  /// Takes a line if it belongs to the trace (`facts`, `fact`, `rules`; `agent` is read too but
-  /// left to the caller as well). Returns true when the line is the trace's only (no game state
+  /// Takes a line if it belongs to the trace (`facts`, `fact`, `rules`; `agent` and `note` are
+  /// read too but left to the caller as well). Returns true when the line is the trace's only (no game state
   /// depends on it).
   // eslint-disable-next-line @typescript-eslint/no-explicit-any
   take(line: {t: number; e?: string; [key: string]: any}): boolean {
     const e = line.e;
-    if (e !== "facts" && e !== "fact" && e !== "rules" && e !== "agent") return false;
-    if (typeof line.robot !== "string") return e !== "agent";
+    if (e !== "facts" && e !== "fact" && e !== "rules" && e !== "agent" && e !== "note") return false;
+    if (typeof line.robot !== "string") return e !== "agent" && e !== "note";
     const r = this.robot(line.robot);
     switch (e) {
       case "facts":
@@ -226,7 +226,9 @@ export class AgentTrace {
         }
         return true;
       default: {
-        const l = {t: line.t, level: String(line.level ?? ""), text: String(line.text ?? "")};
+        // `agent` lines, and `note` lines about the robot (e.g. its agent reloaded in a paced run).
+        const level = e === "note" ? "note" : String(line.level ?? "");
+        const l = {t: line.t, level, text: String(line.text ?? "")};
         r.logT.push(line.t);
         r.log.push(l);
         if (l.level !== "debug") {
