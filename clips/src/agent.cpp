@@ -11,8 +11,8 @@
 
 #include "feature.h"
 #include "llsf/core/config.h"
-#include "tracer.h"
 #include "sandbox.h"
+#include "tracer.h"
 
 namespace llsf::clips {
 
