@@ -55,7 +55,18 @@ std::string trace_line(const TraceEvent& e) {
     case Kind::kCycleEnd:
       break;
   }
+  strip_addresses(out);
   return out;
+}
+
+void strip_addresses(std::string& text) {
+  static constexpr std::string_view kPointer = "<Pointer-C-";
+  for (std::size_t p = text.find(kPointer); p != std::string::npos;
+       p = text.find(kPointer, p + 1)) {
+    const std::size_t end = text.find('>', p);
+    if (end == std::string::npos) return;
+    text.replace(p, end - p + 1, "<Pointer-C>");
+  }
 }
 
 namespace detail {

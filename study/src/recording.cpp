@@ -90,18 +90,6 @@ void append_json_string(std::string& out, std::string_view s) {
   out += '"';
 }
 
-/// Drops the address from CLIPS' "<Pointer-C-0x55d0c2a1e2b0>" (an external address, e.g. a
-/// protobuf message kept in a fact): addresses differ from run to run, recordings must not.
-void strip_addresses(std::string& text) {
-  static constexpr std::string_view kPointer = "<Pointer-C-";
-  for (std::size_t p = text.find(kPointer); p != std::string::npos;
-       p = text.find(kPointer, p + 1)) {
-    const std::size_t end = text.find('>', p);
-    if (end == std::string::npos) return;
-    text.replace(p, end - p + 1, "<Pointer-C>");
-  }
-}
-
 /// One robot's agent trace being collected for the current cycle (Recorder::agent_trace).
 struct AgentFacts {
   const clips::AgentHost* host = nullptr;  // a new host (a reloaded agent): a snapshot is due
@@ -321,7 +309,7 @@ void Recorder::agent_trace(const clips::TraceEvent& e) {
   if (a.fired.empty() && a.first_added < 0 && a.removed.empty() && !snapshot) return;
   a.added.clear();
   if (a.first_added >= 0 && e.host != nullptr) e.host->fact_texts(a.added, a.first_added);
-  for (auto& f : a.added) strip_addresses(f.second);
+  for (auto& f : a.added) clips::strip_addresses(f.second);
   a.first_added = -1;
   std::string head = "{\"t\":";
   head += Json(fixed(e.time.seconds(), 2)).dump();
@@ -363,7 +351,7 @@ void Recorder::agent_trace(const clips::TraceEvent& e) {
     a.snapshot_written = true;
     while (a.next_snapshot <= e.time) a.next_snapshot += kFactSnapshotPeriod;
     e.host->fact_texts(a.all);
-    for (auto& f : a.all) strip_addresses(f.second);
+    for (auto& f : a.all) clips::strip_addresses(f.second);
     m.line = head + ",\"e\":\"facts\",\"robot\":" + robot + ",\"facts\":[";
     for (std::size_t i = 0; i < a.all.size(); ++i) {
       m.line += i > 0 ? ",[" : "[";
@@ -393,7 +381,13 @@ void Recorder::agent(const clips::LogRecord& r) {
   Json j = Impl::event(r.time, "agent");
   j["robot"] = r.agent;
   j["level"] = clips::to_string(r.level);
-  j["text"] = r.text;
+  if (r.text.find("<Pointer-C-") == std::string_view::npos) {
+    j["text"] = r.text;
+  } else {  // e.g. (watch facts) output or a printout of a fact with a message in it
+    std::string text(r.text);
+    clips::strip_addresses(text);
+    j["text"] = text;
+  }
   impl_->write(j);
 }
 

@@ -47,6 +47,13 @@ TEST_CASE("run --trace prints firings with matched facts, fact changes, skills a
   CHECK_FALSE(has(r.err, "] robot2 "));
   // The summary stays on stdout.
   CHECK(has(r.out, "scenario   trace"));
+  // Received messages are facts with an external address: written without it, so that the
+  // same game gives the same trace.
+  CHECK(has(r.err, "(ptr <Pointer-C>)"));
+  CHECK_FALSE(has(r.err, "<Pointer-C-"));
+  const auto again =
+      llsfsim({"run", dir.file("s.yaml"), "--no-db", "--no-record", "--trace", "robot1"});
+  CHECK(again.err == r.err);
 }
 
 TEST_CASE("run --trace with kinds, all robots, into a file") {

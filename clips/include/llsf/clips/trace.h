@@ -62,7 +62,13 @@ std::string trace_prefix(core::SimTime time, std::string_view robot);
 /// The event as one trace line (docs/clips.md, "Tracing"), e.g.
 /// "[  12.30] robot1 FIRE production-start  f-3 (machine (name M1)), f-17 (time 12 300000)",
 /// "[  12.30] robot1 ==> f-18 (state IDLE)", "[  12.30] robot1 msg <- robot2 LockMessage {...}";
-/// "" for kCycleEnd. A kFire line shows the matched facts' text (looked up in `host`).
+/// "" for kCycleEnd. A kFire line shows the matched facts' text (looked up in `host`). Addresses
+/// are stripped (strip_addresses): the same game gives the same trace.
 std::string trace_line(const TraceEvent& event);
+
+/// Replaces CLIPS' "<Pointer-C-0x55d0c2a1e2b0>" (an external address, e.g. a protobuf message
+/// kept in a fact) by "<Pointer-C>": addresses differ from run to run, traces and recordings
+/// must not.
+void strip_addresses(std::string& text);
 
 }  // namespace llsf::clips
