@@ -202,14 +202,19 @@ struct AgentHost::Impl {
     if (rule.empty()) {
       emit(LogLevel::kError, "runtime error: " + msg);
     } else {
-      const auto place = rule_places.find(rule);
-      emit(LogLevel::kError, "runtime error in rule " + rule +
-                                 (place != rule_places.end() ? " (" + place->second + ")" : "") +
-                                 ": " + msg);
+      emit(LogLevel::kError,
+           "runtime error in rule " + rule + place_of(rule_places, rule) + ": " + msg);
     }
     werror.clear();
     ++runtime_errors;
     return 1;
+  }
+
+  // " (file:line)" of a rule or function, or "" if its place is unknown.
+  static std::string place_of(const std::unordered_map<std::string, std::string>& places,
+                              const std::string& name) {
+    const auto it = places.find(name);
+    return it != places.end() ? " (" + it->second + ")" : std::string();
   }
 
   // Where each defrule and deffunction (defgeneric, defmethod) of `text` starts ("file:line"),
@@ -255,9 +260,8 @@ struct AgentHost::Impl {
     switch (env.budget_hit()) {
       case Hit::kDepth: {
         const std::string& fn = env.budget_function();
-        const auto place = function_places.find(fn);
         return "stopped at a call depth of " + std::to_string(state.config.max_call_depth) +
-               " in " + fn + (place != function_places.end() ? " (" + place->second + ")" : "") +
+               " in " + fn + place_of(function_places, fn) +
                " (a recursion without end?); the game goes on";
       }
       case Hit::kWall:
@@ -330,11 +334,10 @@ struct AgentHost::Impl {
       result.limit_reached = true;
       ++limit_hits;
       const std::string rule = env.next_rule();
-      const auto place = rule_places.find(rule);
       emit(LogLevel::kWarn,
            "rule firing limit of " + std::to_string(state.config.max_rules_per_cycle) +
                " reached with rules still on the agenda (endless rule loop?); next: rule " + rule +
-               (place != rule_places.end() ? " (" + place->second + ")" : ""));
+               place_of(rule_places, rule));
     }
     result.steps = env.budget_steps();
     max_steps_seen = std::max(max_steps_seen, result.steps);

@@ -90,6 +90,20 @@ void append_json_string(std::string& out, std::string_view s) {
   out += '"';
 }
 
+/// Appends facts as a JSON list of [index,"text"] pairs.
+void append_fact_list(std::string& out,
+                      const std::vector<std::pair<std::int64_t, std::string>>& facts) {
+  out += '[';
+  for (std::size_t i = 0; i < facts.size(); ++i) {
+    out += i > 0 ? ",[" : "[";
+    out += std::to_string(facts[i].first);
+    out += ',';
+    append_json_string(out, facts[i].second);
+    out += ']';
+  }
+  out += ']';
+}
+
 /// One robot's agent trace being collected for the current cycle (Recorder::agent_trace).
 struct AgentFacts {
   const clips::AgentHost* host = nullptr;  // a new host (a reloaded agent): a snapshot is due
@@ -130,7 +144,7 @@ struct Recorder::Impl {
   sim::HackathonScore score;                   // hackathon: as last written
   bool score_known = false;
   LineSink sink;
-  std::map<std::string, AgentFacts, std::less<>> agent_facts;  // per robot (agent_trace)
+  std::vector<AgentFacts> agent_facts;  // per robot index (agent_trace)
 
   void write(const Json& j) {
     if (file == nullptr && !sink) return;
@@ -261,7 +275,7 @@ void Recorder::skill(const sim::SkillStatusChange& c) {
   impl_->write(j);
 }
 
-void Recorder::agent_trace(const clips::TraceEvent& e) {
+void Recorder::agent_trace(int robot, const clips::TraceEvent& e) {
   using Kind = clips::TraceEvent::Kind;
   Impl& m = *impl_;
   if (m.file == nullptr && !m.sink) return;
@@ -272,10 +286,10 @@ void Recorder::agent_trace(const clips::TraceEvent& e) {
       agent(clips::LogRecord{e.time, e.level, e.agent, e.text});
     return;
   }
-  auto it = m.agent_facts.find(e.agent);
-  if (it == m.agent_facts.end())
-    it = m.agent_facts.emplace(std::string(e.agent), AgentFacts{}).first;
-  AgentFacts& a = it->second;
+  if (robot < 0) throw std::out_of_range("Recorder::agent_trace: robot index < 0");
+  const auto r = static_cast<std::size_t>(robot);
+  if (r >= m.agent_facts.size()) m.agent_facts.resize(r + 1);
+  AgentFacts& a = m.agent_facts[r];
   switch (e.kind) {
     case Kind::kAssert:
       // Indices grow: the facts of the cycle still there at its end are those from the first.
@@ -313,25 +327,18 @@ void Recorder::agent_trace(const clips::TraceEvent& e) {
   a.first_added = -1;
   std::string head = "{\"t\":";
   head += Json(fixed(e.time.seconds(), 2)).dump();
-  std::string robot;
-  append_json_string(robot, e.agent);
+  std::string robot_json;
+  append_json_string(robot_json, e.agent);
   if (!a.fired.empty()) {
-    m.line = head + ",\"e\":\"rules\",\"robot\":" + robot + ",\"fired\":[" + a.fired + "]}";
+    m.line = head + ",\"e\":\"rules\",\"robot\":" + robot_json + ",\"fired\":[" + a.fired + "]}";
     m.write_line();
     a.fired.clear();
   }
   if (!a.added.empty() || !a.removed.empty()) {
-    m.line = head + ",\"e\":\"fact\",\"robot\":" + robot;
+    m.line = head + ",\"e\":\"fact\",\"robot\":" + robot_json;
     if (!a.added.empty()) {
-      m.line += ",\"a\":[";
-      for (std::size_t i = 0; i < a.added.size(); ++i) {
-        m.line += i > 0 ? ",[" : "[";
-        m.line += std::to_string(a.added[i].first);
-        m.line += ',';
-        append_json_string(m.line, a.added[i].second);
-        m.line += ']';
-      }
-      m.line += ']';
+      m.line += ",\"a\":";
+      append_fact_list(m.line, a.added);
     }
     if (!a.removed.empty()) {
       m.line += ",\"r\":[";
@@ -352,15 +359,9 @@ void Recorder::agent_trace(const clips::TraceEvent& e) {
     while (a.next_snapshot <= e.time) a.next_snapshot += kFactSnapshotPeriod;
     e.host->fact_texts(a.all);
     for (auto& f : a.all) clips::strip_addresses(f.second);
-    m.line = head + ",\"e\":\"facts\",\"robot\":" + robot + ",\"facts\":[";
-    for (std::size_t i = 0; i < a.all.size(); ++i) {
-      m.line += i > 0 ? ",[" : "[";
-      m.line += std::to_string(a.all[i].first);
-      m.line += ',';
-      append_json_string(m.line, a.all[i].second);
-      m.line += ']';
-    }
-    m.line += "]}";
+    m.line = head + ",\"e\":\"facts\",\"robot\":" + robot_json + ",\"facts\":";
+    append_fact_list(m.line, a.all);
+    m.line += '}';
     m.write_line();
   }
 }

@@ -425,8 +425,8 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
       options.messages = trace && trace->messages;
       options.log = record_agent || trace->log;
       options.fact_texts = trace && trace->facts;  // the recorder prints what is left at the end
-      auto sink = [&recorder, &hooks, trace, record_agent](const clips::TraceEvent& e) {
-        if (record_agent) recorder->agent_trace(e);
+      auto sink = [&recorder, &hooks, trace, record_agent, i](const clips::TraceEvent& e) {
+        if (record_agent) recorder->agent_trace(i, e);
         if (trace && wants(*trace, e.kind)) hooks.trace_sink(clips::trace_line(e));
       };
       brain.set_trace(options, std::move(sink));

@@ -91,7 +91,7 @@ TEST_CASE("an agent's facts replay from the recording's snapshots and deltas") {
   c.locks = s.robots.at(0).locks;
   sim::AgentBrain& brain = driver.plug_agent(0, c);
   brain.agent().set_trace({.rules = true, .facts = true, .log = true},
-                          [&recorder](const clips::TraceEvent& e) { recorder.agent_trace(e); });
+                          [&recorder](const clips::TraceEvent& e) { recorder.agent_trace(0, e); });
   driver.start(refbox::GamePhase::kPreGame);
   // 70 s: snapshots at the first cycle, 30 s later and 60 s later.
   std::map<double, std::pair<double, Facts>> seen;  // probe -> (tick time, facts)

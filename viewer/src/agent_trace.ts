@@ -5,6 +5,7 @@
 // snapshots, one is kept every kSnapshotEvery deltas, so a seek costs one snapshot's copy plus at
 // most that many deltas, whatever the recording's snapshot period; moving forward a little (playback)
 // applies only the deltas in between. Recordings without these lines have an empty trace.
+import {countAtOrBefore, upperBound} from "./search";
 
 /// A fact: its index in the agent's fact base and its text, `(state IDLE)`.
 export type Fact = [number, string];
@@ -52,17 +53,6 @@ const noFacts = (): FactsAt => ({
 
 const kSnapshotEvery = 200;  // fact entries between the trace's own snapshots
 
-/// The number of entries of the sorted array `ts` with t <= time.
-function upperBound(ts: number[], time: number): number {
-  let lo = 0;
-  let hi = ts.length;
-  while (lo < hi) {
-    const mid = (lo + hi) >>> 1;
-    if (ts[mid] <= time) lo = mid + 1;
-    else hi = mid;
-  }
-  return lo;
-}
 
 /// A robot's trace: fact entries in file order, snapshots of the fact base, rule firings, log.
 class RobotTrace {
@@ -146,13 +136,7 @@ class RobotTrace {
   }
 
   private snapshotAtOrBefore(index: number): {index: number; facts: Fact[]} {
-    let lo = 0;
-    let hi = this.snapshots.length;
-    while (lo < hi) {
-      const mid = (lo + hi) >>> 1;
-      if (this.snapshots[mid].index <= index) lo = mid + 1;
-      else hi = mid;
-    }
+    const lo = countAtOrBefore(this.snapshots, (s) => s.index, index);
     return lo > 0 ? this.snapshots[lo - 1] : {index: 0, facts: []};
   }
 }

@@ -6,6 +6,7 @@
 // snapshot's copy plus a few seconds of lines. The agents' trace (`facts`, `fact`, `rules` lines)
 // is kept apart, per robot, in an AgentTrace (agent_trace.ts): no game state depends on it.
 import {AgentTrace} from "./agent_trace";
+import {countAtOrBefore, upperBound} from "./search";
 
 export interface DeviceInfo {
   name: string;
@@ -435,14 +436,7 @@ export class Recording {
 
   /// The number of lines with t <= time.
   upperBound(time: number): number {
-    let lo = 0;
-    let hi = this.lineT.length;
-    while (lo < hi) {
-      const mid = (lo + hi) >>> 1;
-      if (this.lineT[mid] <= time) lo = mid + 1;
-      else hi = mid;
-    }
-    return lo;
+    return upperBound(this.lineT, time);
   }
 
   /// The index of the last frame with t <= time (-1 when none).
@@ -488,13 +482,7 @@ export class Recording {
   }
 
   /** @internal */ snapshotBefore(index: number): {index: number; state: State} {
-    let lo = 0;
-    let hi = this.snapshots.length;
-    while (lo < hi) {
-      const mid = (lo + hi) >>> 1;
-      if (this.snapshots[mid].index <= index) lo = mid + 1;
-      else hi = mid;
-    }
+    const lo = countAtOrBefore(this.snapshots, (s) => s.index, index);
     return this.snapshots[Math.max(0, lo - 1)];
   }
 

@@ -20,13 +20,13 @@
 // When the recording has no `facts` lines (an llsfsim before the agents' trace), the test writes
 // them itself in that format (synthetic: facts derived from the game's skill and agent lines) and
 // skips step 5; it says which in its last line. Screenshots go to ARTIFACT_DIR (agent-*.png).
-import {execFileSync, spawn} from "node:child_process";
+import {execFileSync} from "node:child_process";
 import {mkdirSync, mkdtempSync, readFileSync, rmSync, writeFileSync} from "node:fs";
 import {tmpdir} from "node:os";
 import {join} from "node:path";
 import {gunzipSync, gzipSync} from "node:zlib";
 
-import {check, launch, prerequisites, sourceDir, viewerDir} from "./e2e_lib.mjs";
+import {check, launch, prerequisites, sourceDir, startLlsfsimServer, viewerDir} from "./e2e_lib.mjs";
 
 const kName = "agent_e2e";
 const {llsfsim, artifacts, chromium} =
@@ -48,39 +48,8 @@ const liveScenario = scenario
 const env = {...process.env, LLSF_VIEWER_DIR: join(viewerDir, "dist")};
 const children = [];
 
-/// Starts `llsfsim ARGS` and resolves with the URL of its first stdout line.
-function startServer(args, cwd) {
-  return new Promise((resolvePromise, reject) => {
-    const child = spawn(llsfsim, args, {cwd, env, stdio: ["ignore", "pipe", "pipe"]});
-    children.push(child);
-    let out = "";
-    let err = "";
-    let done = false;
-    const timer = setTimeout(() => {
-      if (done) return;
-      done = true;
-      reject(new Error(`llsfsim ${args.join(" ")}: no URL on stdout within 30 s\n${out}${err}`));
-    }, 30_000);
-    child.stdout.setEncoding("utf8");
-    child.stderr.setEncoding("utf8");
-    child.stdout.on("data", (d) => {
-      out += d;
-      const m = /llsfsim serve: (http:\/\/\S+)/.exec(out);
-      if (m && !done) {
-        done = true;
-        clearTimeout(timer);
-        resolvePromise({child, url: m[1].endsWith("/") ? m[1] : `${m[1]}/`});
-      }
-    });
-    child.stderr.on("data", (d) => (err += d));
-    child.on("exit", (code) => {
-      if (done) return;
-      done = true;
-      clearTimeout(timer);
-      reject(new Error(`llsfsim ${args.join(" ")} exited (${code}) before serving\n${out}${err}`));
-    });
-  });
-}
+/// Starts `llsfsim ARGS` in `cwd` and resolves with its URL (e2e_lib.mjs, startLlsfsimServer).
+const startServer = (args, cwd) => startLlsfsimServer(llsfsim, args, {cwd, env, children});
 
 // ---------------------------------------------------------------------------------------------
 // The recording, read here independently of the viewer's code.

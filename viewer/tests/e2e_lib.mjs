@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 // What the browser tests (report_e2e.mjs, viewer_e2e.mjs, agent_e2e.mjs) and bench/viewer_replay.mjs share:
-// the paths, the prerequisites with the command that provides each, and Chromium's launch.
+// the paths, the prerequisites with the command that provides each, Chromium's launch and starting an
+// `llsfsim serve` (or `run --serve`) child.
+import {spawn} from "node:child_process";
 import {existsSync} from "node:fs";
 import {dirname, join, resolve} from "node:path";
 import {fileURLToPath} from "node:url";
@@ -65,5 +67,41 @@ export function launch(chromium) {
     headless: true,
     args: chromiumArgs,
     timeout: 60_000,
+  });
+}
+
+/// Starts `llsfsim ARGS` in `cwd` with `env` and resolves with {child, url} once its stdout names
+/// the URL ("llsfsim serve: http://127.0.0.1:PORT/"); rejects if it exits first or prints none
+/// within 30 s. The child is added to `children` (the caller ends them).
+export function startLlsfsimServer(llsfsim, args, {cwd, env, children}) {
+  return new Promise((resolvePromise, reject) => {
+    const child = spawn(llsfsim, args, {cwd, env, stdio: ["ignore", "pipe", "pipe"]});
+    children.push(child);
+    let out = "";
+    let err = "";
+    let done = false;
+    const timer = setTimeout(() => {
+      if (done) return;
+      done = true;
+      reject(new Error(`llsfsim ${args.join(" ")}: no URL on stdout within 30 s\n${out}${err}`));
+    }, 30_000);
+    child.stdout.setEncoding("utf8");
+    child.stderr.setEncoding("utf8");
+    child.stdout.on("data", (d) => {
+      out += d;
+      const m = /llsfsim serve: (http:\/\/\S+)/.exec(out);
+      if (m && !done) {
+        done = true;
+        clearTimeout(timer);
+        resolvePromise({child, url: m[1].endsWith("/") ? m[1] : `${m[1]}/`});
+      }
+    });
+    child.stderr.on("data", (d) => (err += d));
+    child.on("exit", (code) => {
+      if (done) return;
+      done = true;
+      clearTimeout(timer);
+      reject(new Error(`llsfsim ${args.join(" ")} exited (${code}) before serving\n${out}${err}`));
+    });
   });
 }

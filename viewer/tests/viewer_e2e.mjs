@@ -13,12 +13,12 @@
 //      the shown game time advances.
 // Screenshots go to ARTIFACT_DIR (default: the current directory). Exit code 0, or 1 with a
 // message. LLSF_CHROMIUM names another Chromium binary.
-import {execFileSync, spawn} from "node:child_process";
+import {execFileSync} from "node:child_process";
 import {mkdirSync, mkdtempSync, rmSync, writeFileSync} from "node:fs";
 import {tmpdir} from "node:os";
 import {join} from "node:path";
 
-import {check, launch, prerequisites, sourceDir, viewerDir} from "./e2e_lib.mjs";
+import {check, launch, prerequisites, sourceDir, startLlsfsimServer, viewerDir} from "./e2e_lib.mjs";
 
 const kName = "viewer_e2e";
 const {llsfsim, artifacts, chromium} = await prerequisites(kName, "viewer_e2e.mjs", ["index.html", "viewer.js"]);
@@ -51,40 +51,8 @@ const kRuns = 2;
 const env = {...process.env, LLSF_VIEWER_DIR: join(viewerDir, "dist")};
 const children = [];
 
-/// Starts `llsfsim ARGS` and resolves with the URL of its first stdout line
-/// ("llsfsim serve: http://127.0.0.1:PORT/").
-function startServer(args, cwd) {
-  return new Promise((resolvePromise, reject) => {
-    const child = spawn(llsfsim, args, {cwd, env, stdio: ["ignore", "pipe", "pipe"]});
-    children.push(child);
-    let out = "";
-    let err = "";
-    let done = false;
-    const timer = setTimeout(() => {
-      if (done) return;
-      done = true;
-      reject(new Error(`llsfsim ${args.join(" ")}: no URL on stdout within 30 s\n${out}${err}`));
-    }, 30_000);
-    child.stdout.setEncoding("utf8");
-    child.stderr.setEncoding("utf8");
-    child.stdout.on("data", (d) => {
-      out += d;
-      const m = /llsfsim serve: (http:\/\/\S+)/.exec(out);
-      if (m && !done) {
-        done = true;
-        clearTimeout(timer);
-        resolvePromise({child, url: m[1].endsWith("/") ? m[1] : `${m[1]}/`});
-      }
-    });
-    child.stderr.on("data", (d) => (err += d));
-    child.on("exit", (code) => {
-      if (done) return;
-      done = true;
-      clearTimeout(timer);
-      reject(new Error(`llsfsim ${args.join(" ")} exited (${code}) before serving\n${out}${err}`));
-    });
-  });
-}
+/// Starts `llsfsim ARGS` in `cwd` and resolves with its URL (e2e_lib.mjs, startLlsfsimServer).
+const startServer = (args, cwd) => startLlsfsimServer(llsfsim, args, {cwd, env, children});
 
 async function getJson(url) {
   const res = await fetch(url);

@@ -60,8 +60,8 @@ class Recorder {
   /// agent's facts and rule firings become `facts` snapshots (at its first cycle and every
   /// kFactSnapshotPeriod), `fact` deltas and `rules` lines, one of each per cycle at most
   /// (docs/recording.md); kLog events at debug level (e.g. (watch facts) output) become `agent`
-  /// lines. Other events are ignored.
-  void agent_trace(const clips::TraceEvent& event);
+  /// lines. Other events are ignored. `robot` is the robot's index in the game (0-based).
+  void agent_trace(int robot, const clips::TraceEvent& event);
   /// Simulated time between two `facts` snapshots of one robot.
   static constexpr core::SimTime kFactSnapshotPeriod = core::SimTime::from_sec(30);
   /// A free-form event from an agent or tool ({"t":..,"e":"note","robot":..,"text":..}).
