@@ -1,0 +1,4 @@
+(defrule read-secret
+  (time $?)
+  =>
+  (open "/etc/passwd" secret "r"))
