@@ -55,14 +55,27 @@ void require(std::string_view path, double v, const Bound& bound);
 /// as messages print numbers.
 std::string number_text(double v);
 
+/// The limits of strict YAML (docs/security.md, "Strict input files"): nodes of a document once
+/// its aliases are expanded, and maps and lists inside each other.
+inline constexpr std::uint64_t kMaxYamlNodes = 1'000'000;
+inline constexpr int kMaxYamlDepth = 64;
+
+/// Throws ConfigError "<source>:<line>:<column>: <path>: <what>" unless `text` is strict YAML:
+/// UTF-8 text without NUL bytes, at most 16 MiB, no key twice in a map, at most kMaxYamlNodes
+/// nodes with aliases expanded, no alias inside its own anchor, at most kMaxYamlDepth levels.
+/// ConfigNode::parse() and load_file() check this first.
+void check_strict_yaml(std::string_view text, const std::string& source_name);
+
 /// A node of a parsed YAML document with its source name, line/column and dotted path.
 /// Cheap to copy (shares the document). Every failing accessor throws ConfigError with
 /// "<source>:<line>:<column>: <path>: <what>".
 class ConfigNode {
  public:
-  /// Parses a file; throws ConfigError naming the file (and line) if it cannot be read or parsed.
+  /// Parses a file; throws ConfigError naming the file (and line) if it cannot be read (see
+  /// read_input_file(): a regular file of at most 16 MiB) or parsed (see check_strict_yaml()).
   static ConfigNode load_file(const std::string& path);
-  /// Parses text; `source_name` appears in error messages in place of a file name.
+  /// Parses strict YAML (check_strict_yaml()); `source_name` appears in error messages in place of
+  /// a file name.
   static ConfigNode parse(std::string_view text, const std::string& source_name);
 
   ConfigNode();
