@@ -129,3 +129,55 @@ TEST_CASE("load_file reads only regular files") {
                        "one",
                        ConfigError);
 }
+
+TEST_CASE("locate_errors with renames puts a struct's path on the document's key and line") {
+  const ConfigNode root = ConfigNode::parse(
+      "name: x\n"
+      "rates:\n"
+      "  physics_hz: 5\n"
+      "  skill_hz: 15\n"
+      "levels:\n"
+      "  position_noise_m: -1\n"
+      "robots:\n"
+      "  each:\n"
+      "    - {name: a}\n"
+      "    - {name: a}\n"
+      "world:\n"
+      "  robots:\n"
+      "    - {name: w, jersey: 100}\n",
+      "d.yaml");
+  static constexpr llsf::core::PathRename kRenames[] = {
+      {"game.skill", "nothing"},  // a prefix only up to a '.' or '['
+      {"game.skill_rate_hz", "rates.skill_hz"},
+      {"game.levels.localization.position_noise_m", "levels.position_noise_m"},
+      {"robots[", "robots.each["},
+      {"robots[", "world.robots["},
+      {"game", ""},
+  };
+  const auto error_of = [&](const std::string& message) {
+    try {
+      root.locate_errors([&] { throw ConfigError(message); }, kRenames);
+    } catch (const ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  CHECK(error_of("game.skill_rate_hz: must not exceed the physics rate 5 Hz (got 15)") ==
+        "d.yaml:4:13: rates.skill_hz: must not exceed the physics rate 5 Hz (got 15)");
+  CHECK(error_of("game.levels.localization.position_noise_m: must be >= 0 (got -1)") ==
+        "d.yaml:6:21: levels.position_noise_m: must be >= 0 (got -1)");
+  // Of two renames, the one the document has: robots.each[1].name, world.robots[0].jersey.
+  CHECK(error_of("robots[1].name: duplicate robot name 'a'") ==
+        "d.yaml:10:14: robots.each[1].name: duplicate robot name 'a'");
+  CHECK(error_of("robots[0].jersey: must be in 1..99") ==
+        "d.yaml:13:25: world.robots[0].jersey: must be in 1..99");
+  // "game" -> the root: a key the document lacks is named at the top.
+  CHECK(error_of("game.handling.align_s: must be at most 60 s") ==
+        "d.yaml:1:1: handling.align_s: must be at most 60 s");
+  // Without renames, as before: the path stays.
+  try {
+    root.locate_errors([] { throw ConfigError("game.skill_rate_hz: too high"); });
+  } catch (const ConfigError& e) {
+    CHECK(std::string(e.what()) == "d.yaml:1:1: game.skill_rate_hz: too high");
+  }
+}
