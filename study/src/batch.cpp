@@ -56,6 +56,11 @@ std::vector<std::uint64_t> batch_seeds(const Scenario& s, std::optional<int> run
   if (!runs) return s.seeds;
   const int n = *runs;
   if (n < 1) throw core::ConfigError("--runs must be at least 1");
+  if (n > ScenarioLimits::kMaxSeeds) {
+    throw core::ConfigError("--runs " + std::to_string(n) + ": at most " +
+                            std::to_string(ScenarioLimits::kMaxSeeds) +
+                            " seeds per variant (docs/security.md, \"Scenario budgets\")");
+  }
   if (s.seeds.size() == 1) {
     std::vector<std::uint64_t> out;
     for (int i = 0; i < n; ++i) out.push_back(s.seeds.front() + static_cast<std::uint64_t>(i));

@@ -1,11 +1,15 @@
 // SPDX-License-Identifier: MIT
 #include "llsf/study/scenario.h"
 
+#include <array>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
+#include <string_view>
 #include <utility>
 
 #include "llsf/comm/hub_config.h"
@@ -68,26 +72,29 @@ void read_levels(const core::ConfigNode& n, sim::RobotLevelsConfig& l) {
   n.read_enum("skill", l.skill,
               {{"physical", sim::SkillLevel::kPhysical}, {"symbolic", sim::SkillLevel::kSymbolic}},
               "skill level");
-  n.read("position_noise_m", l.localization.position_noise_m);
-  n.read("heading_noise_rad", l.localization.heading_noise_rad);
-  n.read("light_error_rate", l.light.error_rate);
+  // Bounds: docs/security.md, "Scenario budgets".
+  n.read("position_noise_m", l.localization.position_noise_m, core::in_range(0.0, 1.0));
+  n.read("heading_noise_rad", l.localization.heading_noise_rad, core::in_range(0.0, core::kPi));
+  n.read("light_error_rate", l.light.error_rate, core::probability());
   if (const core::ConfigNode delay = n["light_delay_s"]; delay.defined()) {
-    l.light.delay = core::SimTime::from_seconds(delay.as_double());
+    l.light.delay = core::SimTime::from_seconds(delay.as_double(core::in_range(0.0, 60.0)));
   }
-  n.read("cruise_speed_mps", l.symbolic.cruise_speed_mps);
+  n.read("cruise_speed_mps", l.symbolic.cruise_speed_mps, core::in_range(0.01, 10.0));
   n.no_other_keys();
 }
 
 void read_rates(const core::ConfigNode& n, sim::GameConfig& g) {
   if (!n.defined()) return;
   n.require_map();
-  double physics_hz = 0.0;  // 0: not given
-  n.read("physics_hz", physics_hz, core::positive());
+  using L = ScenarioLimits;  // the bounds' reasons: docs/security.md, "Scenario budgets"
+  double physics_hz = 0.0;   // 0: not given
+  n.read("physics_hz", physics_hz, core::in_range(L::kMinPhysicsHz, L::kMaxPhysicsHz));
   if (physics_hz > 0.0) g.world.physics.step = core::SimTime::period_of_hz(physics_hz);
-  n.read("skill_hz", g.skill_rate_hz, core::positive());
-  n.read("agent_hz", g.agent_rate_hz, core::positive());
+  n.read("skill_hz", g.skill_rate_hz, core::in_range(L::kMinCycleHz, L::kMaxPhysicsHz));
+  n.read("agent_hz", g.agent_rate_hz, core::in_range(L::kMinCycleHz, L::kMaxPhysicsHz));
   double beacon_period_s = 0.0;  // 0: not given
-  n.read("beacon_period_s", beacon_period_s, core::positive());
+  n.read("beacon_period_s", beacon_period_s,
+         core::in_range(L::kMinBeaconPeriodS, L::kMaxBeaconPeriodS));
   if (beacon_period_s > 0.0) g.beacon_period = core::SimTime::from_seconds(beacon_period_s);
   n.no_other_keys();
 }
@@ -105,13 +112,18 @@ std::vector<std::uint64_t> read_seeds(const core::ConfigNode& root) {
   if (seeds.is_map()) {
     std::uint64_t first = 1;
     if (const core::ConfigNode f = seeds["first"]; f.defined()) first = one(f);
-    const std::int64_t count = seeds.at("count").as_int(core::in_range(1, 100000));
+    const std::int64_t count =
+        seeds.at("count").as_int(core::in_range(1, static_cast<double>(ScenarioLimits::kMaxSeeds)));
     seeds.no_other_keys();
     for (std::int64_t i = 0; i < count; ++i) out.push_back(first + static_cast<std::uint64_t>(i));
     return out;
   }
   if (!seeds.is_sequence() || seeds.size() == 0)
     seeds.fail("expected a list of seeds or {first, count}");
+  if (seeds.size() > ScenarioLimits::kMaxSeeds) {
+    seeds.fail("a list of " + std::to_string(seeds.size()) + " seeds: at most " +
+               std::to_string(ScenarioLimits::kMaxSeeds) + " (docs/security.md)");
+  }
   for (const core::ConfigNode& e : seeds.elements()) out.push_back(one(e));
   return out;
 }
@@ -123,15 +135,28 @@ void merge_config(clips::ConfigEntries& into, const clips::ConfigEntries& over) 
   }
 }
 
+/// Whether the directory `dir` holds a regular `*.clp` file (what an agent directory loads).
+bool has_clp_file(const std::string& dir) {
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    std::error_code file_ec;
+    if (it->path().extension() == ".clp" && it->is_regular_file(file_ec)) return true;
+  }
+  return false;
+}
+
 std::vector<std::string> read_agent(const core::ConfigNode& n, const std::string& dir) {
   std::vector<std::string> out;
   const std::vector<std::string> entries = string_list(n);
   for (std::size_t i = 0; i < entries.size(); ++i) {
     const std::string p = resolve(dir, entries[i]);
     std::error_code ec;
+    const core::ConfigNode at = n.is_sequence() ? n.at(static_cast<int>(i)) : n;
     if (!fs::exists(p, ec)) {
-      (n.is_sequence() ? n.at(static_cast<int>(i)) : n)
-          .fail("agent file or directory '" + entries[i] + "' not found (looked at " + p + ")");
+      at.fail("agent file or directory '" + entries[i] + "' not found (looked at " + p + ")");
+    }
+    if (fs::is_directory(p, ec) && !has_clp_file(p)) {
+      at.fail("agent directory '" + entries[i] + "' has no .clp files (looked at " + p + ")");
     }
     out.push_back(p);
   }
@@ -232,10 +257,85 @@ void read_tests(const core::ConfigNode& n, Scenario& s) {
         by.fail("by_s works with points_at_least and deliveries_at_least");
       }
       tc.by_s = by.as_double(core::positive());
+      if (*tc.by_s > s.duration.seconds()) {
+        by.fail("must be at most the game's duration " + core::number_text(s.duration.seconds()) +
+                " s (got " + core::number_text(*tc.by_s) + "): the game ends before");
+      }
     }
     tc.name = name.defined() ? name.as_string() : describe(tc);
     s.tests.push_back(std::move(tc));
   }
+}
+
+/// The node at `dotted` ("rates.skill_hz") if the document has it.
+std::optional<core::ConfigNode> find_key(const core::ConfigNode& root, std::string_view dotted) {
+  core::ConfigNode n = root;
+  while (!dotted.empty()) {
+    const std::size_t dot = dotted.find('.');
+    if (!n.is_map()) return std::nullopt;
+    n = n[dotted.substr(0, dot)];
+    if (!n.defined()) return std::nullopt;
+    dotted = dot == std::string_view::npos ? std::string_view() : dotted.substr(dot + 1);
+  }
+  return n;
+}
+
+/// The scenario keys that set a field GameConfig::validate() names, most specific first; a
+/// field is matched by prefix ("game.levels." covers every level field).
+struct GameFieldKeys {
+  std::string_view field;
+  std::array<std::string_view, 3> keys;
+};
+constexpr GameFieldKeys kGameFieldKeys[] = {
+    {"game.levels.localization.position_noise_m", {"levels.position_noise_m", "profile"}},
+    {"game.levels.localization.heading_noise_rad", {"levels.heading_noise_rad", "profile"}},
+    {"game.levels.light.error_rate", {"levels.light_error_rate", "profile"}},
+    {"game.levels.light.delay", {"levels.light_delay_s", "profile"}},
+    {"game.levels.symbolic.cruise_speed_mps", {"levels.cruise_speed_mps"}},
+    {"game.levels.", {"levels", "profile"}},
+    {"game.skill_rate_hz", {"rates.skill_hz", "rates.physics_hz", "world.physics.step_ms"}},
+    {"game.agent_rate_hz", {"rates.agent_hz", "rates.physics_hz", "world.physics.step_ms"}},
+    {"game.beacon_period", {"rates.beacon_period_s"}},
+    {"game.handling.", {"profile"}},
+    {"game.hackathon", {"hackathon"}},
+    {"physics.", {"rates.physics_hz", "world.physics", "world"}},
+};
+
+/// Throws GameConfig::validate()'s error `e` ("game.skill_rate_hz: must not exceed ...") at the
+/// scenario key that set the field, or at the top level if the document has none of its keys.
+[[noreturn]] void fail_at_game_key(const core::ConfigNode& root, const core::ConfigError& e) {
+  const std::string_view what = e.what();
+  for (const GameFieldKeys& f : kGameFieldKeys) {
+    if (!what.starts_with(f.field)) continue;
+    for (const std::string_view key : f.keys) {
+      if (key.empty()) continue;
+      if (const std::optional<core::ConfigNode> n = find_key(root, key)) {
+        const std::size_t colon = what.find(": ");
+        if (colon == std::string_view::npos) n->fail(std::string(what));
+        n->fail(std::string(what.substr(colon + 2)) + " (" + std::string(what.substr(0, colon)) +
+                ")");
+      }
+    }
+  }
+  root.fail("the game config is invalid: " + std::string(what));
+}
+
+/// duration / physics step within ScenarioLimits::kMaxPhysicsSteps, failing at the key that
+/// made it too many: the physics rate, the world's step or the duration.
+void check_physics_steps(const core::ConfigNode& root, const Scenario& s) {
+  const std::int64_t step = s.game.world.physics.step.ns();
+  if (step <= 0) return;  // GameConfig::validate() says it
+  const std::int64_t steps = s.duration.ns() / step;
+  if (steps <= ScenarioLimits::kMaxPhysicsSteps) return;
+  const std::string why = "the game would take " + std::to_string(steps) + " physics steps (" +
+                          core::number_text(s.duration.seconds()) + " s at " +
+                          core::number_text(1e9 / static_cast<double>(step)) + " Hz); at most " +
+                          std::to_string(ScenarioLimits::kMaxPhysicsSteps) +
+                          " (docs/security.md, \"Scenario budgets\")";
+  for (const std::string_view key : {"rates.physics_hz", "world.physics.step_ms", "duration_s"}) {
+    if (const std::optional<core::ConfigNode> n = find_key(root, key)) n->fail(why);
+  }
+  root.fail(why);
 }
 
 Scenario read_scenario(const core::ConfigNode& root, const std::string& file) {
@@ -286,8 +386,10 @@ Scenario read_scenario(const core::ConfigNode& root, const std::string& file) {
     duration += rb.setup_duration.seconds();
   }
   if (s.game.hackathon) duration = kHackathonDefaultDuration.seconds();
-  root.read("duration_s", duration, core::positive());
+  root.read("duration_s", duration,
+            core::in_range(ScenarioLimits::kMinDurationS, ScenarioLimits::kMaxDurationS));
   s.duration = core::SimTime::from_seconds(duration);
+  check_physics_steps(root, s);
   read_robots(root["robots"], dir, s);
   if (const core::ConfigNode n = root["skills"]; n.defined()) {
     s.skills = lua::SkillEngineConfig::from_config(n, dir);  // dirs relative to the file
@@ -301,7 +403,7 @@ Scenario read_scenario(const core::ConfigNode& root, const std::string& file) {
   try {
     s.game.validate();
   } catch (const core::ConfigError& e) {
-    root.fail(std::string("the game config is invalid: ") + e.what());
+    fail_at_game_key(root, e);
   }
   return s;
 }
@@ -347,6 +449,9 @@ Scenario read_scenario_map(const core::ConfigNode& root, const std::string& file
 }
 
 ScenarioFile load_scenario(const std::string& path) {
+  if (std::error_code ec; fs::is_directory(path, ec)) {
+    throw core::ConfigError(path + ": is a directory, expected a scenario file");
+  }
   const std::string text = read_text(path);
   // A test hook, not for users: a deliberate bug (std::logic_error) when LLSF_TEST_INTERNAL_ERROR
   // is set, so that tests/app/exit_code_test.cpp sees llsfsim tell a bug (exit code 3) from bad
@@ -364,8 +469,10 @@ ScenarioFile load_scenario(const std::string& path) {
   }
   matrix.require_map();
   if (matrix.size() == 0) matrix.fail("an empty matrix: give at least one axis or remove it");
-  // Axes and their values, in file order.
+  // Axes and their values, in file order; their product counted before any is expanded.
   std::vector<std::vector<std::string>> values;
+  std::int64_t variants = 1;
+  std::string sizes;
   for (const std::string& axis : matrix.keys()) {
     const core::ConfigNode a = matrix[axis];
     a.require_map();
@@ -373,10 +480,21 @@ ScenarioFile load_scenario(const std::string& path) {
     out.axes.push_back(axis);
     values.push_back(a.keys());
     for (const std::string& v : values.back()) a[v].require_map();
+    sizes += (sizes.empty() ? "" : " x ") + std::to_string(a.size());
+    if (variants > ScenarioLimits::kMaxVariants / a.size()) variants = -1;  // over the limit
+    if (variants > 0) variants *= a.size();
+  }
+  if (variants < 0 || variants > ScenarioLimits::kMaxVariants) {
+    matrix.fail("more than " + std::to_string(ScenarioLimits::kMaxVariants) +
+                " variants (axes of " + sizes + " values): at most " +
+                std::to_string(ScenarioLimits::kMaxVariants) +
+                " (docs/security.md, \"Scenario budgets\")");
   }
   // The cartesian product, last axis fastest; each cell re-parses the file and applies its
   // overrides (errors then point at the override's line).
   std::vector<std::size_t> idx(values.size(), 0);
+  std::map<std::string, std::vector<std::size_t>> named;  // variant name -> its value indices
+  std::int64_t games = 0;
   while (true) {
     core::ConfigNode root = core::ConfigNode::parse(text, path);
     std::string variant;
@@ -390,8 +508,25 @@ ScenarioFile load_scenario(const std::string& path) {
       }
       variant += (variant.empty() ? "" : ",") + out.axes[a] + "=" + v;
     }
+    // Names identify variants in `run --variant` and in the statistics store: unique. Values
+    // with ',' or '=' can give two variants one name.
+    if (const auto [it, fresh] = named.emplace(variant, idx); !fresh) {
+      std::size_t a = 0;
+      while (a + 1 < idx.size() && it->second[a] == idx[a]) ++a;
+      const core::ConfigNode mine = matrix[out.axes[a]][values[a][idx[a]]];
+      const core::ConfigNode other = matrix[out.axes[a]][values[a][it->second[a]]];
+      mine.fail("two variants are named '" + variant + "': this one and the one of " +
+                other.location() + " (a value with ',' or '=' makes names ambiguous)");
+    }
     Scenario s = read_scenario(root, path);
     s.variant = variant;
+    games += static_cast<std::int64_t>(s.seeds.size());
+    if (games > ScenarioLimits::kMaxGames) {
+      matrix.fail("more than " + std::to_string(ScenarioLimits::kMaxGames) +
+                  " games (the variants' seeds summed): at most " +
+                  std::to_string(ScenarioLimits::kMaxGames) +
+                  " (docs/security.md, \"Scenario budgets\")");
+    }
     out.variants.push_back(std::move(s));
     std::size_t a = values.size();
     while (a > 0) {
