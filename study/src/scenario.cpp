@@ -257,8 +257,9 @@ void read_tests(const core::ConfigNode& n, Scenario& s) {
         by.fail("by_s works with points_at_least and deliveries_at_least");
       }
       tc.by_s = by.as_double(core::positive());
-      if (*tc.by_s > s.duration.seconds()) {
-        by.fail("must be at most the game's duration " + core::number_text(s.duration.seconds()) +
+      const double duration_s = static_cast<double>(s.duration.ns()) / 1e9;
+      if (*tc.by_s > duration_s) {
+        by.fail("must be at most the game's duration " + core::number_text(duration_s) +
                 " s (got " + core::number_text(*tc.by_s) + "): the game ends before");
       }
     }
@@ -328,7 +329,7 @@ void check_physics_steps(const core::ConfigNode& root, const Scenario& s) {
   const std::int64_t steps = s.duration.ns() / step;
   if (steps <= ScenarioLimits::kMaxPhysicsSteps) return;
   const std::string why = "the game would take " + std::to_string(steps) + " physics steps (" +
-                          core::number_text(s.duration.seconds()) + " s at " +
+                          core::number_text(static_cast<double>(s.duration.ns()) / 1e9) + " s at " +
                           core::number_text(1e9 / static_cast<double>(step)) + " Hz); at most " +
                           std::to_string(ScenarioLimits::kMaxPhysicsSteps) +
                           " (docs/security.md, \"Scenario budgets\")";
