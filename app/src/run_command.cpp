@@ -250,7 +250,7 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
       hooks.record_path = (dir / study::recording_file_name(s->name, s->variant, seed)).string();
     }
     if (const std::string why = cannot_create(hooks.record_path); !why.empty()) {
-      err << "llsfsim run: " << hooks.record_path << ": cannot write the recording: " << why
+      err << "llsfsim run: " << hooks.record_path << ": cannot create the recording: " << why
           << "\n";
       return kExitBadInput;
     }

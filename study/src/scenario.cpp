@@ -2,6 +2,7 @@
 #include "llsf/study/scenario.h"
 
 #include <array>
+#include <charconv>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -10,6 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string_view>
+#include <system_error>
 #include <utility>
 
 #include "llsf/comm/hub_config.h"
@@ -211,9 +213,9 @@ void read_robots(const core::ConfigNode& n, const std::string& dir, Scenario& s)
     if (const core::ConfigNode p = r["start"]; p.defined()) {
       p.require_map();
       double x = start.pose.x, y = start.pose.y, ori = start.pose.theta * 180.0 / core::kPi;
-      p.read("x", x);
-      p.read("y", y);
-      p.read("ori_deg", ori);
+      p.read("x", x, core::in_range(-1000.0, 1000.0));  // metres; the world checks the field
+      p.read("y", y, core::in_range(-1000.0, 1000.0));
+      p.read("ori_deg", ori, core::in_range(-360.0, 360.0));
       p.no_other_keys();
       start.pose = {x, y, ori * core::kPi / 180.0};
     }
@@ -302,10 +304,44 @@ constexpr GameFieldKeys kGameFieldKeys[] = {
     {"physics.", {"rates.physics_hz", "world.physics", "world"}},
 };
 
+/// The node of a world.validate() error about a robot ("robots[1].jersey: duplicate ...",
+/// "robots[0]: ... is outside the field") if the scenario sets that robot in `robots.each`:
+/// the key named, else its start pose for a position, else the entry.
+std::optional<core::ConfigNode> robot_error_node(const core::ConfigNode& root,
+                                                 std::string_view what) {
+  if (!what.starts_with("robots[")) return std::nullopt;
+  const std::size_t close = what.find(']');
+  if (close == std::string_view::npos) return std::nullopt;
+  int index = -1;
+  const std::string_view digits = what.substr(7, close - 7);
+  if (std::from_chars(digits.data(), digits.data() + digits.size(), index).ec != std::errc()) {
+    return std::nullopt;
+  }
+  const std::optional<core::ConfigNode> each = find_key(root, "robots.each");
+  if (!each || !each->is_sequence() || index < 0 || index >= each->size()) return std::nullopt;
+  const core::ConfigNode entry = each->at(index);
+  if (!entry.is_map()) return entry;
+  std::string_view rest = what.substr(close + 1);
+  if (rest.starts_with('.')) {
+    rest.remove_prefix(1);
+    const std::string_view field = rest.substr(0, rest.find_first_of(".:["));
+    if (const core::ConfigNode n = entry[field]; n.defined()) return n;
+  } else if (what.find("outside the field") != std::string_view::npos ||
+             what.find("overlaps") != std::string_view::npos) {
+    if (const core::ConfigNode n = entry["start"]; n.defined()) return n;
+  }
+  return entry;
+}
+
 /// Throws GameConfig::validate()'s error `e` ("game.skill_rate_hz: must not exceed ...") at the
 /// scenario key that set the field, or at the top level if the document has none of its keys.
 [[noreturn]] void fail_at_game_key(const core::ConfigNode& root, const core::ConfigError& e) {
   const std::string_view what = e.what();
+  if (const std::optional<core::ConfigNode> n = robot_error_node(root, what)) {
+    const std::size_t colon = what.find(": ");
+    n->fail(std::string(colon == std::string_view::npos ? what : what.substr(colon + 2)) + " (" +
+            std::string(what.substr(0, colon)) + ")");
+  }
   for (const GameFieldKeys& f : kGameFieldKeys) {
     if (!what.starts_with(f.field)) continue;
     for (const std::string_view key : f.keys) {

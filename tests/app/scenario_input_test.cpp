@@ -145,7 +145,7 @@ TEST_CASE("run: a recording folder that cannot be written is refused before the 
       {"run", scenario, "--no-db", "--record", (folder / "r.jsonl.gz").string()});
   INFO(r.err);
   CHECK(r.code == llsf::app::kExitBadInput);
-  CHECK(has(r.err, "r.jsonl.gz: cannot write the recording: the folder"));
+  CHECK(has(r.err, "r.jsonl.gz: cannot create the recording: the folder"));
   CHECK(has(r.err, "is not writable"));
   // A missing folder too.
   const Run missing =

@@ -182,3 +182,25 @@ TEST_CASE("scenario budgets: batch --runs is bounded before any seed list is mad
   CHECK_THROWS_AS(batch_seeds(s, ScenarioLimits::kMaxSeeds + 1), core::ConfigError);
   CHECK(batch_seeds(s, 3).size() == 3);
 }
+
+TEST_CASE("scenario budgets: the world's errors about a robot are located at robots.each") {
+  std::string e = refused("robots:\n  count: 2\n  each:\n    - {jersey: 5}\n    - {jersey: 5}\n",
+                          "6:", "robots.each[1].jersey");
+  CHECK(e.find("duplicate jersey number 5") != std::string::npos);
+  refused("robots:\n  each:\n    - {jersey: 1000}\n", "4:", "robots.each[0].jersey");
+  refused("robots:\n  each:\n    - {name: ''}\n", "4:", "robots.each[0].name");
+  e = refused("robots:\n  each:\n    - start: {x: 5.5}\n", "4:", "robots.each[0].start");
+  CHECK(e.find("outside the field") != std::string::npos);
+  refused("robots:\n  each:\n    - start: {x: 1e300}\n", "4:", "robots.each[0].start.x");
+}
+
+TEST_CASE("scenario budgets: a profile's noises and waits are bounded") {
+  refused("profile:\n  name: ideal\n  position_noise_m: 1e300\n", "4:", "profile.position_noise_m");
+  refused("profile:\n  name: ideal\n  heading_noise_rad: 1e300\n",
+          "4:", "profile.heading_noise_rad");
+  refused("profile:\n  name: ideal\n  wait_before_replan_s: 1e300\n",
+          "4:", "profile.wait_before_replan_s");
+  refused("profile:\n  name: ideal\n  backoff_max_s: 1e300\n", "4:", "profile.backoff_max_s");
+  refused("profile:\n  name: ideal\n  motor_max_speed_mps: 1e300\n",
+          "4:", "profile.motor_max_speed_mps");
+}
