@@ -337,20 +337,30 @@ std::optional<core::ConfigNode> robot_error_node(const core::ConfigNode& root,
 /// scenario key that set the field, or at the top level if the document has none of its keys.
 [[noreturn]] void fail_at_game_key(const core::ConfigNode& root, const core::ConfigError& e) {
   const std::string_view what = e.what();
+  // The hackathon's own errors name its keys ("hackathon.colours: no free spot ..."): the
+  // deepest of them the document has.
+  const std::size_t colon = what.find(": ");
+  const std::string reason(colon == std::string_view::npos ? what : what.substr(colon + 2));
+  const std::string field(what.substr(0, colon));
+  std::string_view key = field;
+  if (key.starts_with("game.")) key.remove_prefix(5);
+  while (key.starts_with("hackathon")) {
+    if (const std::optional<core::ConfigNode> n = find_key(root, key)) {
+      n->fail(reason + " (" + field + ")");
+    }
+    const std::size_t dot = key.rfind('.');
+    if (dot == std::string_view::npos) break;
+    key = key.substr(0, dot);
+  }
   if (const std::optional<core::ConfigNode> n = robot_error_node(root, what)) {
-    const std::size_t colon = what.find(": ");
-    n->fail(std::string(colon == std::string_view::npos ? what : what.substr(colon + 2)) + " (" +
-            std::string(what.substr(0, colon)) + ")");
+    n->fail(reason + " (" + field + ")");
   }
   for (const GameFieldKeys& f : kGameFieldKeys) {
     if (!what.starts_with(f.field)) continue;
-    for (const std::string_view key : f.keys) {
-      if (key.empty()) continue;
-      if (const std::optional<core::ConfigNode> n = find_key(root, key)) {
-        const std::size_t colon = what.find(": ");
-        if (colon == std::string_view::npos) n->fail(std::string(what));
-        n->fail(std::string(what.substr(colon + 2)) + " (" + std::string(what.substr(0, colon)) +
-                ")");
+    for (const std::string_view k : f.keys) {
+      if (k.empty()) continue;
+      if (const std::optional<core::ConfigNode> n = find_key(root, k)) {
+        n->fail(reason + " (" + field + ")");
       }
     }
   }
@@ -441,6 +451,14 @@ Scenario read_scenario(const core::ConfigNode& root, const std::string& file) {
     s.game.validate();
   } catch (const core::ConfigError& e) {
     fail_at_game_key(root, e);
+  }
+  if (s.game.hackathon) {
+    // The layout of the first seed: pucks that find no free spot are an error of the file.
+    try {
+      (void)sim::prepare_game_config(s.game);
+    } catch (const core::ConfigError& e) {
+      fail_at_game_key(root, e);
+    }
   }
   return s;
 }

@@ -204,3 +204,12 @@ TEST_CASE("scenario budgets: a profile's noises and waits are bounded") {
   refused("profile:\n  name: ideal\n  motor_max_speed_mps: 1e300\n",
           "4:", "profile.motor_max_speed_mps");
 }
+
+TEST_CASE("scenario budgets: a hackathon layout without room is an error of the file, at its key") {
+  // Pucks 100 m apart cannot be placed: found by the loader (with the line), not by the game.
+  std::string e = refused("hackathon:\n  puck_spacing_m: 100\n", "3:", "hackathon");
+  CHECK(e.find("no free spot for puck") != std::string::npos);
+  e = refused("hackathon:\n  puck_spacing_m: 100\n  colours: [{name: red, count: 3}]\n",
+              "4:", "hackathon.colours");
+  CHECK(e.find("no free spot for puck") != std::string::npos);
+}
