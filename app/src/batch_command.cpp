@@ -77,17 +77,7 @@ int batch(const BatchCommandOptions& o, std::ostream& out, std::ostream& err) {
     for (const std::string& path : o.scenarios) {
       Loaded l{path, study::load_scenario(path), ""};
       l.hash = study::batch_identity_hash(path, l.file);
-      std::int64_t games = 0;
-      for (const study::Scenario& s : l.file.variants) {
-        games += static_cast<std::int64_t>(study::batch_seeds(s, o.runs).size());
-      }
-      if (games > study::ScenarioLimits::kMaxGames) {
-        throw core::ConfigError(fmt::format(
-            "{}: {} variants x --runs {} = {} games: at most {} (docs/security.md, \"Scenario "
-            "budgets\")",
-            path, l.file.variants.size(), o.runs.value_or(0), games,
-            study::ScenarioLimits::kMaxGames));
-      }
+      (void)study::batch_games(l.file, o.runs);  // each variant's seeds, within the budget
       loaded.push_back(std::move(l));
     }
   } catch (const core::UserError& e) {

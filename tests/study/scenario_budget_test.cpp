@@ -213,3 +213,17 @@ TEST_CASE("scenario budgets: a hackathon layout without room is an error of the 
               "4:", "hackathon.colours");
   CHECK(e.find("no free spot for puck") != std::string::npos);
 }
+
+TEST_CASE(
+    "scenario budgets: batch_games counts variants x --runs and refuses more than the budget") {
+  const std::string p = scenario_file("two.yaml", "name: two\nmatrix:\n  a: {x: {}, y: {}}\n");
+  const ScenarioFile f = load_scenario(p);
+  CHECK(batch_games(f, 50000) == 100000);
+  try {
+    (void)batch_games(f, 50001);
+    FAIL("no error");
+  } catch (const core::ConfigError& e) {
+    CHECK(std::string(e.what()) == p + ": 2 variants x --runs 50001 = 100002 games: at most 100000 "
+                                       "(docs/security.md, \"Scenario budgets\")");
+  }
+}
