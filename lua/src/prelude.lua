@@ -25,10 +25,96 @@ local function copy(t)
   for k, v in pairs(t) do c[k] = v end
   return c
 end
-base.math, base.table, base.utf8 = copy(math), copy(table), copy(utf8)
-base.string = copy(string)
-base.string.dump = nil
--- Method calls on strings ("x"):format(...) use the sandbox copy; the metatable is hidden.
+
+-- Tables every skill of the robot shares (libraries, the DSL's classes, interfaces) are
+-- read-only proxies: one skill cannot change what another sees (string.format = ...).
+local frozen = setmetatable({}, {__mode = "k"})  -- proxy -> its name
+local function readonly(t, what)
+  local proxy = setmetatable({}, {
+    __index = t,
+    __newindex = function(_, k)
+      error(fmt("%s is read-only (shared by every skill): cannot set %s.%s", what, what,
+                tostring(k)), 2)
+    end,
+    __pairs = function() return next, t, nil end,
+    __len = function() return #t end,
+    __metatable = false})
+  frozen[proxy] = what
+  return proxy
+end
+
+-- Library functions whose work grows with their arguments charge it to the instruction budget
+-- (native.charge raises at the skill's line); string.rep, find, match, gmatch and gsub are the
+-- engine's bounded versions (patterns.cpp). Costs: docs/skills.md, "Sandbox".
+local charge, tointeger = native.charge, math.tointeger
+local function span(i, j)  -- how many integers i..j (a float: no overflow)
+  if type(i) ~= "number" or type(j) ~= "number" or j < i then return 0 end
+  return (j + 0.0) - i + 1
+end
+local function len_of(t) return type(t) == "table" and #t or 0 end
+local raw_table, raw_string, raw_utf8 = table, string, utf8
+local tab = copy(table)
+tab.move = function(a1, f, e, t, a2)
+  local n = span(f, e)
+  charge(n, fmt("table.move of %.0f elements", n))
+  return raw_table.move(a1, f, e, t, a2)
+end
+tab.concat = function(t, sep, i, j)
+  local n = span(i or 1, j or len_of(t))
+  charge(n, fmt("table.concat of %.0f elements", n))
+  return raw_table.concat(t, sep, i, j)
+end
+tab.unpack = function(t, i, j)
+  local n = span(i or 1, j or len_of(t))
+  charge(n, fmt("table.unpack of %.0f elements", n))
+  return raw_table.unpack(t, i, j)
+end
+tab.insert = function(t, ...)
+  if select("#", ...) >= 2 then
+    local n = span((...), len_of(t))
+    charge(n, fmt("table.insert moving %.0f elements", n))
+  end
+  return raw_table.insert(t, ...)
+end
+tab.remove = function(t, ...)
+  if select("#", ...) >= 1 then
+    local n = span((...), len_of(t))
+    charge(n, fmt("table.remove moving %.0f elements", n))
+  end
+  return raw_table.remove(t, ...)
+end
+tab.sort = function(t, comp)
+  local n = len_of(t)
+  if n > 1 then
+    local cost = n * math.ceil(math.log(n, 2))
+    charge(cost, fmt("table.sort of %d elements", n))
+  end
+  return raw_table.sort(t, comp)
+end
+local str = copy(string)
+str.dump = nil
+for k, f in pairs(native.patterns) do str[k] = f end
+str.byte = function(s, i, j)
+  if j ~= nil and type(s) == "string" then charge(#s, fmt("string.byte of %d bytes", #s)) end
+  return raw_string.byte(s, i, j)
+end
+local u8 = copy(utf8)
+for _, k in ipairs{"len", "codepoint", "offset"} do
+  local f = raw_utf8[k]
+  u8[k] = function(s, ...)
+    if type(s) == "string" then charge(#s // 8, fmt("utf8.%s of %d bytes", k, #s)) end
+    return f(s, ...)
+  end
+end
+base.math = readonly(copy(math), "math")
+base.table = readonly(tab, "table")
+base.string = readonly(str, "string")
+base.utf8 = readonly(u8, "utf8")
+base.rawset = function(t, k, v)
+  if frozen[t] then error(fmt("%s is read-only (shared by every skill)", frozen[t]), 2) end
+  return rawset(t, k, v)
+end
+-- Method calls on strings ("x"):format(...) use the sandbox's string; the metatable is hidden.
 local string_mt = getmetatable("")
 string_mt.__index = base.string
 string_mt.__metatable = false
@@ -48,12 +134,15 @@ base.profile = setmetatable({}, {
   __index = native.profile,
   __newindex = function() error("profile is read-only", 2) end,
   __metatable = false})
+frozen[base.profile] = "profile"
 -- Fawkes skill files start with `module(..., skillenv.module_init)` and call
 -- `skillenv.skill_module(_M)` after their declarations; here declarations are checked as they
 -- are assigned, so both are accepted and do nothing.
-base.skillenv = {skill_module = function() end, module_init = function() end}
+base.skillenv = readonly({skill_module = function() end, module_init = function() end},
+                         "skillenv")
 base.module = function() end
 base.clock = native.clock
+frozen[native.clock] = "clock"
 
 local function args_text(...)
   local n = select("#", ...)
@@ -72,7 +161,8 @@ base.printf = function(f, ...) log(1, fmt(f, ...)) end
 local handles = {}       -- name -> handle
 local handle_list = {}   -- handles in load order (deterministic iteration)
 local loading = nil      -- the handle whose file is running
-local interface_types = native.interfaces  -- type name -> interface object
+local interface_types = native.interfaces  -- type name -> interface object (read-only)
+for type_name, obj in pairs(interface_types) do frozen[obj] = type_name end
 local conventional_vars = {pose = "Position3DInterface", navigator = "NavigatorInterface",
                            motor = "MotorInterface", sensor = "RobotinoSensorInterface",
                            light = "RobotinoLightInterface", pucks = "PuckVisionInterface",
@@ -150,13 +240,15 @@ local function module_env(h)
 end
 
 -- States -------------------------------------------------------------------------------------
-local JumpState = {kind = "jump"}
-local SkillJumpState = {kind = "skill"}
+local JumpState = readonly({kind = "jump"}, "JumpState")
+local SkillJumpState = readonly({kind = "skill"}, "SkillJumpState")
 base.JumpState, base.SkillJumpState = JumpState, SkillJumpState
 
 local SkillHSM = {}
 SkillHSM.__index = SkillHSM
-base.SkillHSM = SkillHSM
+SkillHSM.__metatable = false  -- getmetatable(fsm) must not hand out the shared class
+local fsms = setmetatable({}, {__mode = "k"})  -- every SkillHSM made by SkillHSM:new
+base.SkillHSM = readonly(SkillHSM, "SkillHSM")
 
 local function new_state(fsm, name, kind)
   local st = {name = name, fsm = fsm, kind = kind, transitions = {}, preconds = {}, args = {},
@@ -175,6 +267,7 @@ function SkillHSM:new(o)
                             states = {}, state_list = {}, defaults = {}, vars = {},
                             closure = {}, skill = loading, where = where(2), step_id = 0},
                            SkillHSM)
+  fsms[fsm] = true
   fsm.cond_env = setmetatable(fsm.closure, {__index = loading.env})
   fsm.final = new_state(fsm, "FINAL", "final")
   fsm.failed = new_state(fsm, "FAILED", "failed")
@@ -438,7 +531,7 @@ reset_skill = function(h)
       local ok, err = raw_pcall(fsm.current.exit, fsm.current)
       if not ok then log(3, fmt("%s: exit of %s: %s", h.name, fsm.current.name, tostring(err))) end
     end
-    if not h.fsm and h.env.reset then
+    if not h.fsm and rawget(h.env, "reset") then
       local ok, err = raw_pcall(h.env.reset)
       if not ok then log(3, fmt("%s: reset(): %s", h.name, tostring(err))) end
     end
@@ -542,7 +635,7 @@ function E.finish_module(name)
   end
   local fsm = rawget(env, "fsm")
   if fsm ~= nil then
-    if getmetatable(fsm) ~= SkillHSM then fail("'fsm' must be a SkillHSM") end
+    if not fsms[fsm] then fail("'fsm' must be a SkillHSM") end
     if not fsm.states[fsm.start] then
       error(fmt("%s: start state '%s' is not defined", fsm.where, fsm.start), 0)
     end
