@@ -95,6 +95,9 @@ bool in_class(unsigned char c, unsigned char cls) {
     case 'x':
       r = std::isxdigit(c) != 0;
       break;
+    case 'z':  // deprecated in Lua 5.2 but still understood by 5.4: the zero byte
+      r = c == 0;
+      break;
     default:
       return cls == c;  // %. for any non-alphanumeric '.': the character itself
   }
@@ -349,7 +352,7 @@ void init(Matcher& m, lua_State* L, const char* fn, const char* s, std::size_t l
 // len + 1 if it lies beyond the end.
 std::size_t start_offset(lua_Integer pos, std::size_t len) {
   const auto n = static_cast<lua_Integer>(len);
-  if (pos > 0) return pos > n ? len + 1 : static_cast<std::size_t>(pos - 1);
+  if (pos > 0) return pos - 1 > n ? len + 1 : static_cast<std::size_t>(pos - 1);
   if (pos == 0 || pos < -n) return 0;
   return static_cast<std::size_t>(n + pos);
 }
