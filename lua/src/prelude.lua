@@ -159,6 +159,8 @@ base.printf = function(f, ...) log(1, fmt(f, ...)) end
 
 -- Skill handles (one per skill file, created before any file runs) and the module loading state.
 local handles = {}       -- name -> handle
+local proxies = {}       -- name -> what skills and skill strings see of the handle (read-only)
+local real_of = setmetatable({}, {__mode = "k"})  -- proxy -> handle
 local handle_list = {}   -- handles in load order (deterministic iteration)
 local loading = nil      -- the handle whose file is running
 local interface_types = native.interfaces  -- type name -> interface object (read-only)
@@ -214,7 +216,7 @@ local function module_env(h)
         end
         if not handles[dep] then error(fmt("depends_skills: unknown skill '%s'", dep), 2) end
         if dep == h.name then error("depends_skills: a skill cannot depend on itself", 2) end
-        h.bindings[dep] = handles[dep]
+        h.bindings[dep] = proxies[dep]
         h.depends[#h.depends + 1] = dep
       end
     elseif k == "depends_interfaces" then
@@ -276,11 +278,9 @@ end
 
 local function resolve_subskill(fsm, spec, lvl)
   local s = spec[1]
-  local h = type(s) == "string" and handles[s] or s
-  if type(h) ~= "table" or not h.is_skill then
-    error(fmt("skills: entry %s is not a skill", tostring(s)), lvl)
-  end
-  if fsm.skill.bindings[h.name] ~= h then
+  local h = type(s) == "string" and handles[s] or real_of[s]
+  if not h then error(fmt("skills: entry %s is not a skill", tostring(s)), lvl) end
+  if fsm.skill.bindings[h.name] ~= proxies[h.name] then
     error(fmt("skill '%s' is used but not declared in depends_skills", h.name), lvl)
   end
   local static = nil
@@ -602,6 +602,23 @@ handle_mt.__call = function(h, args)
   return call_skill(h, args)
 end
 
+-- Skills see a read-only proxy of each handle: they can call it, reset it and read its name,
+-- status and error, but not reach or change another skill's state machine or environment.
+local visible = {name = true, is_skill = true, status = true, error = true, documentation = true}
+local proxy_mt = {__metatable = false}
+proxy_mt.__index = function(p, k)
+  local h = real_of[p]
+  if k == "reset" then return function() reset_skill(h) end end
+  if visible[k] then return h[k] end
+  return nil
+end
+proxy_mt.__newindex = function(p, k)
+  local name = real_of[p].name
+  error(fmt("skill '%s' is read-only: cannot set %s.%s", name, name, tostring(k)), 2)
+end
+proxy_mt.__call = function(p, args) return handle_mt.__call(real_of[p], args) end
+proxy_mt.__tostring = function(p) return "skill " .. real_of[p].name end
+
 -- Entry points for the C++ engine ------------------------------------------------------------
 local E = {}
 
@@ -612,6 +629,10 @@ function E.declare_skills(names)
                            handle_mt)
     handles[name] = h
     handle_list[#handle_list + 1] = h
+    local p = setmetatable({}, proxy_mt)
+    real_of[p] = h
+    proxies[name] = p
+    frozen[p] = "skill " .. name
   end
 end
 
@@ -680,7 +701,7 @@ end
 
 local string_env = setmetatable({}, {
   __index = function(t, k)
-    local v = handles[k] or base[k]
+    local v = proxies[k] or base[k]
     if v == nil then error(fmt("unknown skill '%s'", tostring(k)), 2) end
     rawset(t, k, v)
     return v

@@ -219,6 +219,34 @@ TEST_CASE("the library tables are read-only: one skill cannot change another's s
   CHECK(engine.error().empty());
 }
 
+TEST_CASE("a skill sees other skills read-only: it can call them, not reach their internals") {
+  TempDir dir("llsf_budget");
+  dir.write("meddler.lua",
+            "name = 'meddler'\n"
+            "documentation = 'tries to change the skill it depends on'\n"
+            "depends_skills = {'target'}\n"
+            "function execute()\n"
+            "  assert(target.name == 'target' and target.env == nil and target.fsm == nil)\n"
+            "  assert(target.bindings == nil and getmetatable(target) == false)\n"
+            "  assert(not pcall(rawset, target, 'load_error', 'broken'))\n"
+            "  assert(target{} == S_FINAL and target.status == S_FINAL)\n"
+            "  target.execute = nil  -- MARK\n"
+            "end\n");
+  dir.write("target.lua",
+            "name = 'target'\n"
+            "documentation = 'finishes'\n"
+            "function execute() return S_FINAL end\n");
+  FakeRobot robot;
+  lua::SkillEngine engine(budget_config(dir), robot);
+  REQUIRE(engine.exec("meddler{}"));
+  CHECK(engine.cycle() == SkillStatus::kFailed);
+  CHECK(without_dir(engine.error(), dir) ==
+        "meddler: " + test::marked_line(dir.file("meddler.lua")) +
+            ": skill 'target' is read-only: cannot set target.execute");
+  REQUIRE(engine.exec("target{}"));
+  CHECK(engine.cycle() == SkillStatus::kFinal);
+}
+
 TEST_CASE("a plain execute() skill is reset without an error") {
   const Outcome r = run_probe("  local x = 1");
   CHECK(r.status == SkillStatus::kFinal);
