@@ -47,8 +47,9 @@ end
 -- (native.charge raises at the skill's line); string.rep, find, match, gmatch and gsub are the
 -- engine's bounded versions (patterns.cpp). Costs: docs/skills.md, "Sandbox".
 local charge, tointeger = native.charge, math.tointeger
-local function span(i, j)  -- how many integers i..j (a float: no overflow)
-  if type(i) ~= "number" or type(j) ~= "number" or j < i then return 0 end
+local function span(i, j)  -- how many integers i..j (a float: no overflow; "10" counts too)
+  i, j = tonumber(i), tonumber(j)
+  if not i or not j or j < i then return 0 end
   return (j + 0.0) - i + 1
 end
 local function len_of(t) return type(t) == "table" and #t or 0 end
@@ -170,6 +171,13 @@ local conventional_vars = {pose = "Position3DInterface", navigator = "NavigatorI
                            light = "RobotinoLightInterface", pucks = "PuckVisionInterface",
                            laser = "Laser360Interface", puck_detector = "ColourPuckInterface",
                            rescue = "RescueInterface"}
+
+-- The text of an error object: tables and other values would show their address (not the same
+-- from one run to the next).
+local function error_text(e)
+  if type(e) == "string" or type(e) == "number" then return tostring(e) end
+  return "(error object is a " .. type(e) .. " value)"
+end
 
 local function where(level)
   local info = debug_getinfo(level + 1, "Sl")
@@ -529,11 +537,11 @@ reset_skill = function(h)
     if fsm and fsm.current and fsm.current.exit and fsm.current.kind ~= "final" and
        fsm.current.kind ~= "failed" then
       local ok, err = raw_pcall(fsm.current.exit, fsm.current)
-      if not ok then log(3, fmt("%s: exit of %s: %s", h.name, fsm.current.name, tostring(err))) end
+      if not ok then log(3, fmt("%s: exit of %s: %s", h.name, fsm.current.name, error_text(err))) end
     end
     if not h.fsm and rawget(h.env, "reset") then
       local ok, err = raw_pcall(h.env.reset)
-      if not ok then log(3, fmt("%s: reset(): %s", h.name, tostring(err))) end
+      if not ok then log(3, fmt("%s: reset(): %s", h.name, error_text(err))) end
     end
   end
   if h.fsm then
@@ -576,12 +584,12 @@ call_skill = function(h, args)
   caller, h.in_call, depth = outer, false, depth - 1
   if ok then
     h.status = status
-    if status == S_FAILED then h.error = tostring(err or "failed") end
+    if status == S_FAILED then h.error = err == nil and "failed" or error_text(err) end
     return status
   end
   local running = h.fsm and h.fsm.running
   h.status = S_FAILED
-  h.error = running and (running.name .. ": " .. tostring(status)) or tostring(status)
+  h.error = running and (running.name .. ": " .. error_text(status)) or error_text(status)
   if h.fsm then
     h.fsm.error = h.error
     h.fsm.current = h.fsm.failed

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -100,6 +101,8 @@ SkillEngineConfig SkillEngineConfig::from_config(const core::ConfigNode& node,
 
 namespace {
 
+constexpr const char* kPreludeChunkName = "=llsf/prelude.lua";
+
 // Allocator with a heap limit and an allocation budget: refusing an allocation makes Lua raise
 // "not enough memory" (Impl::explain() names the budget in the message).
 void* limited_alloc(void* ud, void* ptr, std::size_t osize, std::size_t nsize) {
@@ -152,7 +155,18 @@ void budget_hook(lua_State* L, lua_Debug* ar) {
   if (e.used < e.config.instruction_budget) return;
   e.used = 0;
   e.budget_exhausted = true;
+  // Name the skill's line: the hook may fire in the prelude's code (a library wrapper, the DSL
+  // runtime) running on the skill's behalf; then the nearest caller outside the prelude.
   lua_getinfo(L, "Sl", ar);
+  lua_Debug caller{};
+  for (int level = 1;
+       std::strcmp(ar->source, kPreludeChunkName) == 0 && lua_getstack(L, level, &caller) != 0;
+       ++level) {
+    lua_getinfo(L, "Sl", &caller);
+    if (caller.currentline > 0 && std::strcmp(caller.source, kPreludeChunkName) != 0) {
+      ar = &caller;
+    }
+  }
   lua_pushfstring(
       L, "%s:%d: instruction budget exhausted (%I instructions per cycle; endless loop?)",
       ar->short_src, ar->currentline, static_cast<LUA_INTEGER>(e.config.instruction_budget));
@@ -376,7 +390,7 @@ void SkillEngine::Impl::build() {
   lua_pop(L, 1);
 
   // The prelude gets the natives and returns the engine's entry table.
-  if (luaL_loadbufferx(L, kPrelude, std::char_traits<char>::length(kPrelude), "=llsf/prelude.lua",
+  if (luaL_loadbufferx(L, kPrelude, std::char_traits<char>::length(kPrelude), kPreludeChunkName,
                        "t") != LUA_OK) {
     LLSF_DEMAND_MSG(false, "prelude: " + pop_message(L));
   }

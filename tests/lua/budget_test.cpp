@@ -58,11 +58,13 @@ struct Outcome {
 };
 
 // Runs `probe{}` for one cycle with `body` in a fresh engine.
-Outcome run_probe(const std::string& body) {
+Outcome run_probe(const std::string& body, std::int64_t instruction_budget = 200'000) {
   TempDir dir("llsf_budget");
   dir.write("probe.lua", probe_skill(body));
   FakeRobot robot;
-  lua::SkillEngine engine(budget_config(dir), robot);
+  lua::SkillEngineConfig cfg = budget_config(dir);
+  cfg.instruction_budget = instruction_budget;
+  lua::SkillEngine engine(cfg, robot);
   Outcome out;
   engine.set_log_sink([&](lua::LogLevel, std::string_view text) { out.log.emplace_back(text); });
   REQUIRE(engine.skills().size() == 1);
@@ -100,13 +102,13 @@ TEST_CASE("table functions charge the elements they touch to the instruction bud
   CHECK(r.error ==
         "probe: probe.lua:4: instruction budget exhausted (200000 instructions per cycle; "
         "table.move of 1125899906842624 elements)");
-  // Each call is affordable; the loop is not (the count hook alone sees ~5 instructions a call).
+  // Each call is affordable; the loop is not (the count hook alone sees ~20 instructions a call).
   r = run_probe(
-      "  local t = {} for i = 1, 10000 do t[i] = 'x' end\n"
+      "  local t = {string.byte(string.rep('x', 100000), 1, -1)}\n"
       "  for i = 1, 1000 do local s = table.concat(t) end");
   CHECK(contains(r.error,
                  "probe.lua:5: instruction budget exhausted (200000 instructions per "
-                 "cycle; table.concat of 10000 elements)"));
+                 "cycle; table.concat of 100000 elements)"));
   r = run_probe(
       "  local t = {} for i = 1, 10000 do t[i] = i end\n"
       "  for i = 1, 1000 do table.insert(t, 1, i) end");
@@ -245,6 +247,28 @@ TEST_CASE("a skill sees other skills read-only: it can call them, not reach thei
             ": skill 'target' is read-only: cannot set target.execute");
   REQUIRE(engine.exec("target{}"));
   CHECK(engine.cycle() == SkillStatus::kFinal);
+}
+
+TEST_CASE("string positions count for the charges; error objects never show an address") {
+  Outcome r = run_probe(
+      "  local t = {string.byte(string.rep('x', 100000), 1, -1)}\n"
+      "  for i = 1, 1000 do local s = table.concat(t, '', '1', '100000') end");
+  CHECK(contains(r.error,
+                 "probe.lua:5: instruction budget exhausted (200000 instructions per "
+                 "cycle; table.concat of 100000 elements)"));
+  r = run_probe("  error({})");
+  CHECK(r.error == "probe: (error object is a table value)");
+  r = run_probe("  do return S_FAILED, {} end");
+  CHECK(r.error == "probe: (error object is a table value)");
+}
+
+TEST_CASE("an endless loop over a library wrapper is reported at the skill's line") {
+  // The wrappers are prelude code: for some budgets the count hook fires inside them.
+  for (std::int64_t budget = 200'000; budget < 230'000; budget += 1000) {
+    const Outcome r = run_probe("  local t = {} while true do table.unpack(t) end", budget);
+    CHECK(r.error == "probe: probe.lua:4: instruction budget exhausted (" + std::to_string(budget) +
+                         " instructions per cycle; endless loop?)");
+  }
 }
 
 TEST_CASE("a plain execute() skill is reset without an error") {
