@@ -332,6 +332,22 @@ try(string.gsub, s, "o", true) try(string.gsub, s, "l", "L", 0) try(string.gsub,
 try(string.gsub, s, "()", "%1") try(string.gsub, "abc", "", "-") try(string.gsub, "abc", "b*", "-")
 try(string.gsub, "abc", "^a", "x") try(string.gsub, "abc", "^", "x") try(string.gsub, "a", ".", "%0%0%0")
 try(string.find, 12345, 3) try(string.gsub, 12345, 3, 9) try(string.match, "x", nil)
+-- Random patterns and subjects (a fixed linear congruential sequence: the same on both sides).
+local seed = 12345
+local function rnd(n) seed = (seed * 1103515245 + 12345) % 2147483648 return seed % n + 1 end
+local pat_chars = {"a", "b", "%", "(", ")", "[", "]", "^", "$", "*", "+", "-", "?", ".", "1",
+                   "2", "f", "%a", "%d", "%b()", "%f[ab]", "[^a]", "[a-c]", "%1", "()"}
+local subj_chars = {"a", "b", "c", "(", ")", "1", " ", "-", "^", "%", "]"}
+for _ = 1, 2500 do
+  local p, sub = {}, {}
+  for i = 1, rnd(7) do p[i] = pat_chars[rnd(#pat_chars)] end
+  for i = 1, rnd(12) - 1 do sub[i] = subj_chars[rnd(#subj_chars)] end
+  p, sub = table.concat(p), table.concat(sub)
+  try(string.find, sub, p)
+  try(string.match, sub, p, rnd(5) - 2)
+  try(string.gsub, sub, p, "<%0%1>")
+  all(sub, p)
+end
 return table.concat(out, "\n")
 )lua";
 
