@@ -46,7 +46,7 @@ end
 -- Library functions whose work grows with their arguments charge it to the instruction budget
 -- (native.charge raises at the skill's line); string.rep, find, match, gmatch and gsub are the
 -- engine's bounded versions (patterns.cpp). Costs: docs/skills.md, "Sandbox".
-local charge, tointeger = native.charge, math.tointeger
+local charge = native.charge
 local function span(i, j)  -- how many integers i..j (a float: no overflow; "10" counts too)
   i, j = tonumber(i), tonumber(j)
   if not i or not j or j < i then return 0 end

@@ -401,8 +401,6 @@ void SkillEngine::Impl::build() {
   luaL_setfuncs(L, natives, 0);
   lua_pushlstring(L, robot.name().data(), robot.name().size());
   lua_setfield(L, -2, "robot_name");
-  lua_pushinteger(L, static_cast<lua_Integer>(config.memory_limit_bytes));
-  lua_setfield(L, -2, "max_string_bytes");
   lua_createtable(L, 0, 2);
   lua_pushstring(L, config.profile.c_str());
   lua_setfield(L, -2, "name");
