@@ -234,13 +234,35 @@ std::string user_paths(std::string text, const std::string& tmp, const std::stri
 /// A hint for a Lua or skill error message.
 std::string hint_for(const std::string& msg, const std::string& skill) {
   auto has = [&](const char* s) { return msg.find(s) != std::string::npos; };
+  if (has("pattern matching)") || has("plain search)")) {
+    return "a string search that takes too long: a pattern with several `*`, `+` or `-` on a "
+           "long string backtracks a lot; search a shorter string or use a simpler pattern "
+           "(docs/skills.md, \"Sandbox\").";
+  }
+  if (has("instruction budget exhausted (") && has(" elements)")) {
+    return "a table function over too many elements in one cycle (table.move, table.concat, "
+           "table.insert at the front of a long list ...): check its range, or spread the work "
+           "over several cycles.";
+  }
+  if (has("string.rep: result of")) {
+    return "string.rep would build a string bigger than the skill's memory: check its count.";
+  }
+  if (has("allocation budget exhausted")) {
+    return "the skill copies too much memory in one cycle (e.g. `s = s .. x` or s:upper() on a "
+           "big string in a loop): build strings with table.concat, or do less per cycle.";
+  }
+  if (has("is read-only (shared by every skill)")) {
+    return "the libraries (string, table, math, utf8) and the DSL's classes are shared by every "
+           "skill and cannot be changed: use a local variable (local fmt = function ... end).";
+  }
   if (has("instruction budget exhausted")) {
     return "an endless loop: hooks and conditions run once per skill cycle (30 times a second) "
            "and must return quickly. Do not wait in a `while` loop; add a state and a "
            "transition (cond=..., timeout=...) that waits instead.";
   }
   if (has("not enough memory")) {
-    return "the skill used more memory than allowed (64 MiB): a table that grows every cycle?";
+    return "the skill used more memory than allowed (its heap limit): a table that grows every "
+           "cycle?";
   }
   if (has("does not match its file name")) {
     return "the exercise loads your file as the skill '" + skill + "': keep the line name = \"" +

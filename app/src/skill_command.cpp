@@ -107,8 +107,14 @@ int run_skill(const SkillOptions& o, std::ostream& out, std::ostream& err) {
     print_skills(brain, out);
     return kExitOk;
   }
+  // A skill file that does not load is bad input (exit 2), as for `llsfsim exercise`.
   const std::vector<std::string> load_errors = brain.engine().load_errors();
   for (const std::string& e : load_errors) err << "skill file error: " << e << "\n";
+  if (!load_errors.empty()) {
+    err << "llsfsim skill: " << load_errors.size()
+        << " skill file(s) do not load; fix them and run again (nothing was run)\n";
+    return kExitBadInput;
+  }
 
   const std::string robot_name(game.robot(index).name());
   brain.engine().set_log_sink([&](lua::LogLevel level, std::string_view text) {
@@ -205,8 +211,9 @@ Action add_skill_command(CLI::App& app) {
       "  llsfsim skill --list\n"
       "Status lines: [game time] robot STATUS skill-string  -> result; the skill library is "
       "documented in docs/skills.md.\n"
-      "Exit code: 0 every skill succeeded, 1 one failed, 2 bad input (options, skill string or "
-      "file), 3 internal error (a bug: please report it).");
+      "Exit code: 0 every skill succeeded, 1 one failed (also: stopped by a budget of the "
+      "sandbox), 2 bad input (options, skill string, a skill file that does not load), 3 "
+      "internal error (a bug: please report it).");
   app.add_option("skill_strings", o->skill_strings,
                  "Skill strings to run in turn, e.g. 'drive_to{place=\"M3\"}'; stops at the "
                  "first failure");

@@ -23,7 +23,22 @@ extern const char* const kPrelude;
 struct LuaHeap {
   std::int64_t used = 0;
   std::int64_t limit = 0;
+  /// Bytes allocated since the budget was last armed, and how many may be (allocation budget).
+  std::int64_t allocated = 0;
+  std::int64_t budget = 0;
+  /// Set when an allocation was refused for the allocation budget; from then on the running code
+  /// gets kAllocationGrace more bytes (to unwind and report), then nothing.
+  bool exhausted = false;
+  /// Set when an allocation was refused for the heap limit.
+  bool limit_hit = false;
 };
+
+/// Bytes an interpreter may still allocate after its allocation budget ran out (error messages,
+/// the prelude's bookkeeping while the failure unwinds).
+inline constexpr std::int64_t kAllocationGrace = 1 << 20;
+/// The count hook runs every kHookInterval VM instructions (or every instruction_budget
+/// instructions if that is smaller) and adds them to Impl::used.
+inline constexpr std::int64_t kHookInterval = 1000;
 
 /// One skill file as last loaded (for hot reload).
 struct SkillFile {
@@ -44,6 +59,9 @@ struct SkillEngine::Impl {
   int engine_ref = LUA_NOREF;  // the prelude's entry table
   int chunk_ref = LUA_NOREF;   // the compiled skill string
   bool budget_exhausted = false;
+  /// Instructions used since the budget was armed: VM instructions counted by the hook plus the
+  /// work library functions charge (charge()).
+  std::int64_t used = 0;
   std::vector<SkillFile> files;
   int loads = 0;
 
@@ -66,14 +84,28 @@ struct SkillEngine::Impl {
   /// Closes the interpreter and builds a new one with every skill loaded.
   void build();
   void close();
-  /// Starts a fresh instruction budget for the next protected call.
+  /// Starts fresh budgets (instructions, allocation) for the next protected call.
   void arm_budget();
+  /// lua_pcall under fresh budgets; the allocation budget applies only inside.
+  int protected_call(int nargs, int nresults);
   /// Calls the entry `fn` of the prelude with `nargs` arguments already pushed, protected and
   /// under a fresh budget; returns the Lua status (the error message is left on the stack).
   int call_entry(const char* fn, int nargs, int nresults);
   /// Aborts the running skill string: resets every skill (exit hooks run).
   void abort_running();
+  /// "not enough memory" in `msg` explained: the allocation budget that ran out, or the heap limit
+  /// with its figure (for the last protected call).
+  std::string explain(std::string msg) const;
 };
+
+/// Charges `cost` instructions of work done by a library function (`what`, e.g. "table.move of
+/// 10 elements") to the running code's instruction budget; raises the budget error at the Lua
+/// code `level` levels up (1: the caller of the C function running) once it is exhausted.
+void charge(lua_State* L, std::int64_t cost, int level, const char* what);
+
+/// Pushes a table with the bounded string functions rep, find, match, gmatch, gsub
+/// (patterns.cpp).
+void push_pattern_functions(lua_State* L);
 
 /// Registers the robot interfaces: pushes a table type name -> interface object, and sets the
 /// globals the prelude reads from `native` (clock, interface names).

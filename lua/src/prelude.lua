@@ -25,10 +25,97 @@ local function copy(t)
   for k, v in pairs(t) do c[k] = v end
   return c
 end
-base.math, base.table, base.utf8 = copy(math), copy(table), copy(utf8)
-base.string = copy(string)
-base.string.dump = nil
--- Method calls on strings ("x"):format(...) use the sandbox copy; the metatable is hidden.
+
+-- Tables every skill of the robot shares (libraries, the DSL's classes, interfaces) are
+-- read-only proxies: one skill cannot change what another sees (string.format = ...).
+local frozen = setmetatable({}, {__mode = "k"})  -- proxy -> its name
+local function readonly(t, what)
+  local proxy = setmetatable({}, {
+    __index = t,
+    __newindex = function(_, k)
+      error(fmt("%s is read-only (shared by every skill): cannot set %s.%s", what, what,
+                tostring(k)), 2)
+    end,
+    __pairs = function() return next, t, nil end,
+    __len = function() return #t end,
+    __metatable = false})
+  frozen[proxy] = what
+  return proxy
+end
+
+-- Library functions whose work grows with their arguments charge it to the instruction budget
+-- (native.charge raises at the skill's line); string.rep, find, match, gmatch and gsub are the
+-- engine's bounded versions (patterns.cpp). Costs: docs/skills.md, "Sandbox".
+local charge = native.charge
+local function span(i, j)  -- how many integers i..j (a float: no overflow; "10" counts too)
+  i, j = tonumber(i), tonumber(j)
+  if not i or not j or j < i then return 0 end
+  return (j + 0.0) - i + 1
+end
+local function len_of(t) return type(t) == "table" and #t or 0 end
+local raw_table, raw_string, raw_utf8 = table, string, utf8
+local tab = copy(table)
+tab.move = function(a1, f, e, t, a2)
+  local n = span(f, e)
+  charge(n, fmt("table.move of %.0f elements", n))
+  return raw_table.move(a1, f, e, t, a2)
+end
+tab.concat = function(t, sep, i, j)
+  local n = span(i or 1, j or len_of(t))
+  charge(n, fmt("table.concat of %.0f elements", n))
+  return raw_table.concat(t, sep, i, j)
+end
+tab.unpack = function(t, i, j)
+  local n = span(i or 1, j or len_of(t))
+  charge(n, fmt("table.unpack of %.0f elements", n))
+  return raw_table.unpack(t, i, j)
+end
+tab.insert = function(t, ...)
+  if select("#", ...) >= 2 then
+    local n = span((...), len_of(t))
+    charge(n, fmt("table.insert moving %.0f elements", n))
+  end
+  return raw_table.insert(t, ...)
+end
+tab.remove = function(t, ...)
+  if select("#", ...) >= 1 then
+    local n = span((...), len_of(t))
+    charge(n, fmt("table.remove moving %.0f elements", n))
+  end
+  return raw_table.remove(t, ...)
+end
+tab.sort = function(t, comp)
+  local n = len_of(t)
+  if n > 1 then
+    local cost = n * math.ceil(math.log(n, 2))
+    charge(cost, fmt("table.sort of %d elements", n))
+  end
+  return raw_table.sort(t, comp)
+end
+local str = copy(string)
+str.dump = nil
+for k, f in pairs(native.patterns) do str[k] = f end
+str.byte = function(s, i, j)
+  if j ~= nil and type(s) == "string" then charge(#s, fmt("string.byte of %d bytes", #s)) end
+  return raw_string.byte(s, i, j)
+end
+local u8 = copy(utf8)
+for _, k in ipairs{"len", "codepoint", "offset"} do
+  local f = raw_utf8[k]
+  u8[k] = function(s, ...)
+    if type(s) == "string" then charge(#s // 8, fmt("utf8.%s of %d bytes", k, #s)) end
+    return f(s, ...)
+  end
+end
+base.math = readonly(copy(math), "math")
+base.table = readonly(tab, "table")
+base.string = readonly(str, "string")
+base.utf8 = readonly(u8, "utf8")
+base.rawset = function(t, k, v)
+  if frozen[t] then error(fmt("%s is read-only (shared by every skill)", frozen[t]), 2) end
+  return rawset(t, k, v)
+end
+-- Method calls on strings ("x"):format(...) use the sandbox's string; the metatable is hidden.
 local string_mt = getmetatable("")
 string_mt.__index = base.string
 string_mt.__metatable = false
@@ -48,12 +135,15 @@ base.profile = setmetatable({}, {
   __index = native.profile,
   __newindex = function() error("profile is read-only", 2) end,
   __metatable = false})
+frozen[base.profile] = "profile"
 -- Fawkes skill files start with `module(..., skillenv.module_init)` and call
 -- `skillenv.skill_module(_M)` after their declarations; here declarations are checked as they
 -- are assigned, so both are accepted and do nothing.
-base.skillenv = {skill_module = function() end, module_init = function() end}
+base.skillenv = readonly({skill_module = function() end, module_init = function() end},
+                         "skillenv")
 base.module = function() end
 base.clock = native.clock
+frozen[native.clock] = "clock"
 
 local function args_text(...)
   local n = select("#", ...)
@@ -70,14 +160,24 @@ base.printf = function(f, ...) log(1, fmt(f, ...)) end
 
 -- Skill handles (one per skill file, created before any file runs) and the module loading state.
 local handles = {}       -- name -> handle
+local proxies = {}       -- name -> what skills and skill strings see of the handle (read-only)
+local real_of = setmetatable({}, {__mode = "k"})  -- proxy -> handle
 local handle_list = {}   -- handles in load order (deterministic iteration)
 local loading = nil      -- the handle whose file is running
-local interface_types = native.interfaces  -- type name -> interface object
+local interface_types = native.interfaces  -- type name -> interface object (read-only)
+for type_name, obj in pairs(interface_types) do frozen[obj] = type_name end
 local conventional_vars = {pose = "Position3DInterface", navigator = "NavigatorInterface",
                            motor = "MotorInterface", sensor = "RobotinoSensorInterface",
                            light = "RobotinoLightInterface", pucks = "PuckVisionInterface",
                            laser = "Laser360Interface", puck_detector = "ColourPuckInterface",
                            rescue = "RescueInterface"}
+
+-- The text of an error object: tables and other values would show their address (not the same
+-- from one run to the next).
+local function error_text(e)
+  if type(e) == "string" or type(e) == "number" then return tostring(e) end
+  return "(error object is a " .. type(e) .. " value)"
+end
 
 local function where(level)
   local info = debug_getinfo(level + 1, "Sl")
@@ -124,7 +224,7 @@ local function module_env(h)
         end
         if not handles[dep] then error(fmt("depends_skills: unknown skill '%s'", dep), 2) end
         if dep == h.name then error("depends_skills: a skill cannot depend on itself", 2) end
-        h.bindings[dep] = handles[dep]
+        h.bindings[dep] = proxies[dep]
         h.depends[#h.depends + 1] = dep
       end
     elseif k == "depends_interfaces" then
@@ -150,13 +250,15 @@ local function module_env(h)
 end
 
 -- States -------------------------------------------------------------------------------------
-local JumpState = {kind = "jump"}
-local SkillJumpState = {kind = "skill"}
+local JumpState = readonly({kind = "jump"}, "JumpState")
+local SkillJumpState = readonly({kind = "skill"}, "SkillJumpState")
 base.JumpState, base.SkillJumpState = JumpState, SkillJumpState
 
 local SkillHSM = {}
 SkillHSM.__index = SkillHSM
-base.SkillHSM = SkillHSM
+SkillHSM.__metatable = false  -- getmetatable(fsm) must not hand out the shared class
+local fsms = setmetatable({}, {__mode = "k"})  -- every SkillHSM made by SkillHSM:new
+base.SkillHSM = readonly(SkillHSM, "SkillHSM")
 
 local function new_state(fsm, name, kind)
   local st = {name = name, fsm = fsm, kind = kind, transitions = {}, preconds = {}, args = {},
@@ -175,6 +277,7 @@ function SkillHSM:new(o)
                             states = {}, state_list = {}, defaults = {}, vars = {},
                             closure = {}, skill = loading, where = where(2), step_id = 0},
                            SkillHSM)
+  fsms[fsm] = true
   fsm.cond_env = setmetatable(fsm.closure, {__index = loading.env})
   fsm.final = new_state(fsm, "FINAL", "final")
   fsm.failed = new_state(fsm, "FAILED", "failed")
@@ -183,11 +286,9 @@ end
 
 local function resolve_subskill(fsm, spec, lvl)
   local s = spec[1]
-  local h = type(s) == "string" and handles[s] or s
-  if type(h) ~= "table" or not h.is_skill then
-    error(fmt("skills: entry %s is not a skill", tostring(s)), lvl)
-  end
-  if fsm.skill.bindings[h.name] ~= h then
+  local h = type(s) == "string" and handles[s] or real_of[s]
+  if not h then error(fmt("skills: entry %s is not a skill", tostring(s)), lvl) end
+  if fsm.skill.bindings[h.name] ~= proxies[h.name] then
     error(fmt("skill '%s' is used but not declared in depends_skills", h.name), lvl)
   end
   local static = nil
@@ -436,11 +537,11 @@ reset_skill = function(h)
     if fsm and fsm.current and fsm.current.exit and fsm.current.kind ~= "final" and
        fsm.current.kind ~= "failed" then
       local ok, err = raw_pcall(fsm.current.exit, fsm.current)
-      if not ok then log(3, fmt("%s: exit of %s: %s", h.name, fsm.current.name, tostring(err))) end
+      if not ok then log(3, fmt("%s: exit of %s: %s", h.name, fsm.current.name, error_text(err))) end
     end
-    if not h.fsm and h.env.reset then
+    if not h.fsm and rawget(h.env, "reset") then
       local ok, err = raw_pcall(h.env.reset)
-      if not ok then log(3, fmt("%s: reset(): %s", h.name, tostring(err))) end
+      if not ok then log(3, fmt("%s: reset(): %s", h.name, error_text(err))) end
     end
   end
   if h.fsm then
@@ -483,12 +584,12 @@ call_skill = function(h, args)
   caller, h.in_call, depth = outer, false, depth - 1
   if ok then
     h.status = status
-    if status == S_FAILED then h.error = tostring(err or "failed") end
+    if status == S_FAILED then h.error = err == nil and "failed" or error_text(err) end
     return status
   end
   local running = h.fsm and h.fsm.running
   h.status = S_FAILED
-  h.error = running and (running.name .. ": " .. tostring(status)) or tostring(status)
+  h.error = running and (running.name .. ": " .. error_text(status)) or error_text(status)
   if h.fsm then
     h.fsm.error = h.error
     h.fsm.current = h.fsm.failed
@@ -509,6 +610,23 @@ handle_mt.__call = function(h, args)
   return call_skill(h, args)
 end
 
+-- Skills see a read-only proxy of each handle: they can call it, reset it and read its name,
+-- status and error, but not reach or change another skill's state machine or environment.
+local visible = {name = true, is_skill = true, status = true, error = true, documentation = true}
+local proxy_mt = {__metatable = false}
+proxy_mt.__index = function(p, k)
+  local h = real_of[p]
+  if k == "reset" then return function() reset_skill(h) end end
+  if visible[k] then return h[k] end
+  return nil
+end
+proxy_mt.__newindex = function(p, k)
+  local name = real_of[p].name
+  error(fmt("skill '%s' is read-only: cannot set %s.%s", name, name, tostring(k)), 2)
+end
+proxy_mt.__call = function(p, args) return handle_mt.__call(real_of[p], args) end
+proxy_mt.__tostring = function(p) return "skill " .. real_of[p].name end
+
 -- Entry points for the C++ engine ------------------------------------------------------------
 local E = {}
 
@@ -519,6 +637,10 @@ function E.declare_skills(names)
                            handle_mt)
     handles[name] = h
     handle_list[#handle_list + 1] = h
+    local p = setmetatable({}, proxy_mt)
+    real_of[p] = h
+    proxies[name] = p
+    frozen[p] = "skill " .. name
   end
 end
 
@@ -542,7 +664,7 @@ function E.finish_module(name)
   end
   local fsm = rawget(env, "fsm")
   if fsm ~= nil then
-    if getmetatable(fsm) ~= SkillHSM then fail("'fsm' must be a SkillHSM") end
+    if not fsms[fsm] then fail("'fsm' must be a SkillHSM") end
     if not fsm.states[fsm.start] then
       error(fmt("%s: start state '%s' is not defined", fsm.where, fsm.start), 0)
     end
@@ -587,7 +709,7 @@ end
 
 local string_env = setmetatable({}, {
   __index = function(t, k)
-    local v = handles[k] or base[k]
+    local v = proxies[k] or base[k]
     if v == nil then error(fmt("unknown skill '%s'", tostring(k)), 2) end
     rawset(t, k, v)
     return v

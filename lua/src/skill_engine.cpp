@@ -6,9 +6,11 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <sstream>
 #include <system_error>
 
@@ -52,6 +54,10 @@ void SkillEngineConfig::validate() const {
     throw core::ConfigError("skill engine: memory_limit_bytes must be >= 1 MiB, got " +
                             std::to_string(memory_limit_bytes));
   }
+  if (allocation_budget_bytes < (1LL << 20)) {
+    throw core::ConfigError("skill engine: allocation_budget_bytes must be >= 1 MiB, got " +
+                            std::to_string(allocation_budget_bytes));
+  }
   for (const std::string& dir : skill_dirs) {
     std::error_code ec;
     if (!fs::is_directory(dir, ec)) {
@@ -77,6 +83,7 @@ SkillEngineConfig SkillEngineConfig::from_config(const core::ConfigNode& node,
   node.read("rate_hz", cfg.rate_hz);
   node.read("instruction_budget", cfg.instruction_budget);
   node.read("memory_limit_bytes", cfg.memory_limit_bytes);
+  node.read("allocation_budget_bytes", cfg.allocation_budget_bytes);
   node.read("hot_reload", cfg.hot_reload);
   std::int64_t seed = 0;
   node.read("random_seed", seed);
@@ -95,7 +102,10 @@ SkillEngineConfig SkillEngineConfig::from_config(const core::ConfigNode& node,
 
 namespace {
 
-// Allocator with a heap limit: refusing an allocation makes Lua raise "not enough memory".
+constexpr const char* kPreludeChunkName = "=llsf/prelude.lua";
+
+// Allocator with a heap limit and an allocation budget: refusing an allocation makes Lua raise
+// "not enough memory" (Impl::explain() names the budget in the message).
 void* limited_alloc(void* ud, void* ptr, std::size_t osize, std::size_t nsize) {
   auto* heap = static_cast<LuaHeap*>(ud);
   const std::int64_t old_size = ptr != nullptr ? static_cast<std::int64_t>(osize) : 0;
@@ -105,9 +115,24 @@ void* limited_alloc(void* ud, void* ptr, std::size_t osize, std::size_t nsize) {
     return nullptr;
   }
   const std::int64_t grow = static_cast<std::int64_t>(nsize) - old_size;
-  if (grow > 0 && heap->used + grow > heap->limit) return nullptr;
+  if (grow > 0) {
+    if (heap->used + grow > heap->limit) {
+      heap->limit_hit = true;
+      return nullptr;
+    }
+    if (heap->budget > 0 && heap->allocated + grow > heap->budget) {
+      if (!heap->exhausted) {
+        heap->exhausted = true;
+        heap->budget = heap->allocated + kAllocationGrace;
+      }
+      return nullptr;
+    }
+  }
   void* p = std::realloc(ptr, nsize);
-  if (p != nullptr) heap->used += grow;
+  if (p != nullptr) {
+    heap->used += grow;
+    if (grow > 0) heap->allocated += grow;
+  }
   return p;
 }
 
@@ -118,22 +143,46 @@ int panic(lua_State* L) {
   return 0;
 }
 
-// Count hook: the cycle used up its instruction budget. Names the running code's file:line.
+std::int64_t hook_interval(const SkillEngineConfig& config) {
+  return std::min(config.instruction_budget, kHookInterval);
+}
+
+// Count hook, every hook_interval() instructions: once the cycle used up its instruction budget,
+// an error naming the running code's file:line. The count starts again from 0, so the code that
+// catches it (the prelude) has a whole budget to unwind.
 void budget_hook(lua_State* L, lua_Debug* ar) {
   SkillEngine::Impl& e = SkillEngine::Impl::of(L);
+  e.used += hook_interval(e.config);
+  if (e.used < e.config.instruction_budget) return;
+  e.used = 0;
   e.budget_exhausted = true;
+  // Name the skill's line: the hook may fire in the prelude's code (a library wrapper, the DSL
+  // runtime) running on the skill's behalf; then the nearest caller outside the prelude.
   lua_getinfo(L, "Sl", ar);
+  lua_Debug caller{};
+  for (int level = 1;
+       std::strcmp(ar->source, kPreludeChunkName) == 0 && lua_getstack(L, level, &caller) != 0;
+       ++level) {
+    lua_getinfo(L, "Sl", &caller);
+    if (caller.currentline > 0 && std::strcmp(caller.source, kPreludeChunkName) != 0) {
+      ar = &caller;
+    }
+  }
   lua_pushfstring(
       L, "%s:%d: instruction budget exhausted (%I instructions per cycle; endless loop?)",
       ar->short_src, ar->currentline, static_cast<LUA_INTEGER>(e.config.instruction_budget));
   lua_error(L);
 }
 
+bool any_budget_exhausted(const SkillEngine::Impl& e) {
+  return e.budget_exhausted || e.heap.exhausted;
+}
+
 // pcall for skills: like the standard one, but an exhausted budget cannot be caught.
 int sandbox_pcall(lua_State* L) {
   luaL_checkany(L, 1);
   const int status = lua_pcall(L, lua_gettop(L) - 1, LUA_MULTRET, 0);
-  if (status != LUA_OK && SkillEngine::Impl::of(L).budget_exhausted) return lua_error(L);
+  if (status != LUA_OK && any_budget_exhausted(SkillEngine::Impl::of(L))) return lua_error(L);
   lua_pushboolean(L, status == LUA_OK);
   lua_insert(L, 1);
   return lua_gettop(L);
@@ -145,8 +194,21 @@ int native_now_ns(lua_State* L) {
 }
 
 int native_exhausted(lua_State* L) {
-  lua_pushboolean(L, SkillEngine::Impl::of(L).budget_exhausted);
+  lua_pushboolean(L, any_budget_exhausted(SkillEngine::Impl::of(L)) ? 1 : 0);
   return 1;
+}
+
+// charge(cost, what): the prelude's library wrappers charge `cost` instructions of work; an
+// exhausted budget is reported at the wrapper's caller (the skill's line).
+int native_charge(lua_State* L) {
+  const lua_Number cost = luaL_checknumber(L, 1);
+  const char* what = luaL_checkstring(L, 2);
+  // Costs beyond any budget (e.g. 2^60 elements) are clamped; NaN charges nothing.
+  const std::int64_t c = cost >= 9.0e18 ? std::numeric_limits<std::int64_t>::max()
+                         : cost > 0.0   ? static_cast<std::int64_t>(cost)
+                                        : 0;
+  charge(L, c, 2, what);
+  return 0;
 }
 
 int native_log(lua_State* L) {
@@ -208,8 +270,53 @@ void SkillEngine::Impl::close() {
 
 void SkillEngine::Impl::arm_budget() {
   budget_exhausted = false;
-  lua_sethook(L, budget_hook, LUA_MASKCOUNT,
-              static_cast<int>(std::min<std::int64_t>(config.instruction_budget, 1'000'000'000)));
+  used = 0;
+  heap.allocated = 0;
+  heap.budget = config.allocation_budget_bytes;
+  heap.exhausted = false;
+  heap.limit_hit = false;
+  lua_sethook(L, budget_hook, LUA_MASKCOUNT, static_cast<int>(hook_interval(config)));
+}
+
+int SkillEngine::Impl::protected_call(int nargs, int nresults) {
+  arm_budget();
+  const int rc = lua_pcall(L, nargs, nresults, 0);
+  // Outside protected calls nothing may be refused for the budget (an unprotected error would
+  // panic); the flag stays for explain().
+  heap.budget = 0;
+  return rc;
+}
+
+std::string SkillEngine::Impl::explain(std::string msg) const {
+  if (!heap.exhausted && !heap.limit_hit) return msg;
+  const std::string_view oom = "not enough memory";
+  const std::size_t at = msg.find(oom);
+  if (at == std::string::npos) return msg;
+  if (heap.exhausted) {
+    return msg.replace(at, oom.size(),
+                       "allocation budget exhausted (" +
+                           std::to_string(config.allocation_budget_bytes) +
+                           " bytes allocated per cycle; copying big strings in a loop?)");
+  }
+  return msg.replace(
+      at, oom.size(),
+      "not enough memory (heap limit of " + std::to_string(config.memory_limit_bytes) + " bytes)");
+}
+
+void charge(lua_State* L, std::int64_t cost, int level, const char* what) {
+  SkillEngine::Impl& e = SkillEngine::Impl::of(L);
+  if (cost <= 0) return;
+  if (cost <= e.config.instruction_budget - e.used) {
+    e.used += cost;
+    return;
+  }
+  e.used = 0;
+  e.budget_exhausted = true;
+  luaL_where(L, level);
+  lua_pushfstring(L, "instruction budget exhausted (%I instructions per cycle; %s)",
+                  static_cast<LUA_INTEGER>(e.config.instruction_budget), what);
+  lua_concat(L, 2);
+  lua_error(L);
 }
 
 int SkillEngine::Impl::call_entry(const char* fn, int nargs, int nresults) {
@@ -217,8 +324,7 @@ int SkillEngine::Impl::call_entry(const char* fn, int nargs, int nresults) {
   lua_getfield(L, -1, fn);
   lua_remove(L, -2);
   lua_insert(L, -(nargs + 1));
-  arm_budget();
-  return lua_pcall(L, nargs, nresults, 0);
+  return protected_call(nargs, nresults);
 }
 
 std::vector<SkillFile> SkillEngine::Impl::scan() const {
@@ -284,16 +390,14 @@ void SkillEngine::Impl::build() {
   lua_pop(L, 1);
 
   // The prelude gets the natives and returns the engine's entry table.
-  if (luaL_loadbufferx(L, kPrelude, std::char_traits<char>::length(kPrelude), "=llsf/prelude.lua",
+  if (luaL_loadbufferx(L, kPrelude, std::char_traits<char>::length(kPrelude), kPreludeChunkName,
                        "t") != LUA_OK) {
     LLSF_DEMAND_MSG(false, "prelude: " + pop_message(L));
   }
   lua_newtable(L);
-  const luaL_Reg natives[] = {{"now_ns", native_now_ns},
-                              {"exhausted", native_exhausted},
-                              {"log", native_log},
-                              {"pcall", sandbox_pcall},
-                              {nullptr, nullptr}};
+  const luaL_Reg natives[] = {{"now_ns", native_now_ns}, {"exhausted", native_exhausted},
+                              {"log", native_log},       {"pcall", sandbox_pcall},
+                              {"charge", native_charge}, {nullptr, nullptr}};
   luaL_setfuncs(L, natives, 0);
   lua_pushlstring(L, robot.name().data(), robot.name().size());
   lua_setfield(L, -2, "robot_name");
@@ -304,8 +408,9 @@ void SkillEngine::Impl::build() {
   lua_setfield(L, -2, "stuck_detection");
   lua_setfield(L, -2, "profile");
   push_interfaces(L);  // sets native.interfaces, interface_names, clock
-  arm_budget();
-  if (lua_pcall(L, 1, 1, 0) != LUA_OK) LLSF_DEMAND_MSG(false, "prelude: " + pop_message(L));
+  push_pattern_functions(L);
+  lua_setfield(L, -2, "patterns");
+  if (protected_call(1, 1) != LUA_OK) LLSF_DEMAND_MSG(false, "prelude: " + pop_message(L));
   engine_ref = luaL_ref(L, LUA_REGISTRYINDEX);
 
   // Handles for every skill first, so that depends_skills can be checked while files load.
@@ -334,17 +439,16 @@ void SkillEngine::Impl::build() {
       } else {
         const std::string chunkname = "@" + f.path;
         if (luaL_loadbufferx(L, text.data(), text.size(), chunkname.c_str(), "t") != LUA_OK) {
-          load_error = pop_message(L);
+          load_error = explain(pop_message(L));
           lua_pop(L, 1);  // the module env
         } else {
           lua_insert(L, -2);                      // chunk, env
           LLSF_DEMAND(lua_setupvalue(L, -2, 1));  // _ENV = env
-          arm_budget();
-          if (lua_pcall(L, 0, 0, 0) != LUA_OK) {
-            load_error = pop_message(L);
+          if (protected_call(0, 0) != LUA_OK) {
+            load_error = explain(pop_message(L));
           } else {
             lua_pushstring(L, f.name.c_str());
-            if (call_entry("finish_module", 1, 0) != LUA_OK) load_error = pop_message(L);
+            if (call_entry("finish_module", 1, 0) != LUA_OK) load_error = explain(pop_message(L));
           }
         }
       }
@@ -430,12 +534,12 @@ SkillStatus SkillEngine::cycle() {
   lua_rawgeti(e.L, LUA_REGISTRYINDEX, e.chunk_ref);
   if (e.call_entry("run_cycle", 1, 3) != LUA_OK) {
     e.status = SkillStatus::kFailed;
-    e.error = pop_message(e.L);
+    e.error = e.explain(pop_message(e.L));
   } else {
     const lua_Integer s = lua_tointeger(e.L, -3);
     e.status = static_cast<SkillStatus>(std::clamp<lua_Integer>(s, 0, 3));
     if (e.status == SkillStatus::kFailed) {
-      e.error = lua_isstring(e.L, -2) ? lua_tostring(e.L, -2) : "FAILED";
+      e.error = e.explain(lua_isstring(e.L, -2) ? lua_tostring(e.L, -2) : "FAILED");
     }
     if (e.status != SkillStatus::kRunning) {
       const char* r = lua_tostring(e.L, -1);

@@ -121,6 +121,43 @@ end
         0);
 }
 
+TEST_CASE("exercise: work the count hook cannot see is stopped at file:line with a hint, exit 1") {
+  struct Bomb {
+    const char* line;
+    const char* error;
+    const char* hint;
+  };
+  const Bomb bombs[] = {
+      {"string.find(string.rep('a', 30000), 'a*a*a*a*a*b')",
+       ":7: instruction budget exhausted (1000000 instructions per cycle; string.find: pattern "
+       "matching)",
+       "hint     a string search that takes too long"},
+      {"table.move({}, 1, 2^50, 2)",
+       ":7: instruction budget exhausted (1000000 instructions per cycle; table.move of "
+       "1125899906842624 elements)",
+       "hint     a table function over too many elements"},
+      {"local s = string.rep('', 2^50) .. string.rep('x', 2^40)",
+       ":7: string.rep: result of 1099511627776 bytes over the limit of", "hint     string.rep"},
+      {"string.format = nil", ":7: string is read-only (shared by every skill)",
+       "hint     the libraries"},
+  };
+  for (const Bomb& b : bombs) {
+    const std::string path = write_temp("llsfex_bomb.lua", std::string(R"lua(name = "drive_to_point"
+fsm = SkillHSM:new{name=name, start="S"}
+documentation = [==[x]==]
+fsm:define_states{ export_to=_M, {"S", JumpState} }
+fsm:add_transitions{ {"S", "FINAL", cond="vars.done"} }
+function S:loop()
+   )lua") + b.line + "\nend\n");
+    const Run r = llsfsim({"exercise", "01", "--skill", path});
+    INFO(b.line, "\n", r.out, r.err);
+    CHECK(r.code == llsf::app::kExitFailed);
+    CHECK(has(r.out, "error    " + path + b.error));
+    CHECK(has(r.out, b.hint));
+    CHECK(has(r.out, "result   FAIL"));
+  }
+}
+
 TEST_CASE("exercise: a runtime error names file:line with a hint; bad input exits 2") {
   const std::string path = write_temp("llsfex_nil.lua", R"lua(name = "drive_to_point"
 fsm = SkillHSM:new{name=name, start="S"}

@@ -66,6 +66,30 @@ TEST_CASE("llsfsim skill: a failing skill exits 1 with its reason; bad input exi
   CHECK(r.code == llsf::app::kExitBadInput);
 }
 
+TEST_CASE("llsfsim skill: a skill file that does not load exits 2; an exhausted budget exits 1") {
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("llsf_skill_cmd_" +
+                    std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "broken.lua") << "name = 'broken'\ndocumentation = 'x'\nfunction execute(\n";
+  Run r = llsfsim({"skill", "--skills", dir.string(), "get_s0{}"});
+  INFO(r.out, r.err);
+  CHECK(r.code == llsf::app::kExitBadInput);
+  CHECK(has(r.err, "broken.lua:4:"));
+  CHECK(has(r.err, "1 skill file(s) do not load"));
+  r = llsfsim({"skill", "--skills", dir.string(), "--list"});
+  CHECK(r.code == llsf::app::kExitOk);
+  CHECK(has(r.out, "LOAD ERROR"));
+
+  std::filesystem::remove(dir / "broken.lua");
+  std::ofstream(dir / "bomb.lua") << "name = 'bomb'\ndocumentation = 'x'\n"
+                                     "function execute() table.move({}, 1, 2^50, 2) end\n";
+  r = llsfsim({"skill", "--skills", dir.string(), "bomb{}"});
+  CHECK(r.code == llsf::app::kExitFailed);
+  CHECK(has(r.out, "bomb.lua:3: instruction budget exhausted"));
+  std::filesystem::remove_all(dir);
+}
+
 TEST_CASE("llsfsim --help, skill --help and skill --list") {
   Run r = llsfsim({"--help"});
   CHECK(r.code == 0);

@@ -217,14 +217,16 @@ TEST_CASE("the sandbox: no files, processes, network, debug, bytecode or finaliz
   CHECK_FALSE(engine.exec(std::string("\x1bLua", 4)).ok);  // binary chunks are refused
 }
 
-TEST_CASE("the heap limit fails a skill that allocates too much") {
+TEST_CASE("string.rep beyond the heap limit fails the skill at its line; the engine goes on") {
   FakeRobot robot;
   lua::SkillEngineConfig cfg = config();
   cfg.memory_limit_bytes = 16 << 20;
   lua::SkillEngine engine(cfg, robot);
   REQUIRE(engine.exec("memory_hog{}"));
   CHECK(engine.cycle() == SkillStatus::kFailed);
-  CHECK(contains(engine.error(), "not enough memory"));
+  CHECK(contains(engine.error(), test::marked_line(test_skill("memory_hog")) +
+                                     ": string.rep: result of 1073741824 bytes over the limit of "
+                                     "16777216 bytes"));
   REQUIRE(engine.exec("say_hello{}"));
   CHECK(engine.cycle() == SkillStatus::kFinal);
 }
@@ -312,15 +314,22 @@ TEST_CASE("bad configurations throw ConfigError naming the field") {
   cfg = config();
   cfg.instruction_budget = 10;
   CHECK_THROWS_AS(lua::SkillEngine(cfg, robot), core::ConfigError);
+  cfg = config();
+  cfg.allocation_budget_bytes = 1000;
+  CHECK_THROWS_WITH_AS(lua::SkillEngine(cfg, robot),
+                       doctest::Contains("allocation_budget_bytes must be >= 1 MiB"),
+                       core::ConfigError);
 
   const core::ConfigNode node = core::ConfigNode::parse(
       "skills:\n  skill_dirs: [" + test::example_skills_dir() +
-          "]\n  rate_hz: 15\n  instruction_budget: 5000\n  hot_reload: false\n",
+          "]\n  rate_hz: 15\n  instruction_budget: 5000\n  allocation_budget_bytes: 2000000\n"
+          "  hot_reload: false\n",
       "robot.yaml");
   const lua::SkillEngineConfig parsed = lua::SkillEngineConfig::from_config(node["skills"]);
   CHECK(parsed.skill_dirs == std::vector<std::string>{test::example_skills_dir()});
   CHECK(parsed.rate_hz == 15.0);
   CHECK(parsed.instruction_budget == 5000);
+  CHECK(parsed.allocation_budget_bytes == 2'000'000);
   CHECK_FALSE(parsed.hot_reload);
   const core::ConfigNode bad = core::ConfigNode::parse("skills:\n  rate: 15\n", "robot.yaml");
   CHECK_THROWS_WITH_AS(lua::SkillEngineConfig::from_config(bad["skills"]),

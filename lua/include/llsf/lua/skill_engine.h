@@ -32,10 +32,15 @@ struct SkillEngineConfig {
   std::vector<std::string> skill_dirs;
   /// Rate at which `sim/` calls cycle(), in simulated Hz (the engine itself never waits).
   double rate_hz = 30.0;
-  /// Lua VM instructions one cycle (or loading one file) may execute; beyond, the skill fails.
+  /// Lua VM instructions one cycle (or loading one file) may execute, counted in steps of 1000,
+  /// plus the work library functions charge (docs/skills.md, "Sandbox"); beyond, the skill fails.
   std::int64_t instruction_budget = 1'000'000;
   /// Heap limit of the interpreter in bytes; allocations beyond fail with "not enough memory".
+  /// Also the largest string string.rep may build.
   std::int64_t memory_limit_bytes = 64LL << 20;
+  /// Bytes one cycle (or loading one file) may allocate in all (freed memory counts too): bounds
+  /// the time spent copying big strings, e.g. `s .. s` or `s:upper()` in a loop.
+  std::int64_t allocation_budget_bytes = 256LL << 20;
   /// Reload skill files that changed (mtime or size) when a new skill string is executed.
   bool hot_reload = true;
   /// Seed of `math.random` inside the interpreter (e.g. from rng.stream("lua/robot1")).
@@ -48,10 +53,10 @@ struct SkillEngineConfig {
 
   /// Throws core::ConfigError naming the bad field.
   void validate() const;
-  /// Reads `skill_dirs`, `rate_hz`, `instruction_budget`, `memory_limit_bytes`, `hot_reload`,
-  /// `random_seed` from a map node (unknown keys are errors). Relative dirs are taken relative
-  /// to `base_dir` (e.g. the scenario file's directory); with no `base_dir` they stay as written
-  /// (relative to the working directory).
+  /// Reads `skill_dirs`, `rate_hz`, `instruction_budget`, `memory_limit_bytes`,
+  /// `allocation_budget_bytes`, `hot_reload`, `random_seed` from a map node (unknown keys are
+  /// errors). Relative dirs are taken relative to `base_dir` (e.g. the scenario file's directory);
+  /// with no `base_dir` they stay as written (relative to the working directory).
   static SkillEngineConfig from_config(const core::ConfigNode& node,
                                        const std::string& base_dir = {});
 };

@@ -1,0 +1,10 @@
+-- SPDX-License-Identifier: MIT
+-- Hostile exercise skill: string.rep of 2^40 bytes
+name = "drive_to_point"
+fsm = SkillHSM:new{name=name, start="S"}
+documentation = [==[hostile]==]
+fsm:define_states{ export_to=_M, {"S", JumpState} }
+fsm:add_transitions{ {"S", "FINAL", cond="vars.done"} }
+function S:loop()
+   local s = string.rep("x", 2^40)
+end

@@ -1,0 +1,10 @@
+-- SPDX-License-Identifier: MIT
+-- Hostile exercise skill: changing the shared string library
+name = "drive_to_point"
+fsm = SkillHSM:new{name=name, start="S"}
+documentation = [==[hostile]==]
+fsm:define_states{ export_to=_M, {"S", JumpState} }
+fsm:add_transitions{ {"S", "FINAL", cond="vars.done"} }
+function S:loop()
+   string.format = print
+end
