@@ -622,7 +622,7 @@ void ConfigNode::fail_at(std::string_view rel, const std::string& reason) const 
                     reason);
 }
 
-void ConfigNode::relocate(const ConfigError& e, std::span<const PathRename> renames) const {
+void ConfigNode::relocate(const ConfigError& e) const {
   const std::string what = e.what();
   const std::size_t colon = what.find(": ");
   const std::string_view head = std::string_view(what).substr(0, colon);
@@ -630,34 +630,7 @@ void ConfigNode::relocate(const ConfigError& e, std::span<const PathRename> rena
       colon != std::string::npos && !head.empty() &&
       std::all_of(head.begin(), head.end(), [](char ch) { return is_path_char(ch); });
   if (!is_path) throw ConfigError(location() + ": " + what);
-  // The renamed path that the document has, else the one that reaches deepest into it.
-  std::string path(head);
-  std::optional<std::size_t> best;  // how deep the best candidate reaches into the document
-  for (const PathRename& r : renames) {
-    if (r.from.empty() || !head.starts_with(r.from)) continue;
-    const std::string_view rest = head.substr(r.from.size());
-    if (!rest.empty() && r.from.back() != '[' && rest.front() != '.' && rest.front() != '[') {
-      continue;  // "game.skill" does not start "game.skill_rate_hz"
-    }
-    std::string renamed(r.to);
-    renamed += renamed.empty() && !rest.empty() && rest.front() == '.' ? rest.substr(1) : rest;
-    std::string want = impl_->path;
-    if (!want.empty() && !renamed.empty() && renamed.front() != '[') want += ".";
-    want += renamed;
-    const std::string found = resolve(renamed).path();
-    if (found == want) {
-      path = renamed;
-      break;
-    }
-    // Depth in keys and indices: on a tie the earlier rename wins.
-    const auto depth = static_cast<std::size_t>(
-        std::count_if(found.begin(), found.end(), [](char ch) { return ch == '.' || ch == '['; }));
-    if (!best || depth > *best) {
-      best = depth;
-      path = renamed;
-    }
-  }
-  fail_at(path, what.substr(colon + 2));
+  fail_at(head, what.substr(colon + 2));
 }
 
 }  // namespace llsf::core
