@@ -27,6 +27,7 @@
 #include "llsf/app/cli.h"
 #include "llsf/clips/agent.h"
 #include "llsf/core/error.h"
+#include "llsf/core/input_file.h"
 #include "llsf/core/text.h"
 #include "llsf/sim/agent_brain.h"
 #include "llsf/sim/driver.h"
@@ -346,10 +347,9 @@ struct AgentSource {
 std::vector<AgentSource> read_agent_sources(const std::vector<std::string>& entries) {
   std::vector<AgentSource> out;
   for (const std::string& f : sim::agent_files(entries)) {
-    std::ifstream in(f, std::ios::binary);
-    std::ostringstream text;
-    text << in.rdbuf();
-    AgentSource src{f, text.str()};
+    std::string error;  // reported when the agent loads
+    AgentSource src{
+        f, core::try_read_input_file(f, core::kMaxSourceBytes, "CLIPS file", error).value_or("")};
     bool in_string = false;
     bool comment = false;
     for (char& c : src.code) {

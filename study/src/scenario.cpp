@@ -16,6 +16,7 @@
 
 #include "llsf/comm/hub_config.h"
 #include "llsf/core/error.h"
+#include "llsf/core/input_file.h"
 #include "llsf/kinematic/world_config.h"
 #include "llsf/planner/config.h"
 #include "llsf/refbox/config.h"
@@ -31,11 +32,7 @@ namespace fs = std::filesystem;
 constexpr core::SimTime kHackathonDefaultDuration = core::SimTime::from_sec(300);
 
 std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw core::ConfigError(path + ": cannot read the scenario file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
+  return core::read_input_file(path, core::kMaxSourceBytes, "scenario file");
 }
 
 /// A path of the scenario, relative to its directory unless absolute.
