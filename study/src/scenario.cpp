@@ -501,9 +501,6 @@ Scenario read_scenario_map(const core::ConfigNode& root, const std::string& file
 }
 
 ScenarioFile load_scenario(const std::string& path) {
-  if (std::error_code ec; fs::is_directory(path, ec)) {
-    throw core::ConfigError(path + ": is a directory, expected a scenario file");
-  }
   const std::string text = read_text(path);
   // A test hook, not for users: a deliberate bug (std::logic_error) when LLSF_TEST_INTERNAL_ERROR
   // is set, so that tests/app/exit_code_test.cpp sees llsfsim tell a bug (exit code 3) from bad

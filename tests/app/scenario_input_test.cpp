@@ -76,7 +76,7 @@ TEST_CASE("check, run and batch: a directory given as the scenario is named as s
     const Run r = llsfsim(args);
     INFO(args.front() << ": " << r.err);
     CHECK(r.code == llsf::app::kExitBadInput);
-    CHECK(has(r.err, d + ": is a directory, expected a scenario file"));
+    CHECK(has(r.err, d + ": not a regular file (a directory); the scenario file must be one"));
   }
 }
 

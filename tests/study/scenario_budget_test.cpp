@@ -162,7 +162,8 @@ TEST_CASE("scenario budgets: two matrix variants of one name are refused with bo
 TEST_CASE("scenario budgets: a directory is not a scenario file") {
   std::filesystem::create_directories(temp().path / "a-dir");
   const std::string p = (temp().path / "a-dir").string();
-  CHECK(error_of(p) == p + ": is a directory, expected a scenario file");
+  // core::read_input_file() says what it is (a regular file only: docs/security.md).
+  CHECK(error_of(p) == p + ": not a regular file (a directory); the scenario file must be one");
 }
 
 TEST_CASE("scenario budgets: an agent directory without .clp files is refused at its key") {
