@@ -164,12 +164,13 @@ struct AgentHost::Impl {
   }
 
   // Output arrives in pieces; complete lines go to the sink, werror is collected as an error.
-  // Both are bounded: error text past kMaxErrorText is dropped, and a line longer than
+  // Both are bounded: error text beyond kMaxErrorText loses its middle, and a line longer than
   // max_string_length is logged in pieces of that size (a loop printing without a newline).
   void on_output(std::string_view name, std::string_view text) {
     if (name == "werror") {
-      if (werror.size() < kMaxErrorText)
-        werror.append(text.substr(0, kMaxErrorText - werror.size()));
+      werror.append(text);
+      if (werror.size() > kMaxErrorText)  // keep the cause (head) and the halted rule (tail)
+        werror.erase(kMaxErrorText / 2, werror.size() - kMaxErrorText);
       return;
     }
     const LogLevel level = level_of(name);

@@ -504,7 +504,7 @@ struct Environment::SizeGuard {
       return quoted && d.type == STRING ? 2 * n + 2 : n;
     }
     std::int64_t n = 2;
-    for (long i = d.begin; i <= d.end; ++i) {
+    for (long i = GetDOBegin(d), end = GetDOEnd(d); i <= end; ++i) {  // 1-based
       const std::int64_t len = text_length(GetMFType(d.value, i), GetMFValue(d.value, i));
       n += 1 + (quoted && GetMFType(d.value, i) == STRING ? 2 * len + 2 : len);
     }
