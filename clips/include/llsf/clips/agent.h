@@ -89,7 +89,7 @@ struct AgentConfig {
   /// The memory budget (docs/clips.md, "Budgets"): the bytes CLIPS may hold for this agent
   /// (facts, strings, multifields, rules; CLIPS' own count, EnvMemUsed). Checked at every step of
   /// the work budget: past it, the running rule's actions stop as above (while the agent holds
-  /// more, every cycle stops at its first step). The shipped agents hold about 3 MB.
+  /// more, every cycle stops at its first step). The shipped LLSF 2013 agent holds at most 2 MB.
   std::int64_t max_memory_bytes = 128LL << 20;
   /// The largest string (characters) and multifield (fields) that one call of str-cat, sym-cat,
   /// implode$, format, printout (what one call prints), create$, insert$, replace$, explode$ or
