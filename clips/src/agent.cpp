@@ -109,6 +109,7 @@ struct AgentHost::Impl {
   int limit_hits = 0;
   std::int64_t rules_fired = 0;
   std::string werror;         // CLIPS error output not yet reported
+  std::string werror_rule;    // the rule whose actions ran when `werror` began ("" if none)
   std::string lines[4];       // partial output lines per level
   std::string budget_reason;  // set when the work budget stopped the cycle
   std::unordered_map<std::string, std::string> rule_places;      // defrule name -> "file:line"
@@ -168,6 +169,9 @@ struct AgentHost::Impl {
   // max_string_length is logged in pieces of that size (a loop printing without a newline).
   void on_output(std::string_view name, std::string_view text) {
     if (name == "werror") {
+      // The rule running when the error text began: named even when CLIPS does not halt it
+      // (a build or undeftemplate that fails only returns FALSE).
+      if (werror.empty()) werror_rule = env.executing_rule();
       werror.append(text);
       if (werror.size() > kMaxErrorText)  // keep the cause (head) and the halted rule (tail)
         werror.erase(kMaxErrorText / 2, werror.size() - kMaxErrorText);
@@ -212,6 +216,7 @@ struct AgentHost::Impl {
       // Keep the cause; the "execution halted" line only names the rule.
       if (auto first = text.find("[PRCCODE4]"); first > 0) text = text.substr(0, first);
     }
+    if (rule.empty()) rule = werror_rule;
     std::string msg = one_line(text);
     if (!budget_reason.empty()) {
       msg = budget_reason;

@@ -800,6 +800,12 @@ void Environment::start_budget(std::int64_t max_steps, double max_wall_s, int ma
   budget_start_ = std::chrono::steady_clock::now();
 }
 
+std::string Environment::executing_rule() const {
+  struct defrule* rule = EngineData(env_)->ExecutingRule;
+  const char* name = rule != nullptr ? EnvGetDefruleName(env_, rule) : nullptr;
+  return name != nullptr ? std::string(name) : std::string();
+}
+
 std::string Environment::next_rule() const {
   void* act = EnvGetNextActivation(env_, nullptr);
   if (act == nullptr) return {};

@@ -188,6 +188,8 @@ class Environment {
   const std::string& budget_function() const { return budget_function_; }
   /// With kMemory: the bytes CLIPS held when the memory budget stopped execution.
   std::int64_t budget_memory() const { return budget_memory_; }
+  /// The rule whose actions are running now, or "" outside of a rule's actions.
+  std::string executing_rule() const;
   /// The rule of the first activation on the agenda, or "" if it is empty.
   std::string next_rule() const;
   /// True if the current focus has activations left.
