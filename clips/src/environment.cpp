@@ -671,6 +671,18 @@ struct Environment::SizeGuard {
     name_expr.type = name.type;
     name_expr.value = name.type == MULTIFIELD ? static_cast<void*>(&name) : name.value;
     name_expr.nextArg = &piece;
+    // A logical name no router takes: CLIPS' printout reports it once and prints nothing (called
+    // per argument, it would report it once per argument).
+    if (name.type == SYMBOL || name.type == STRING) {
+      const std::string_view logical = ValueToString(name.value);
+      if (logical != "t" && logical != "nil" &&
+          QueryRouters(clips_env, ValueToString(name.value)) == FALSE) {
+        name_expr.nextArg = first->nextArg;
+        print(&name_expr);
+        ValueDeinstall(clips_env, &name);
+        return;
+      }
+    }
     const std::int64_t limit = b->self->limits_.string_length;
     std::int64_t printed = 0;
     for (struct expr* a = first->nextArg; a != nullptr; a = a->nextArg) {

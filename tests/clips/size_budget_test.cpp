@@ -225,3 +225,17 @@ TEST_CASE("CLIPS out of memory for real: a clear message and exit code 3") {
   CHECK(err.find("llsfsim: fatal: out of memory: CLIPS could not allocate ") == 0);
   CHECK(err.find("exiting with code 3") != std::string::npos);
 }
+
+TEST_CASE("printout to a logical name no router takes reports it once, as CLIPS does") {
+  AgentFixture f;
+  f.load("(defrule badname (time $?) => (printout nosuch \"a\" \"b\" \"c\"))\n", "name.clp");
+  CHECK(f.step().runtime_errors == 1);
+  int reports = 0;
+  for (const auto& l : f.log()) {
+    for (std::size_t at = l.text.find("[ROUTER1]"); at != std::string::npos;
+         at = l.text.find("[ROUTER1]", at + 1))
+      ++reports;
+  }
+  CHECK(reports == 1);
+  CHECK(f.logged("runtime error in rule badname (name.clp:1): [ROUTER1] Logical name nosuch"));
+}
