@@ -57,6 +57,12 @@ void AgentConfig::validate() const {
   if (!(max_cycle_wall_s > 0.0))
     throw std::invalid_argument("AgentConfig.max_cycle_wall_s must be > 0");
   if (max_call_depth <= 0) throw std::invalid_argument("AgentConfig.max_call_depth must be > 0");
+  if (max_memory_bytes <= 0)
+    throw std::invalid_argument("AgentConfig.max_memory_bytes must be > 0");
+  if (max_string_length <= 0)
+    throw std::invalid_argument("AgentConfig.max_string_length must be > 0");
+  if (max_multifield_length <= 0)
+    throw std::invalid_argument("AgentConfig.max_multifield_length must be > 0");
   if (locks) lock_config.validate();
 }
 
@@ -104,6 +110,7 @@ struct AgentHost::Impl {
   int limit_hits = 0;
   std::int64_t rules_fired = 0;
   std::string werror;         // CLIPS error output not yet reported
+  std::string werror_rule;    // the rule whose actions ran when `werror` began ("" if none)
   std::string lines[4];       // partial output lines per level
   std::string budget_reason;  // set when the work budget stopped the cycle
   std::unordered_map<std::string, std::string> rule_places;      // defrule name -> "file:line"
@@ -127,6 +134,8 @@ struct AgentHost::Impl {
           };
     }
     state.log = [this](LogLevel level, std::string_view text) { emit(level, text); };
+    env.set_size_limits({state.config.max_memory_bytes, state.config.max_string_length,
+                         state.config.max_multifield_length});
     env.set_output_handler(
         [this](std::string_view name, std::string_view text) { on_output(name, text); });
     // Fixed order: functions first (the built-in code may call them), then the code, then the
@@ -157,9 +166,16 @@ struct AgentHost::Impl {
   }
 
   // Output arrives in pieces; complete lines go to the sink, werror is collected as an error.
+  // Both are bounded: error text beyond kMaxErrorText loses its middle, and a line longer than
+  // max_string_length is logged in pieces of that size (a loop printing without a newline).
   void on_output(std::string_view name, std::string_view text) {
     if (name == "werror") {
+      // The rule running when the error text began: named even when CLIPS does not halt it
+      // (a build or undeftemplate that fails only returns FALSE).
+      if (werror.empty()) werror_rule = env.executing_rule();
       werror.append(text);
+      if (werror.size() > kMaxErrorText)  // keep the cause (head) and the halted rule (tail)
+        werror.erase(kMaxErrorText / 2, werror.size() - kMaxErrorText);
       return;
     }
     const LogLevel level = level_of(name);
@@ -170,7 +186,13 @@ struct AgentHost::Impl {
       emit(level, std::string_view(buf).substr(0, pos));
       buf.erase(0, pos + 1);
     }
+    const auto max_line = static_cast<std::size_t>(state.config.max_string_length);
+    while (buf.size() > max_line) {
+      emit(level, std::string_view(buf).substr(0, max_line));
+      buf.erase(0, max_line);
+    }
   }
+  static constexpr std::size_t kMaxErrorText = 64 * 1024;
 
   void flush_output() {
     for (int i = 0; i < 4; ++i) {
@@ -195,6 +217,7 @@ struct AgentHost::Impl {
       // Keep the cause; the "execution halted" line only names the rule.
       if (auto first = text.find("[PRCCODE4]"); first > 0) text = text.substr(0, first);
     }
+    if (rule.empty()) rule = werror_rule;
     std::string msg = one_line(text);
     if (!budget_reason.empty()) {
       msg = budget_reason;
@@ -265,6 +288,11 @@ struct AgentHost::Impl {
                " in " + fn + place_of(function_places, fn) +
                " (a recursion without end?); the game goes on";
       }
+      case Hit::kMemory:
+        return "stopped at " + std::to_string(env.budget_memory()) +
+               " bytes of CLIPS memory, more than the memory budget of " +
+               std::to_string(state.config.max_memory_bytes) +
+               " bytes (max_memory_bytes; facts piling up?); the game goes on";
       case Hit::kWall:
         return "stopped after " + core::number_text(state.config.max_cycle_wall_s) +
                " s of wall time in one agent cycle (an endless loop in its actions?); the game "

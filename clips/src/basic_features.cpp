@@ -46,6 +46,9 @@ class LogFeature final : public Feature {
         s_.log(level, text);
         return Value{};
       });
+      // Within the string budget (the arguments of (log-info (expand$ ?m)) may repeat one long
+      // string a million times).
+      env.guard_concatenation(name);
     }
   }
 

@@ -3,7 +3,12 @@
 // specific (DATA_OBJECT, routers, string sources, fact slots, the 6.30 Env* API) stays here.
 #include "environment.h"
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <stdexcept>
 
 // CLIPS 6.30 is C without extern "C" guards; its macros must come after all C++ headers.
@@ -191,7 +196,19 @@ struct RouterAccess {
   }
   static int getc(void*, const char*) { return EOF; }
   static int ungetc(void*, int c, const char*) { return c; }
-  static int exit(void*, int) { return TRUE; }
+  // CLIPS ends the process (exit(code) follows): an agent's (exit) with the sandbox off, or one
+  // of CLIPS' internal errors. Say so on stderr, as nothing else would.
+  static int exit(void*, int code) {
+    char text[256];
+    const int n =
+        std::snprintf(text, sizeof text,
+                      "llsfsim: CLIPS ends the process with exit code %d: an agent called "
+                      "(exit) with robots.sandbox false, or CLIPS hit an internal error "
+                      "(docs/security.md)\n",
+                      code);
+    if (n > 0) (void)!::write(2, text, std::min(static_cast<std::size_t>(n), sizeof text - 1));
+    return TRUE;
+  }
 
   // All user-defined functions go through this one entry point (context = FunctionEntry*).
   static void dispatch(void* env, DATA_OBJECT* rv) {
@@ -393,6 +410,340 @@ struct Environment::CallGuard {
   }
 };
 
+// The size guard. CLIPS calls a function through its FunctionDefinition's functionPointer (with
+// the definition's context as the function context). The guard points the definitions of the
+// functions that build strings and multifields at its own evaluators: they evaluate the call's
+// arguments once (protected with ValueInstall while the next ones are evaluated), bound the size
+// of the result from those values and, within the budgets, run CLIPS' own function on a copy of
+// the call whose arguments are the values as constants (CLIPS evaluates a MULTIFIELD constant to
+// the DATA_OBJECT it points to). So CLIPS' behaviour is unchanged for every call within budget,
+// and a call past one never allocates: str-cat sums its lengths in an int, a 2 GB string wraps.
+struct Environment::SizeGuard {
+  enum class Kind : std::uint8_t {
+    kConcat,         // str-cat, sym-cat: the arguments' printed lengths
+    kImplode,        // implode$, str-implode: each field quoted and escaped, plus spaces
+    kFormat,         // format: the control string, its widths and the arguments
+    kPrint,          // printout: what it prints
+    kFields,         // create$, insert$, replace$, mv-append, mv-replace: the fields of all args
+    kExplode,        // explode$, str-explode: at most one field per two characters
+    kReplaceMember,  // replace-member$: each field may become the whole replacement
+  };
+  struct Builder {
+    Environment* self;
+    std::string name;
+    Kind kind;
+    char type;              // CLIPS' return type code of the function
+    int (*original)(void);  // CLIPS' own function
+    void* original_context;
+  };
+  std::deque<Builder> builders;  // stable addresses: the definitions' contexts point at them
+
+  static constexpr std::pair<const char*, Kind> kFunctions[] = {
+      {"str-cat", Kind::kConcat},      {"sym-cat", Kind::kConcat},
+      {"implode$", Kind::kImplode},    {"str-implode", Kind::kImplode},
+      {"format", Kind::kFormat},       {"printout", Kind::kPrint},
+      {"create$", Kind::kFields},      {"mv-append", Kind::kFields},
+      {"insert$", Kind::kFields},      {"replace$", Kind::kFields},
+      {"mv-replace", Kind::kFields},   {"explode$", Kind::kExplode},
+      {"str-explode", Kind::kExplode}, {"replace-member$", Kind::kReplaceMember},
+  };
+
+  void install(Environment& self, void* clips_env) {
+    for (const auto& [name, kind] : kFunctions) guard(self, clips_env, name, kind);
+  }
+  // Points the definition of `name` (if CLIPS has it) at the evaluator for its return type.
+  void guard(Environment& self, void* clips_env, const char* name, Kind kind) {
+    struct FunctionDefinition* fd = FindFunction(clips_env, name);
+    if (fd == nullptr || !fd->environmentAware) return;
+    int (*evaluator)(void) = nullptr;
+    switch (fd->returnValueType) {
+      case 'v':
+        evaluator = reinterpret_cast<int (*)(void)>(reinterpret_cast<void (*)()>(&call_print));
+        break;
+      case 's':
+      case 'w':
+        evaluator = reinterpret_cast<int (*)(void)>(reinterpret_cast<void (*)()>(&call_symbol));
+        break;
+      case 'j':
+      case 'k':
+      case 'm':
+      case 'n':
+      case 'u':
+        evaluator = reinterpret_cast<int (*)(void)>(reinterpret_cast<void (*)()>(&call_value));
+        break;
+      default:
+        throw std::logic_error(std::string("CLIPS: cannot guard function ") + name);
+    }
+    builders.push_back(
+        Builder{&self, name, kind, fd->returnValueType, fd->functionPointer, fd->context});
+    fd->functionPointer = evaluator;
+    fd->context = &builders.back();
+  }
+
+  // The printed length of an atom (a bound for numbers and addresses).
+  static std::int64_t text_length(int type, void* value) {
+    switch (type) {
+      case SYMBOL:
+      case STRING:
+      case INSTANCE_NAME:
+        return static_cast<std::int64_t>(std::strlen(ValueToString(value)));
+      case INTEGER:
+      case FLOAT:
+        return 32;
+      default:
+        return 64;
+    }
+  }
+  static std::int64_t fields(const DATA_OBJECT& d) {
+    return d.type == MULTIFIELD ? d.end - d.begin + 1 : 1;
+  }
+  // The printed length of a value; a multifield's fields with a separator each, and 2 for ().
+  static std::int64_t printed_length(const DATA_OBJECT& d, bool quoted) {
+    if (d.type != MULTIFIELD) {
+      const std::int64_t n = text_length(d.type, d.value);
+      return quoted && d.type == STRING ? 2 * n + 2 : n;
+    }
+    std::int64_t n = 2;
+    for (long i = GetDOBegin(d), end = GetDOEnd(d); i <= end; ++i) {  // 1-based
+      const std::int64_t len = text_length(GetMFType(d.value, i), GetMFValue(d.value, i));
+      n += 1 + (quoted && GetMFType(d.value, i) == STRING ? 2 * len + 2 : len);
+    }
+    return n;
+  }
+  // The format control string's widths and precisions (all digit runs after a %).
+  static std::int64_t format_widths(const char* control) {
+    std::int64_t sum = 0;
+    for (const char* c = control; *c != '\0'; ++c) {
+      if (*c != '%') continue;
+      std::int64_t number = 0;
+      for (++c; *c != '\0' && std::strchr("0123456789.-+# ", *c) != nullptr; ++c) {
+        if (*c >= '0' && *c <= '9') {
+          number = std::min<std::int64_t>(number * 10 + (*c - '0'), std::int64_t{1} << 40);
+        } else {
+          sum += number;
+          number = 0;
+        }
+      }
+      sum += number;
+      if (*c == '\0') break;
+    }
+    return sum;
+  }
+
+  // The result's size in characters (`chars`) or fields; false if it is past a budget (then the
+  // error has been reported).
+  static bool within_budget(const Builder& b, void* clips_env, const DATA_OBJECT* args, int n) {
+    std::int64_t chars = -1, count = -1;
+    switch (b.kind) {
+      case Kind::kConcat:
+      case Kind::kPrint:  // (call_print checks its own sum)
+        chars = 0;
+        for (int i = 0; i < n; ++i) chars += printed_length(args[i], false);
+        break;
+      case Kind::kImplode:
+        chars = 0;
+        for (int i = 0; i < n; ++i) chars += printed_length(args[i], true);
+        break;
+      case Kind::kFormat:
+        chars = 0;
+        for (int i = 1; i < n; ++i) chars += printed_length(args[i], false);
+        if (n >= 2 && (args[1].type == STRING || args[1].type == SYMBOL))
+          chars += format_widths(ValueToString(args[1].value));
+        break;
+      case Kind::kFields:
+        count = 0;
+        for (int i = 0; i < n; ++i) count += fields(args[i]);
+        break;
+      case Kind::kExplode:
+        count = n >= 1 ? printed_length(args[0], false) / 2 + 1 : 0;
+        break;
+      case Kind::kReplaceMember:
+        count = n >= 2 ? fields(args[0]) * std::max<std::int64_t>(1, fields(args[1])) : 0;
+        break;
+    }
+    Environment& self = *b.self;
+    const SizeLimits& limits = self.limits_;
+    std::string why;
+    if (chars >= 0 && limits.string_length > 0 && chars > limits.string_length) {
+      why = (b.kind == Kind::kPrint ? "would print up to " : "the result would have up to ") +
+            std::to_string(chars) + " characters, more than the string budget of " +
+            std::to_string(limits.string_length) + " (max_string_length)";
+    } else if (count >= 0 && limits.multifield_length > 0 && count > limits.multifield_length) {
+      why = "the result would have up to " + std::to_string(count) +
+            " fields, more than the multifield budget of " +
+            std::to_string(limits.multifield_length) + " (max_multifield_length)";
+    } else if (limits.memory_bytes > 0) {
+      const std::int64_t bytes =
+          chars >= 0 ? chars : count * static_cast<std::int64_t>(sizeof(struct field));
+      const std::int64_t used = EnvMemUsed(clips_env);
+      if (used + bytes > limits.memory_bytes)
+        why = "the result would take up to " + std::to_string(bytes) + " bytes where CLIPS holds " +
+              std::to_string(used) + ", more than the memory budget of " +
+              std::to_string(limits.memory_bytes) + " bytes (max_memory_bytes)";
+    }
+    if (why.empty()) return true;
+    self.error(b.name, why + "; the game goes on");
+    return false;
+  }
+
+  // Evaluates the arguments, checks the budgets and calls CLIPS' function on the values; false
+  // if it was not called (an argument failed or a budget was hit).
+  template <class Call>
+  static bool guarded(void* clips_env, Call&& original) {
+    auto* b = static_cast<Builder*>(GetEnvironmentFunctionContext(clips_env));
+    struct expr* const call = EvaluationData(clips_env)->CurrentExpression;
+    int n = 0;
+    for (struct expr* a = call->argList; a != nullptr; a = a->nextArg) ++n;
+    constexpr int kInline = 8;
+    DATA_OBJECT inline_values[kInline];
+    struct expr inline_exprs[kInline];
+    std::unique_ptr<DATA_OBJECT[]> heap_values;
+    std::unique_ptr<struct expr[]> heap_exprs;
+    DATA_OBJECT* values = inline_values;
+    struct expr* exprs = inline_exprs;
+    if (n > kInline) {
+      heap_values = std::make_unique<DATA_OBJECT[]>(static_cast<std::size_t>(n));
+      heap_exprs = std::make_unique<struct expr[]>(static_cast<std::size_t>(n));
+      values = heap_values.get();
+      exprs = heap_exprs.get();
+    }
+    int installed = 0;
+    bool ok = true;
+    for (struct expr* a = call->argList; a != nullptr; a = a->nextArg) {
+      DATA_OBJECT& v = values[installed];
+      EvaluateExpression(clips_env, a, &v);
+      if (EvaluationData(clips_env)->EvaluationError || EvaluationData(clips_env)->HaltExecution) {
+        ok = false;
+        break;
+      }
+      ValueInstall(clips_env, &v);  // kept while the next arguments are evaluated
+      ++installed;
+    }
+    if (ok) ok = within_budget(*b, clips_env, values, n);
+    if (ok) {
+      for (int i = 0; i < n; ++i) {
+        exprs[i].type = values[i].type;
+        exprs[i].value =
+            values[i].type == MULTIFIELD ? static_cast<void*>(&values[i]) : values[i].value;
+        exprs[i].argList = nullptr;
+        exprs[i].nextArg = i + 1 < n ? &exprs[i + 1] : nullptr;
+      }
+      struct expr with_values = *call;
+      with_values.argList = n > 0 ? &exprs[0] : nullptr;
+      EvaluationData(clips_env)->CurrentExpression = &with_values;
+      SetEnvironmentFunctionContext(clips_env, b->original_context);
+      original(b);
+      SetEnvironmentFunctionContext(clips_env, b);
+      EvaluationData(clips_env)->CurrentExpression = call;
+    }
+    for (int i = 0; i < installed; ++i) ValueDeinstall(clips_env, &values[i]);
+    return ok;
+  }
+  // printout prints each argument right after evaluating it (a deffunction in its arguments may
+  // print too): CLIPS' printout is called once per argument, with the logical name, so the
+  // output and its order stay CLIPS' own; what one call prints is summed against the budget.
+  static void call_print(void* clips_env) {
+    auto* b = static_cast<Builder*>(GetEnvironmentFunctionContext(clips_env));
+    struct expr* const call = EvaluationData(clips_env)->CurrentExpression;
+    const auto print = [&](struct expr* args) {
+      struct expr with_values = *call;
+      with_values.argList = args;
+      EvaluationData(clips_env)->CurrentExpression = &with_values;
+      SetEnvironmentFunctionContext(clips_env, b->original_context);
+      reinterpret_cast<void (*)(void*)>(reinterpret_cast<void (*)()>(b->original))(clips_env);
+      SetEnvironmentFunctionContext(clips_env, b);
+      EvaluationData(clips_env)->CurrentExpression = call;
+    };
+    struct expr* const first = call->argList;
+    if (first == nullptr || first->nextArg == nullptr) {
+      print(first);
+      return;
+    }
+    const auto failed = [clips_env] {
+      return EvaluationData(clips_env)->EvaluationError || EvaluationData(clips_env)->HaltExecution;
+    };
+    DATA_OBJECT name;
+    EvaluateExpression(clips_env, first, &name);
+    if (failed()) return;
+    ValueInstall(clips_env, &name);
+    struct expr name_expr {};
+    struct expr piece {};
+    name_expr.type = name.type;
+    name_expr.value = name.type == MULTIFIELD ? static_cast<void*>(&name) : name.value;
+    name_expr.nextArg = &piece;
+    // A logical name no router takes: CLIPS' printout reports it once and prints nothing (called
+    // per argument, it would report it once per argument).
+    if (name.type == SYMBOL || name.type == STRING) {
+      const std::string_view logical = ValueToString(name.value);
+      if (logical != "t" && logical != "nil" &&
+          QueryRouters(clips_env, ValueToString(name.value)) == FALSE) {
+        name_expr.nextArg = first->nextArg;
+        print(&name_expr);
+        ValueDeinstall(clips_env, &name);
+        return;
+      }
+    }
+    const std::int64_t limit = b->self->limits_.string_length;
+    std::int64_t printed = 0;
+    for (struct expr* a = first->nextArg; a != nullptr; a = a->nextArg) {
+      DATA_OBJECT v;
+      EvaluateExpression(clips_env, a, &v);
+      if (failed()) break;
+      printed += printed_length(v, false);
+      if (limit > 0 && printed > limit) {
+        b->self->error(b->name, "would print up to " + std::to_string(printed) +
+                                    " characters, more than the string budget of " +
+                                    std::to_string(limit) +
+                                    " (max_string_length); the game goes on");
+        break;
+      }
+      ValueInstall(clips_env, &v);
+      piece.type = v.type;
+      piece.value = v.type == MULTIFIELD ? static_cast<void*>(&v) : v.value;
+      print(&name_expr);
+      ValueDeinstall(clips_env, &v);
+      if (failed()) break;
+    }
+    ValueDeinstall(clips_env, &name);
+  }
+  static void* call_symbol(void* clips_env) {
+    void* result = nullptr;
+    const bool called = guarded(clips_env, [clips_env, &result](Builder* b) {
+      result =
+          reinterpret_cast<void* (*)(void*)>(reinterpret_cast<void (*)()>(b->original))(clips_env);
+    });
+    return called ? result : EnvAddSymbol(clips_env, "");
+  }
+  static void call_value(void* clips_env, DATA_OBJECT* rv) {
+    const bool called = guarded(clips_env, [clips_env, rv](Builder* b) {
+      reinterpret_cast<void (*)(void*, DATA_OBJECT*)>(reinterpret_cast<void (*)()>(b->original))(
+          clips_env, rv);
+    });
+    if (!called) {
+      rv->type = SYMBOL;
+      rv->value = EnvFalseSymbol(clips_env);
+    }
+  }
+};
+
+namespace {
+
+// CLIPS' allocator calls this when malloc fails; returning would hand CLIPS a null pointer (or,
+// returning FALSE, retry forever), so the process ends here with a clear word instead of CLIPS'
+// silent exit(1). The memory budget (max_memory_bytes) is meant to stop an agent long before.
+int out_of_memory(void* clips_env, size_t size) {
+  char text[320];
+  const int n = std::snprintf(text, sizeof text,
+                              "llsfsim: fatal: out of memory: CLIPS could not allocate %zu bytes "
+                              "(this agent's environment holds %ld bytes); exiting with code 3 "
+                              "(docs/clips.md, \"Budgets\")\n",
+                              size, EnvMemUsed(clips_env));
+  if (n > 0) (void)!::write(2, text, std::min(static_cast<std::size_t>(n), sizeof text - 1));
+  std::_Exit(3);
+}
+
+}  // namespace
+
 // ---- Environment -----------------------------------------------------------------------------
 
 Environment::Environment() {
@@ -404,7 +755,12 @@ Environment::Environment() {
   EnvAddPeriodicFunction(env_, "llsf-budget", &Environment::periodic, 0);
   guard_ = std::make_unique<CallGuard>();
   guard_->install(env_);
+  sizes_ = std::make_unique<SizeGuard>();
+  sizes_->install(*this, env_);
+  EnvSetOutOfMemoryFunction(env_, &out_of_memory);
 }
+
+std::int64_t Environment::memory_used() const { return EnvMemUsed(env_); }
 
 bool Environment::enter_call(void* callee, bool generic) {
   periodic(env_);  // a call is a step of the work budget
@@ -428,7 +784,11 @@ void Environment::periodic(void* clips_env) {
   if (self == nullptr || self->max_steps_ <= 0) return;
   ++self->steps_;
   if (self->budget_hit_ == BudgetHit::kNone) {
-    if (self->steps_ > self->max_steps_) {
+    const std::int64_t memory = self->limits_.memory_bytes > 0 ? EnvMemUsed(clips_env) : 0;
+    if (memory > self->limits_.memory_bytes) {
+      self->budget_hit_ = BudgetHit::kMemory;
+      self->budget_memory_ = memory;
+    } else if (self->steps_ > self->max_steps_) {
       self->budget_hit_ = BudgetHit::kSteps;
     } else if ((self->steps_ & 1023) == 0) {
       // The wall clock only cuts runaway work (it never changes a game that stays in budget).
@@ -445,10 +805,17 @@ void Environment::start_budget(std::int64_t max_steps, double max_wall_s, int ma
   max_call_depth_ = max_call_depth;
   call_depth_ = 0;
   budget_function_.clear();
+  budget_memory_ = 0;
   max_steps_ = max_steps;
   max_wall_s_ = max_wall_s;
   budget_hit_ = BudgetHit::kNone;
   budget_start_ = std::chrono::steady_clock::now();
+}
+
+std::string Environment::executing_rule() const {
+  struct defrule* rule = EngineData(env_)->ExecutingRule;
+  const char* name = rule != nullptr ? EnvGetDefruleName(env_, rule) : nullptr;
+  return name != nullptr ? std::string(name) : std::string();
 }
 
 std::string Environment::next_rule() const {
@@ -496,6 +863,12 @@ struct expr* forbidden_parser(void* clips_env, struct expr* top, const char* /*l
 }
 
 }  // namespace
+
+void Environment::guard_concatenation(const std::string& name) {
+  if (FindFunction(env_, name.c_str()) == nullptr)
+    throw std::logic_error("CLIPS: no function " + name + " to guard");
+  sizes_->guard(*this, env_, name.c_str(), SizeGuard::Kind::kConcat);
+}
 
 void Environment::forbid_function(const std::string& name, const std::string& message) {
   if (FindFunction(env_, name.c_str()) == nullptr) return;

@@ -122,6 +122,10 @@ class Environment {
   /// a call that needs no parsing (funcall) fails the same way at run time. A function this
   /// CLIPS does not have is skipped.
   void forbid_function(const std::string& name, const std::string& message);
+  /// Puts the size guard (set_size_limits) on `name`, a function defined before whose result
+  /// is the concatenation of its arguments (as str-cat's): its arguments are evaluated once, and
+  /// a call whose text would be longer than the string budget fails before `name` runs.
+  void guard_concatenation(const std::string& name);
   /// Why `name` is forbidden (forbid_function).
   std::string forbidden_reason(std::string_view name) const;
   /// Reports a bad call: prints "[LLSF1] name: message" to werror and sets CLIPS' evaluation
@@ -151,7 +155,25 @@ class Environment {
   std::int64_t run(std::int64_t limit);
 
   /// Why a budget stopped execution.
-  enum class BudgetHit : std::uint8_t { kNone, kSteps, kWall, kDepth };
+  enum class BudgetHit : std::uint8_t { kNone, kSteps, kWall, kDepth, kMemory };
+  /// The size budgets (0: none). `memory_bytes`: what CLIPS holds for this environment
+  /// (EnvMemUsed: facts, symbols, strings, multifields, rules), checked at every budget step
+  /// (BudgetHit::kMemory) and before a guarded function builds its result. `string_length` and
+  /// `multifield_length`: the largest string (characters) and multifield (fields) that
+  /// str-cat, sym-cat, implode$, format, printout, create$, insert$, replace$, explode$,
+  /// replace-member$ and their old aliases may build. Those functions are guarded in every
+  /// environment: their arguments are evaluated first, the result's size is bounded from them,
+  /// and only a call within the budgets reaches CLIPS' own function (with the values); a call
+  /// past a budget fails as error() does ("[LLSF1] str-cat: the result would have ...").
+  struct SizeLimits {
+    std::int64_t memory_bytes = 0;
+    std::int64_t string_length = 0;
+    std::int64_t multifield_length = 0;
+  };
+  void set_size_limits(const SizeLimits& limits) { limits_ = limits; }
+  const SizeLimits& size_limits() const { return limits_; }
+  /// The bytes CLIPS holds for this environment now (EnvMemUsed).
+  std::int64_t memory_used() const;
   /// Starts a work budget for the following run()s: a step is one of CLIPS' periodic callbacks
   /// (about two per rule firing, one per iteration of while, loop-for-count, progn$, ...).
   /// Past `max_steps` steps, or (checked every 1,024 steps) past `max_wall_s` seconds of wall
@@ -164,6 +186,10 @@ class Environment {
   std::int64_t budget_steps() const { return steps_; }
   /// With kDepth: the deffunction or generic function whose call went too deep.
   const std::string& budget_function() const { return budget_function_; }
+  /// With kMemory: the bytes CLIPS held when the memory budget stopped execution.
+  std::int64_t budget_memory() const { return budget_memory_; }
+  /// The rule whose actions are running now, or "" outside of a rule's actions.
+  std::string executing_rule() const;
   /// The rule of the first activation on the agenda, or "" if it is empty.
   std::string next_rule() const;
   /// True if the current focus has activations left.
@@ -208,6 +234,9 @@ class Environment {
   // replaced in this environment by ones that count depth and steps (environment.cpp).
   struct CallGuard;
   bool enter_call(void* callee, bool generic);
+  // The size guard: str-cat, create$, ... replaced in this environment by evaluators that check
+  // the result's size before CLIPS builds it (environment.cpp).
+  struct SizeGuard;
 
   void* env_ = nullptr;
   OutputHandler output_;
@@ -235,6 +264,9 @@ class Environment {
   int call_depth_ = 0;
   std::string budget_function_;
   std::unique_ptr<CallGuard> guard_;
+  SizeLimits limits_;
+  std::int64_t budget_memory_ = 0;
+  std::unique_ptr<SizeGuard> sizes_;
 };
 
 }  // namespace llsf::clips::detail

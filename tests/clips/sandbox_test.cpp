@@ -111,10 +111,10 @@ TEST_CASE("sandbox: eval, build and funcall at run time fail as runtime errors n
       f.logged("runtime error in rule by-eval (agent.clp:1): [LLSF2] open: not available in "
                "agents"));
   // funcall refuses every function with its own parser, which the sandbox gives them (CLIPS
-  // does not halt the rule for it, so the message names no rule).
+  // does not halt the rule for it; the host names the rule that was running).
   CHECK(trigger("(b)") == 1);
   CHECK(
-      f.logged("runtime error: [ARGACCES5] Function funcall "
+      f.logged("runtime error in rule by-funcall (agent.clp:2): [ARGACCES5] Function funcall "
                "expected argument #1 to be of type function without specialized parser"));
   // build only returns FALSE on a parse error (CLIPS halts nothing); the message is reported
   // with the next cycle's errors, if any: the rule x was not built.

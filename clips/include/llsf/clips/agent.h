@@ -86,6 +86,17 @@ struct AgentConfig {
   /// same way (a recursion without end would otherwise overflow the C stack). A level takes
   /// 0.5-1 KB of stack (measured: docs/clips.md, "Budgets").
   int max_call_depth = 2'000;
+  /// The memory budget (docs/clips.md, "Budgets"): the bytes CLIPS may hold for this agent
+  /// (facts, strings, multifields, rules; CLIPS' own count, EnvMemUsed). Checked at every step of
+  /// the work budget: past it, the running rule's actions stop as above (while the agent holds
+  /// more, every cycle stops at its first step). The shipped LLSF 2013 agent holds at most 2 MB.
+  std::int64_t max_memory_bytes = 128LL << 20;
+  /// The largest string (characters) and multifield (fields) that one call of str-cat, sym-cat,
+  /// implode$, format, printout (what one call prints), create$, insert$, replace$, explode$ or
+  /// replace-member$ may build (and log-* print); a call past either is a runtime error naming
+  /// the function and the rule, and builds nothing.
+  std::int64_t max_string_length = 1'000'000;
+  std::int64_t max_multifield_length = 1'000'000;
   ConfigEntries config;  ///< asserted as confval facts after (reset)
   /// The sandbox (docs/security.md): files, I/O routers, load/save, dribble, system, exit, clear,
   /// reset and construct removal are unavailable to the agent's code. Turn it off only for a

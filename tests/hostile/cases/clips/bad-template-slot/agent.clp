@@ -1,0 +1,4 @@
+(defrule where
+  (pose (z ?z))
+  =>
+  (printout t ?z crlf))

@@ -1,0 +1,6 @@
+(defrule glue
+  (time $?)
+  (not (done))
+  =>
+  (assert (done))
+  (bind ?s "xxxxxxxxxxxxxxxx") (loop-for-count 15 (bind ?s (str-cat ?s ?s))) (bind ?m (create$ ?s ?s ?s)) (implode$ ?m))

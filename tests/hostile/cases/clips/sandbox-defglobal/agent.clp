@@ -1,0 +1,1 @@
+(defglobal ?*gone* = (remove "/tmp/llsf-x"))

@@ -1,0 +1,6 @@
+(defrule trace
+  (time $?)
+  (not (done))
+  =>
+  (assert (done))
+  (dribble-on "/tmp/llsf-dribble.txt"))

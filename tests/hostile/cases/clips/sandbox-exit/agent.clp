@@ -1,0 +1,6 @@
+(defrule quit
+  (time $?)
+  (not (done))
+  =>
+  (assert (done))
+  (exit))

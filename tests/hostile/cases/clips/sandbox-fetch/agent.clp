@@ -1,0 +1,6 @@
+(defrule peek
+  (time $?)
+  (not (done))
+  =>
+  (assert (done))
+  (fetch "/etc/passwd"))

@@ -1,0 +1,6 @@
+(defrule sneak
+  (time $?)
+  (not (done))
+  =>
+  (assert (done))
+  (load "/etc/passwd"))

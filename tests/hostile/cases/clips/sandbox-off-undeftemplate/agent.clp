@@ -1,0 +1,6 @@
+(defrule pull
+  (time $?)
+  (not (done))
+  =>
+  (assert (done))
+  (undeftemplate pose))

@@ -1,0 +1,6 @@
+(defrule wait
+  (time $?)
+  (not (done))
+  =>
+  (assert (done))
+  (bind ?x (read)))

@@ -1,0 +1,6 @@
+(defrule wipe
+  (time $?)
+  (not (done))
+  =>
+  (assert (done))
+  (reset))

@@ -1,0 +1,4 @@
+(defrule broken
+  (time $?)
+  =>
+  (assert (x)

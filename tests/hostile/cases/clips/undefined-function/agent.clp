@@ -1,0 +1,6 @@
+(defrule typo
+  (time $?)
+  (not (done))
+  =>
+  (assert (done))
+  (pritnout t "x" crlf))
