@@ -126,12 +126,19 @@ std::vector<StreamEvent> StreamServer::take_events() {
 
 bool StreamServer::send(ClientId client, const google::protobuf::Message& message) {
   const auto it = impl_->open.find(client.value());
-  return it != impl_->open.end() && it->second->send(message);
+  if (it == impl_->open.end()) return false;
+  const auto conn = it->second;  // a full send queue closes it, which erases it from the map
+  return conn->send(message);
 }
 
 int StreamServer::broadcast(const google::protobuf::Message& message) {
+  // A send may close its connection (send queue full), which erases it from `open`: iterate
+  // over a copy.
+  std::vector<std::shared_ptr<StreamConnection>> conns;
+  conns.reserve(impl_->open.size());
+  for (const auto& [id, conn] : impl_->open) conns.push_back(conn);
   int n = 0;
-  for (const auto& [id, conn] : impl_->open) n += conn->send(message) ? 1 : 0;
+  for (const auto& conn : conns) n += conn->send(message) ? 1 : 0;
   return n;
 }
 

@@ -26,6 +26,7 @@ struct UdpHub::Impl {
     udp::endpoint destination;  ///< where frames for this peer go
     bool destination_known = false;
     bool learn_destination = false;
+    int bound_port = 0;  ///< where the hub listens for this peer
     std::vector<std::uint8_t> buffer = std::vector<std::uint8_t>(kReceiveBuffer);
   };
 
@@ -82,10 +83,8 @@ struct UdpHub::Impl {
   /// Whether `ep` is one of the hub's listening sockets.
   bool is_own_endpoint(const udp::endpoint& ep) const {
     for (const auto& other : sockets) {
-      boost::system::error_code ec;
-      const udp::endpoint local = other->socket.local_endpoint(ec);
-      if (!ec && local.port() == ep.port() &&
-          (local.address() == ep.address() || local.address().is_unspecified())) {
+      if (other->bound_port == ep.port() &&
+          (ep.address() == address || address.is_unspecified() || ep.address().is_loopback())) {
         return true;
       }
     }
@@ -153,10 +152,11 @@ PeerId UdpHub::add_peer(const UdpPeerConfig& peer) {
   // peer's), and a new listening port must not be an earlier peer's receive port: either way a
   // frame would be forwarded back into the hub for ever.
   const int bound = s->socket.local_endpoint(ec).port();
+  s->bound_port = bound;
   for (std::size_t i = 0; i < impl_->sockets.size(); ++i) {
     const Impl::Socket& other = *impl_->sockets[i];
     const std::string& other_name = impl_->hub.peer_name(PeerId(static_cast<int>(i)));
-    if (peer.recv_port > 0 && other.socket.local_endpoint(ec).port() == peer.recv_port) {
+    if (peer.recv_port > 0 && other.bound_port == peer.recv_port) {
       throw std::runtime_error("UdpHub: peer '" + peer.name + "': recv_port " +
                                std::to_string(peer.recv_port) + " is where the hub listens for '" +
                                other_name + "' (a forwarding loop)");

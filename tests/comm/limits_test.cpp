@@ -259,3 +259,30 @@ TEST_CASE("TCP: a client that does not read is closed when its send queue is ful
   REQUIRE(log.size() == 1);
   CHECK(log[0].find("send_queue_full") != std::string::npos);
 }
+
+TEST_CASE("TCP: broadcast to clients that do not read closes each at its send-queue bound") {
+  const MessageRegistry reg = registry();
+  StreamServerOptions o{"127.0.0.1", 0};
+  o.max_send_queue_bytes = 2048;
+  o.log = [](std::string_view) {};
+  StreamServer server(reg, o);
+  asio::io_context io;
+  std::vector<tcp::socket> readers;
+  for (int i = 0; i < 3; ++i) {
+    readers.emplace_back(io).connect(
+        tcp::endpoint(kLoopback, static_cast<unsigned short>(server.port())));
+  }
+  const auto deadline = Clock::now() + std::chrono::seconds(5);
+  while (server.client_count() < 3 && Clock::now() < deadline) server.run_for(milliseconds(2));
+  REQUIRE(server.client_count() == 3);
+  // Without running the event loop nothing is written: every queue fills up, and the broadcast
+  // that overflows them closes all three (each erased from the server while it iterates).
+  int rounds = 0;
+  while (server.client_count() > 0 && rounds < 100000) {
+    server.broadcast(lock(rounds));
+    ++rounds;
+  }
+  CHECK(rounds < 2048 / 8);
+  CHECK(server.client_count() == 0);
+  for (int c = 0; c < 3; ++c) CHECK(server.counters(ClientId(c)).closed_for == "send_queue_full");
+}
