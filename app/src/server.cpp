@@ -457,6 +457,9 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     ws_.read_message_max(64 * 1024);
     ws_.async_accept(req, [self = shared_from_this()](beast::error_code ec) {
       if (ec) return;
+      // Drop the entries of clients gone since (after the game no fan_out() prunes them).
+      std::erase_if(self->server_.ws_sessions,
+                    [](const std::weak_ptr<WsSession>& w) { return w.expired(); });
       self->server_.ws_sessions.push_back(self);
       self->read();
       self->pump();
