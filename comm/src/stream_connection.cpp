@@ -52,9 +52,11 @@ void StreamConnection::read() {
 void StreamConnection::on_bytes(std::size_t n) {
   if (!open_) return;
   decoder_.feed(std::span<const std::uint8_t>(read_buffer_.data(), n));
+  bool frame_done = false;
   for (;;) {
     const StreamDecoder::Next next = decoder_.next();
     if (next.status == StreamDecoder::Next::Status::kNeedMore) break;
+    frame_done = true;
     if (next.status == StreamDecoder::Next::Status::kOversized) {
       ++counters_->malformed[static_cast<std::size_t>(FrameError::kOversized)];
       close_for("oversized", "a frame header announces more than " +
@@ -76,13 +78,15 @@ void StreamConnection::on_bytes(std::size_t n) {
     sink_(std::move(e));
     if (!open_) return;  // the sink closed us
   }
-  watch_partial_frame();
+  watch_partial_frame(frame_done);
 }
 
-void StreamConnection::watch_partial_frame() {
+void StreamConnection::watch_partial_frame(bool frame_done) {
   if (limits_.partial_frame_timeout.count() <= 0) return;
   const bool partial = decoder_.buffered() > 0;
-  if (partial == partial_watched_) return;  // a frame under way keeps its first deadline
+  // The frame under way keeps its first deadline, however slowly its bytes come; a frame that
+  // starts after one completed gets a new one.
+  if (partial == partial_watched_ && !(partial && frame_done)) return;
   partial_watched_ = partial;
   ++partial_generation_;
   if (!partial) {

@@ -45,8 +45,9 @@ class StreamConnection : public std::enable_shared_from_this<StreamConnection> {
   void read();
   void on_bytes(std::size_t n);
   void write_next();
-  /// Arms the partial-frame timer when a frame is incomplete, disarms it when none is.
-  void watch_partial_frame();
+  /// Arms the partial-frame timer when a frame is incomplete (again when a new frame started
+  /// after `frame_done`), disarms it when none is.
+  void watch_partial_frame(bool frame_done);
   /// Closes for a limit: logs "stream <peer>: <reason>: <detail>" and records the reason.
   void close_for(const char* reason, const std::string& detail);
 

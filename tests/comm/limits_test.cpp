@@ -286,3 +286,37 @@ TEST_CASE("TCP: broadcast to clients that do not read closes each at its send-qu
   CHECK(server.client_count() == 0);
   for (int c = 0; c < 3; ++c) CHECK(server.counters(ClientId(c)).closed_for == "send_queue_full");
 }
+
+TEST_CASE("TCP: a busy client whose reads always end mid-frame is not timed out") {
+  const MessageRegistry reg = registry();
+  StreamServerOptions o{"127.0.0.1", 0};
+  o.partial_frame_timeout = milliseconds(200);
+  o.log = [](std::string_view) {};
+  StreamServer server(reg, o);
+  asio::io_context io;
+  tcp::socket busy(io);
+  busy.connect(tcp::endpoint(kLoopback, static_cast<unsigned short>(server.port())));
+  busy.set_option(tcp::no_delay(true));
+  // Frames back to back, written so that every write ends in the middle of a frame, for three
+  // times the timeout: each frame completes well within it.
+  std::vector<std::uint8_t> bytes;
+  for (int i = 0; i < 200; ++i) {
+    const auto f = reg.encode(lock(i));
+    bytes.insert(bytes.end(), f.begin(), f.end());
+  }
+  const std::size_t frame = reg.encode(lock(0)).size();
+  std::size_t sent = 0;
+  const auto until = Clock::now() + milliseconds(600);
+  std::int64_t messages = 0;
+  while (Clock::now() < until && sent + frame < bytes.size()) {
+    const std::size_t n = frame + frame / 2;
+    asio::write(busy, asio::buffer(bytes.data() + sent, std::min(n, bytes.size() - sent)));
+    sent += n;
+    server.run_for(milliseconds(25));
+    for (const auto& e : server.take_events()) messages += e.kind == StreamEvent::Kind::kMessage;
+  }
+  CHECK(Clock::now() >= until);
+  CHECK(server.client_count() == 1);
+  CHECK(server.counters(ClientId(0)).closed_for.empty());
+  CHECK(messages > 10);
+}
