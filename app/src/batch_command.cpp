@@ -77,7 +77,7 @@ int batch(const BatchCommandOptions& o, std::ostream& out, std::ostream& err) {
     for (const std::string& path : o.scenarios) {
       Loaded l{path, study::load_scenario(path), ""};
       l.hash = study::batch_identity_hash(path, l.file);
-      for (const study::Scenario& s : l.file.variants) (void)study::batch_seeds(s, o.runs);
+      (void)study::batch_games(l.file, o.runs);  // each variant's seeds, within the budget
       loaded.push_back(std::move(l));
     }
   } catch (const core::UserError& e) {
@@ -87,6 +87,7 @@ int batch(const BatchCommandOptions& o, std::ostream& out, std::ostream& err) {
   std::optional<study::StatsStore> store;
   try {
     store.emplace(o.db);
+    store->require_writable();
   } catch (const study::StatsError& e) {
     err << "llsfsim batch: " << e.what() << "\n";
     return kExitBadInput;
@@ -126,12 +127,11 @@ int batch(const BatchCommandOptions& o, std::ostream& out, std::ostream& err) {
 
 Action add_batch_command(CLI::App& app) {
   auto o = std::make_shared<BatchCommandOptions>();
-  app.add_option("scenarios", o->scenarios, "Scenario files (docs/scenarios.md)")
-      ->required()
-      ->check(CLI::ExistingFile);
+  app.add_option("scenarios", o->scenarios, "Scenario files (docs/scenarios.md)")->required();
   app.add_option("--runs", o->runs,
                  "Seeds per variant: the first N of the scenario's list, or s..s+N-1 for a "
-                 "single seed s (default: the scenario's seeds)")
+                 "single seed s (default: the scenario's seeds); at most 100000, and at most "
+                 "100000 games in all (variants x seeds)")
       ->check(CLI::PositiveNumber);
   app.add_option("--jobs,-j", o->jobs, "Games played at once (default: the number of cores)")
       ->check(CLI::PositiveNumber);

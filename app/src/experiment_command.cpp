@@ -20,6 +20,7 @@
 #include "llsf/app/cli.h"
 #include "llsf/clips/agent.h"
 #include "llsf/core/error.h"
+#include "llsf/core/input_file.h"
 #include "llsf/study/batch.h"
 #include "llsf/study/experiment.h"
 #include "llsf/study/stats_store.h"
@@ -43,11 +44,8 @@ struct ExperimentOptions {
 
 /// Reads a whole file; nullopt if it cannot be read.
 std::optional<std::string> read_file(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) return std::nullopt;
-  std::string text{std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
-  if (f.bad()) return std::nullopt;
-  return text;
+  std::string error;
+  return core::try_read_input_file(path, core::kMaxSourceBytes, "markdown file", error);
 }
 
 /// Writes `text` next to `path` and renames it into place: a failed write leaves no half file.

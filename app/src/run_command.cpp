@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -26,6 +27,7 @@
 #include "llsf/app/cli.h"
 #include "llsf/clips/agent.h"
 #include "llsf/core/error.h"
+#include "llsf/core/input_file.h"
 #include "llsf/core/text.h"
 #include "llsf/sim/agent_brain.h"
 #include "llsf/sim/driver.h"
@@ -56,6 +58,24 @@ struct RunOptions {
   bool no_record_agents = false;   ///< no facts/fact/rules lines in the recording
   LiveOptions live;                ///< --speed, --realtime, --serve, --port, --serve-exit
 };
+
+/// Why a file cannot be created or replaced at `path` ("" if it can): checked before a game, so
+/// that a recording that cannot be written costs no game.
+std::string cannot_create(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path dir = fs::path(path).has_parent_path() ? fs::path(path).parent_path() : ".";
+  if (!fs::is_directory(dir, ec)) return "the folder " + dir.string() + " does not exist";
+  if (fs::is_directory(path, ec)) return "it is a directory";
+  if (::access(dir.c_str(), W_OK | X_OK) != 0) {
+    return "the folder " + dir.string() +
+           " is not writable: " + std::error_code(errno, std::generic_category()).message();
+  }
+  if (fs::exists(path, ec) && ::access(path.c_str(), W_OK) != 0) {
+    return "the file is not writable: " + std::error_code(errno, std::generic_category()).message();
+  }
+  return "";
+}
 
 const study::Scenario* pick_variant(const study::ScenarioFile& f, const std::string& name,
                                     std::ostream& err) {
@@ -183,6 +203,7 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
   if (!o.no_db) {
     try {
       store.emplace(o.db);
+      store->require_writable();
       key.kind = study::BatchKey::Kind::kRun;
       key.scenario_file = o.scenario;
       key.scenario_name = s->name;
@@ -228,6 +249,11 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
         return kExitBadInput;
       }
       hooks.record_path = (dir / study::recording_file_name(s->name, s->variant, seed)).string();
+    }
+    if (const std::string why = cannot_create(hooks.record_path); !why.empty()) {
+      err << "llsfsim run: " << hooks.record_path << ": cannot create the recording: " << why
+          << "\n";
+      return kExitBadInput;
     }
   }
   // Paced mode: sleep between ticks so that game time runs `speed` times as fast as the wall
@@ -321,10 +347,9 @@ struct AgentSource {
 std::vector<AgentSource> read_agent_sources(const std::vector<std::string>& entries) {
   std::vector<AgentSource> out;
   for (const std::string& f : sim::agent_files(entries)) {
-    std::ifstream in(f, std::ios::binary);
-    std::ostringstream text;
-    text << in.rdbuf();
-    AgentSource src{f, text.str()};
+    std::string error;  // reported when the agent loads
+    AgentSource src{
+        f, core::try_read_input_file(f, core::kMaxSourceBytes, "CLIPS file", error).value_or("")};
     bool in_string = false;
     bool comment = false;
     for (char& c : src.code) {
@@ -460,9 +485,7 @@ int check(const std::vector<std::string>& files, std::ostream& out, std::ostream
 
 Action add_run_command(CLI::App& app) {
   auto o = std::make_shared<RunOptions>();
-  app.add_option("scenario", o->scenario, "Scenario file (docs/scenarios.md)")
-      ->required()
-      ->check(CLI::ExistingFile);
+  app.add_option("scenario", o->scenario, "Scenario file (docs/scenarios.md)")->required();
   app.add_option("--seed", o->seed, "Seed to play (default: the scenario's first)");
   app.add_option("--variant", o->variant,
                  "Matrix variant, e.g. 'config=P3-P3' or just 'P3-P3' (default: the first)");

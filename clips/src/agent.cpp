@@ -11,6 +11,7 @@
 
 #include "feature.h"
 #include "llsf/core/config.h"
+#include "llsf/core/input_file.h"
 #include "sandbox.h"
 #include "tracer.h"
 
@@ -364,11 +365,10 @@ AgentHost& AgentHost::operator=(AgentHost&& other) noexcept {
 }
 
 void AgentHost::load_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw AgentLoadError(path + ": cannot read the file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  impl_->load(text.str(), path);
+  std::string error;
+  const auto text = core::try_read_input_file(path, core::kMaxSourceBytes, "CLIPS file", error);
+  if (!text) throw AgentLoadError(error);
+  impl_->load(*text, path);
 }
 
 void AgentHost::load_string(std::string_view code, std::string_view source_name) {

@@ -18,11 +18,13 @@
 #include <map>
 #include <numbers>
 #include <optional>
+#include <sstream>
 #include <stdexcept>
 #include <utility>
 
 #include "llsf/comm/registry.h"
 #include "llsf/core/config.h"
+#include "llsf/core/input_file.h"
 #include "llsf/core/text.h"
 
 namespace llsf::clips {
@@ -612,7 +614,7 @@ int setup_first_line(const ConfigNode& setup, const std::string& path) {
   if (c1 == std::string::npos) return 1;
   const int line = std::atoi(loc.c_str() + c1 + 1);
   const int column = std::atoi(loc.c_str() + c2 + 1);
-  std::ifstream in(path);
+  std::istringstream in(core::read_input_file(path, core::kMaxSourceBytes, "rule-test file"));
   std::string text;
   for (int i = 0; i < line && std::getline(in, text); ++i) {
   }

@@ -1,16 +1,20 @@
 // SPDX-License-Identifier: MIT
 #include "llsf/core/config.h"
 
+#include <yaml-cpp/eventhandler.h>
+#include <yaml-cpp/parser.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <fstream>
+#include <cstdio>
 #include <map>
 #include <optional>
+#include <set>
 #include <sstream>
 
+#include "llsf/core/input_file.h"
 #include "llsf/core/text.h"
 
 namespace llsf::core {
@@ -95,6 +99,214 @@ std::string describe(const YAML::Node& n) {
 }
 }  // namespace
 
+// --- Strict YAML ------------------------------------------------------------------------------
+
+namespace {
+
+/// One pass over the events of a document before yaml-cpp builds its tree: refuses a key given
+/// twice in a map, aliases that expand past kMaxYamlNodes, an alias inside its own anchor (a
+/// tree that contains itself) and nesting past kMaxYamlDepth, each at the offending node's
+/// file:line:column with its path.
+class StrictChecker : public YAML::EventHandler {
+ public:
+  explicit StrictChecker(const std::string& source) : source_(source) {}
+
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override {}
+  void OnAnchor(const YAML::Mark&, const std::string& name) override { pending_name_ = name; }
+
+  void OnNull(const YAML::Mark& mark, YAML::anchor_t anchor) override {
+    const std::string path = begin_node(mark, nullptr);
+    count(mark, path, 1);
+    if (anchor != YAML::NullAnchor) finish_anchor(anchor, 1, std::nullopt);
+    end_node();
+  }
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t anchor) override {
+    const auto scalar = scalars_.find(anchor);
+    const std::string path = begin_node(mark, scalar == scalars_.end() ? nullptr : &scalar->second);
+    if (open_.count(anchor) != 0) {
+      fail(mark, path,
+           "the alias *" + name_of(anchor) +
+               " is inside its own anchor (a structure that contains itself)");
+    }
+    const auto size = sizes_.find(anchor);
+    aliases_ = true;
+    count(mark, path, size == sizes_.end() ? 1 : size->second);
+    end_node();
+  }
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor,
+                const std::string& value) override {
+    const std::string path = begin_node(mark, &value);
+    count(mark, path, 1);
+    if (anchor != YAML::NullAnchor) finish_anchor(anchor, 1, value);
+    end_node();
+  }
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor,
+                       YAML::EmitterStyle::value) override {
+    start_container(mark, anchor, false);
+  }
+  void OnSequenceEnd() override { end_container(); }
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor,
+                  YAML::EmitterStyle::value) override {
+    start_container(mark, anchor, true);
+  }
+  void OnMapEnd() override { end_container(); }
+
+ private:
+  struct Frame {
+    bool is_map = false;
+    std::string path;
+    int index = 0;                                       // a list: the next element's index
+    bool at_key = true;                                  // a map: the next node is a key
+    std::string key;                                     // a map: the key of the value that follows
+    std::map<std::string, int, std::less<>> first_line;  // a map: each key's first line
+    YAML::anchor_t anchor = YAML::NullAnchor;
+    std::uint64_t nodes_before = 0;
+  };
+
+  [[noreturn]] void fail(const YAML::Mark& mark, const std::string& path,
+                         const std::string& message) const {
+    throw ConfigError(source_ + ":" + std::to_string(mark.line + 1) + ":" +
+                      std::to_string(mark.column + 1) + ": " +
+                      (path.empty() ? std::string("(top level)") : shorten(path)) + ": " + message);
+  }
+
+  /// `s`, or its start and end around "..." if it is longer than 120 characters (a path 64
+  /// levels deep, a key of a megabyte).
+  static std::string shorten(const std::string& s) {
+    if (s.size() <= 120) return s;
+    return s.substr(0, 56) + "..." + s.substr(s.size() - 56);
+  }
+
+  std::string name_of(YAML::anchor_t anchor) const {
+    const auto it = names_.find(anchor);
+    return it == names_.end() ? std::to_string(anchor) : it->second;
+  }
+
+  /// The path of the node that starts at `mark`; checks a map key (`scalar` is its text, or
+  /// null for a key that is not a scalar) against the map's earlier keys.
+  std::string begin_node(const YAML::Mark& mark, const std::string* scalar) {
+    if (stack_.empty()) return "";
+    Frame& f = stack_.back();
+    if (!f.is_map) return f.path + "[" + std::to_string(f.index) + "]";
+    if (!f.at_key) return child_path(f.path, f.key);
+    f.key = scalar != nullptr ? *scalar : std::string("(key)");
+    const std::string path = child_path(f.path, f.key);
+    if (scalar != nullptr) {
+      const auto [it, fresh] = f.first_line.emplace(*scalar, mark.line + 1);
+      if (!fresh) {
+        fail(mark, path,
+             "key '" + shorten(*scalar) + "' given twice (first at line " +
+                 std::to_string(it->second) + ")");
+      }
+    }
+    return path;
+  }
+
+  /// After a node: the next node of a map is a value or a key, of a list the next element.
+  void end_node() {
+    if (stack_.empty()) return;
+    Frame& f = stack_.back();
+    if (f.is_map) {
+      f.at_key = !f.at_key;
+    } else {
+      ++f.index;
+    }
+  }
+
+  void count(const YAML::Mark& mark, const std::string& path, std::uint64_t n) {
+    nodes_ += n;
+    if (nodes_ <= kMaxYamlNodes) return;
+    if (aliases_) {
+      fail(mark, path,
+           "the aliases expand the document to more than " + std::to_string(kMaxYamlNodes) +
+               " nodes (aliases of aliases, a \"billion laughs\"?)");
+    }
+    fail(mark, path, "more than " + std::to_string(kMaxYamlNodes) + " nodes in the document");
+  }
+
+  void finish_anchor(YAML::anchor_t anchor, std::uint64_t size,
+                     const std::optional<std::string>& scalar) {
+    sizes_[anchor] = size;
+    if (scalar) scalars_[anchor] = *scalar;
+    if (!pending_name_.empty()) names_[anchor] = pending_name_;
+    pending_name_.clear();
+  }
+
+  void start_container(const YAML::Mark& mark, YAML::anchor_t anchor, bool is_map) {
+    const std::string path = begin_node(mark, nullptr);
+    if (static_cast<int>(stack_.size()) >= kMaxYamlDepth) {
+      fail(mark, path,
+           "nesting deeper than " + std::to_string(kMaxYamlDepth) +
+               " levels (maps and lists inside each other)");
+    }
+    Frame f;
+    f.is_map = is_map;
+    f.path = path;
+    f.anchor = anchor;
+    f.nodes_before = nodes_;
+    if (anchor != YAML::NullAnchor) {
+      open_.insert(anchor);
+      if (!pending_name_.empty()) names_[anchor] = pending_name_;
+      pending_name_.clear();
+    }
+    count(mark, path, 1);
+    stack_.push_back(std::move(f));
+  }
+
+  void end_container() {
+    const Frame f = std::move(stack_.back());
+    stack_.pop_back();
+    if (f.anchor != YAML::NullAnchor) {
+      open_.erase(f.anchor);
+      sizes_[f.anchor] = nodes_ - f.nodes_before;
+    }
+    end_node();
+  }
+
+  const std::string& source_;
+  std::vector<Frame> stack_;
+  std::uint64_t nodes_ = 0;
+  bool aliases_ = false;
+  std::map<YAML::anchor_t, std::uint64_t> sizes_;  // nodes of each anchor, expanded
+  std::map<YAML::anchor_t, std::string> scalars_;  // the text of each scalar anchor
+  std::map<YAML::anchor_t, std::string> names_;    // each anchor's name
+  std::set<YAML::anchor_t> open_;                  // anchors of containers not yet ended
+  std::string pending_name_;
+};
+
+std::string location_of(const std::string& source, std::string_view text, std::size_t offset) {
+  const TextPosition p = text_position(text, offset);
+  return source + ":" + std::to_string(p.line) + ":" + std::to_string(p.column);
+}
+
+}  // namespace
+
+void check_strict_yaml(std::string_view text, const std::string& source_name) {
+  if (text.size() > kMaxSourceBytes) {
+    throw ConfigError(source_name + ": " + byte_size_text(text.size()) + " is over the limit of " +
+                      byte_size_text(kMaxSourceBytes) + " for YAML");
+  }
+  if (const std::optional<std::size_t> nul = find_nul(text)) {
+    throw ConfigError(location_of(source_name, text, *nul) + ": a NUL byte: YAML must be text");
+  }
+  if (const std::optional<std::size_t> bad = find_invalid_utf8(text)) {
+    char byte[8];
+    std::snprintf(byte, sizeof byte, "0x%02X", static_cast<unsigned char>(text[*bad]));
+    throw ConfigError(location_of(source_name, text, *bad) + ": invalid UTF-8 (byte " + byte +
+                      "): YAML must be UTF-8 text");
+  }
+  std::istringstream in{std::string(text)};
+  StrictChecker checker(source_name);
+  try {
+    YAML::Parser parser(in);
+    parser.HandleNextDocument(checker);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(source_name + ":" + std::to_string(e.mark.line + 1) + ":" +
+                      std::to_string(e.mark.column + 1) + ": YAML syntax error: " + e.msg);
+  }
+}
+
 ConfigNode::ConfigNode() : impl_(std::make_shared<Impl>()) {}
 ConfigNode::~ConfigNode() = default;
 ConfigNode::ConfigNode(const ConfigNode&) = default;
@@ -102,14 +314,11 @@ ConfigNode& ConfigNode::operator=(const ConfigNode&) = default;
 ConfigNode::ConfigNode(std::shared_ptr<const Impl> impl) : impl_(std::move(impl)) {}
 
 ConfigNode ConfigNode::load_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ConfigError(path + ": cannot open file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return parse(ss.str(), path);
+  return parse(read_input_file(path, kMaxSourceBytes, "YAML file"), path);
 }
 
 ConfigNode ConfigNode::parse(std::string_view text, const std::string& source_name) {
+  check_strict_yaml(text, source_name);
   auto impl = std::make_shared<Impl>();
   impl->source = source_name;
   try {
@@ -413,7 +622,7 @@ void ConfigNode::fail_at(std::string_view rel, const std::string& reason) const 
                     reason);
 }
 
-void ConfigNode::relocate(const ConfigError& e) const {
+void ConfigNode::relocate(const ConfigError& e, std::span<const PathRename> renames) const {
   const std::string what = e.what();
   const std::size_t colon = what.find(": ");
   const std::string_view head = std::string_view(what).substr(0, colon);
@@ -421,7 +630,34 @@ void ConfigNode::relocate(const ConfigError& e) const {
       colon != std::string::npos && !head.empty() &&
       std::all_of(head.begin(), head.end(), [](char ch) { return is_path_char(ch); });
   if (!is_path) throw ConfigError(location() + ": " + what);
-  fail_at(head, what.substr(colon + 2));
+  // The renamed path that the document has, else the one that reaches deepest into it.
+  std::string path(head);
+  std::optional<std::size_t> best;  // how deep the best candidate reaches into the document
+  for (const PathRename& r : renames) {
+    if (r.from.empty() || !head.starts_with(r.from)) continue;
+    const std::string_view rest = head.substr(r.from.size());
+    if (!rest.empty() && r.from.back() != '[' && rest.front() != '.' && rest.front() != '[') {
+      continue;  // "game.skill" does not start "game.skill_rate_hz"
+    }
+    std::string renamed(r.to);
+    renamed += renamed.empty() && !rest.empty() && rest.front() == '.' ? rest.substr(1) : rest;
+    std::string want = impl_->path;
+    if (!want.empty() && !renamed.empty() && renamed.front() != '[') want += ".";
+    want += renamed;
+    const std::string found = resolve(renamed).path();
+    if (found == want) {
+      path = renamed;
+      break;
+    }
+    // Depth in keys and indices: on a tie the earlier rename wins.
+    const auto depth = static_cast<std::size_t>(
+        std::count_if(found.begin(), found.end(), [](char ch) { return ch == '.' || ch == '['; }));
+    if (!best || depth > *best) {
+      best = depth;
+      path = renamed;
+    }
+  }
+  fail_at(path, what.substr(colon + 2));
 }
 
 }  // namespace llsf::core

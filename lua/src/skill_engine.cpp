@@ -17,6 +17,7 @@
 #include "engine_impl.h"
 #include "llsf/core/assert.h"
 #include "llsf/core/error.h"
+#include "llsf/core/input_file.h"
 
 namespace llsf::lua {
 
@@ -172,10 +173,9 @@ void open_lib(lua_State* L, const char* name, lua_CFunction fn) {
   lua_pop(L, 1);
 }
 
-std::string read_file(const std::string& path, bool& ok) {
-  std::ifstream in(path, std::ios::binary);
-  ok = static_cast<bool>(in);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+std::string read_file(const std::string& path, std::string& error) {
+  return core::try_read_input_file(path, core::kMaxSourceBytes, "Lua skill file", error)
+      .value_or("");
 }
 
 bool is_identifier(const std::string& s) {
@@ -320,10 +320,10 @@ void SkillEngine::Impl::build() {
 
   for (const SkillFile& f : files) {
     std::string load_error;
-    bool ok = false;
-    const std::string text = read_file(f.path, ok);
-    if (!ok) {
-      load_error = f.path + ": cannot read the file";
+    std::string read_error;
+    const std::string text = read_file(f.path, read_error);
+    if (!read_error.empty()) {
+      load_error = read_error;
     } else if (!is_identifier(f.name)) {
       load_error = f.path + ": a skill's file name must be a Lua identifier";
     } else {

@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "llsf/clips/rule_test.h"
+#include "llsf/core/input_file.h"
 
 namespace llsf::sim {
 
@@ -62,8 +63,9 @@ std::unique_ptr<clips::AgentHost> AgentBrain::make_host() const {
     } catch (const clips::AgentLoadError& e) {
       // The lock template exists only with the lock protocol on: name the switch.
       const std::string what = e.what();
-      std::ifstream in(f, std::ios::binary);
-      const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+      std::string error;
+      const std::string text =
+          core::try_read_input_file(f, core::kMaxSourceBytes, "CLIPS file", error).value_or("");
       if (!locks_ && (what.find("deftemplate lock") != std::string::npos ||
                       text.find("(lock (") != std::string::npos)) {
         throw clips::AgentLoadError(

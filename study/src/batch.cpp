@@ -56,6 +56,11 @@ std::vector<std::uint64_t> batch_seeds(const Scenario& s, std::optional<int> run
   if (!runs) return s.seeds;
   const int n = *runs;
   if (n < 1) throw core::ConfigError("--runs must be at least 1");
+  if (n > ScenarioLimits::kMaxSeeds) {
+    throw core::ConfigError("--runs " + std::to_string(n) + ": at most " +
+                            std::to_string(ScenarioLimits::kMaxSeeds) +
+                            " seeds per variant (docs/security.md, \"Scenario budgets\")");
+  }
   if (s.seeds.size() == 1) {
     std::vector<std::uint64_t> out;
     for (int i = 0; i < n; ++i) out.push_back(s.seeds.front() + static_cast<std::uint64_t>(i));
@@ -66,6 +71,20 @@ std::vector<std::uint64_t> batch_seeds(const Scenario& s, std::optional<int> run
                             std::to_string(s.seeds.size()) + " seeds");
   }
   return {s.seeds.begin(), s.seeds.begin() + n};
+}
+
+std::int64_t batch_games(const ScenarioFile& file, std::optional<int> runs) {
+  std::int64_t games = 0;
+  for (const Scenario& s : file.variants) {
+    games += static_cast<std::int64_t>(batch_seeds(s, runs).size());
+  }
+  if (games > ScenarioLimits::kMaxGames) {
+    throw core::ConfigError(
+        file.file + ": " + std::to_string(file.variants.size()) + " variants x --runs " +
+        std::to_string(runs.value_or(0)) + " = " + std::to_string(games) + " games: at most " +
+        std::to_string(ScenarioLimits::kMaxGames) + " (docs/security.md, \"Scenario budgets\")");
+  }
+  return games;
 }
 
 bool BatchResult::all_passed() const {
@@ -112,6 +131,7 @@ BatchResult run_batch(const ScenarioFile& file, const std::string& scenario_hash
                       const BatchOptions& options, const BatchHooks& hooks) {
   if (file.variants.empty()) throw core::ConfigError(file.file + ": no variants");
   if (options.jobs < 0) throw core::ConfigError("--jobs must be at least 1");
+  (void)batch_games(file, options.runs);  // within the budget
 
   // Every (variant, seed), seed-major: an interrupted batch has every variant on its first seeds.
   std::vector<std::vector<std::uint64_t>> seeds;

@@ -72,7 +72,7 @@ void RobotProfile::validate() const {
   core::require(p + "max_accel_mps2", max_accel_mps2, core::positive());
   core::require(p + "max_alpha_rps2", max_alpha_rps2, core::positive());
   core::require(p + "max_speed_mps", max_speed_mps, core::at_most(3.0));
-  core::require(p + "motor_max_speed_mps", motor_max_speed_mps, core::non_negative());
+  core::require(p + "motor_max_speed_mps", motor_max_speed_mps, core::in_range(0.0, 3.0));
   core::require(p + "motor_max_omega_rps", motor_max_omega_rps, core::non_negative());
   core::require(p + "align_s", align_s, core::non_negative());
   core::require(p + "align_s", align_s, core::at_most(60.0));
@@ -83,10 +83,12 @@ void RobotProfile::validate() const {
   core::require(p + "light_error_rate", light_error_rate, core::probability());
   core::require(p + "laser_rate_hz", laser_rate_hz, core::positive());
   core::require(p + "laser_rate_hz", laser_rate_hz, core::at_most(100.0));
-  core::require(p + "position_noise_m", position_noise_m, core::non_negative());
-  core::require(p + "heading_noise_rad", heading_noise_rad, core::non_negative());
-  core::require(p + "wait_before_replan_s", wait_before_replan_s, core::non_negative());
+  // As the scenario's levels keys (docs/security.md, "Scenario budgets").
+  core::require(p + "position_noise_m", position_noise_m, core::in_range(0.0, 1.0));
+  core::require(p + "heading_noise_rad", heading_noise_rad, core::in_range(0.0, core::kPi));
+  core::require(p + "wait_before_replan_s", wait_before_replan_s, core::in_range(0.0, 60.0));
   core::require(p + "backoff_min_s", backoff_min_s, core::non_negative());
+  core::require(p + "backoff_max_s", backoff_max_s, core::at_most(60.0));
   if (!(backoff_max_s >= backoff_min_s) || !std::isfinite(backoff_max_s)) {
     throw core::ConfigError(p + "backoff_max_s: must be >= backoff_min_s (got " +
                             core::number_text(backoff_max_s) + ")");

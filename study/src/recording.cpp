@@ -4,6 +4,7 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -11,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string_view>
+#include <system_error>
 #include <unordered_map>
 
 #include "llsf/core/error.h"
@@ -176,7 +178,10 @@ Recorder::Recorder(const std::string& path, const sim::Game& game, const Recordi
   m.sink = std::move(sink);
   if (!path.empty()) {
     m.file = gzopen(path.c_str(), "wb6");
-    if (m.file == nullptr) throw core::UserError(path + ": cannot create the recording");
+    if (m.file == nullptr) {
+      throw core::UserError(path + ": cannot create the recording: " +
+                            std::error_code(errno, std::generic_category()).message());
+    }
   }
   m.paths.resize(static_cast<std::size_t>(game.robot_count()));
   m.jam_device.assign(static_cast<std::size_t>(game.robot_count()), -1);

@@ -739,7 +739,7 @@ std::string to_json(const RunResult& r) {
     tests.push_back({{"name", t.name}, {"passed", t.passed}, {"detail", t.detail}});
   }
   char hash[17];
-  std::snprintf(hash, sizeof hash, "%llx", static_cast<unsigned long long>(r.result_hash));
+  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(r.result_hash));
   Json j = {{"scenario", r.scenario},
             {"variant", r.variant},
             {"seed", r.seed},

@@ -1,15 +1,22 @@
 // SPDX-License-Identifier: MIT
 #include "llsf/study/scenario.h"
 
+#include <array>
+#include <charconv>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
+#include <string_view>
+#include <system_error>
 #include <utility>
 
 #include "llsf/comm/hub_config.h"
 #include "llsf/core/error.h"
+#include "llsf/core/input_file.h"
 #include "llsf/kinematic/world_config.h"
 #include "llsf/planner/config.h"
 #include "llsf/refbox/config.h"
@@ -25,11 +32,7 @@ namespace fs = std::filesystem;
 constexpr core::SimTime kHackathonDefaultDuration = core::SimTime::from_sec(300);
 
 std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw core::ConfigError(path + ": cannot read the scenario file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
+  return core::read_input_file(path, core::kMaxSourceBytes, "scenario file");
 }
 
 /// A path of the scenario, relative to its directory unless absolute.
@@ -68,26 +71,29 @@ void read_levels(const core::ConfigNode& n, sim::RobotLevelsConfig& l) {
   n.read_enum("skill", l.skill,
               {{"physical", sim::SkillLevel::kPhysical}, {"symbolic", sim::SkillLevel::kSymbolic}},
               "skill level");
-  n.read("position_noise_m", l.localization.position_noise_m);
-  n.read("heading_noise_rad", l.localization.heading_noise_rad);
-  n.read("light_error_rate", l.light.error_rate);
+  // Bounds: docs/security.md, "Scenario budgets".
+  n.read("position_noise_m", l.localization.position_noise_m, core::in_range(0.0, 1.0));
+  n.read("heading_noise_rad", l.localization.heading_noise_rad, core::in_range(0.0, core::kPi));
+  n.read("light_error_rate", l.light.error_rate, core::probability());
   if (const core::ConfigNode delay = n["light_delay_s"]; delay.defined()) {
-    l.light.delay = core::SimTime::from_seconds(delay.as_double());
+    l.light.delay = core::SimTime::from_seconds(delay.as_double(core::in_range(0.0, 60.0)));
   }
-  n.read("cruise_speed_mps", l.symbolic.cruise_speed_mps);
+  n.read("cruise_speed_mps", l.symbolic.cruise_speed_mps, core::in_range(0.01, 10.0));
   n.no_other_keys();
 }
 
 void read_rates(const core::ConfigNode& n, sim::GameConfig& g) {
   if (!n.defined()) return;
   n.require_map();
-  double physics_hz = 0.0;  // 0: not given
-  n.read("physics_hz", physics_hz, core::positive());
+  using L = ScenarioLimits;  // the bounds' reasons: docs/security.md, "Scenario budgets"
+  double physics_hz = 0.0;   // 0: not given
+  n.read("physics_hz", physics_hz, core::in_range(L::kMinPhysicsHz, L::kMaxPhysicsHz));
   if (physics_hz > 0.0) g.world.physics.step = core::SimTime::period_of_hz(physics_hz);
-  n.read("skill_hz", g.skill_rate_hz, core::positive());
-  n.read("agent_hz", g.agent_rate_hz, core::positive());
+  n.read("skill_hz", g.skill_rate_hz, core::in_range(L::kMinCycleHz, L::kMaxPhysicsHz));
+  n.read("agent_hz", g.agent_rate_hz, core::in_range(L::kMinCycleHz, L::kMaxPhysicsHz));
   double beacon_period_s = 0.0;  // 0: not given
-  n.read("beacon_period_s", beacon_period_s, core::positive());
+  n.read("beacon_period_s", beacon_period_s,
+         core::in_range(L::kMinBeaconPeriodS, L::kMaxBeaconPeriodS));
   if (beacon_period_s > 0.0) g.beacon_period = core::SimTime::from_seconds(beacon_period_s);
   n.no_other_keys();
 }
@@ -105,13 +111,18 @@ std::vector<std::uint64_t> read_seeds(const core::ConfigNode& root) {
   if (seeds.is_map()) {
     std::uint64_t first = 1;
     if (const core::ConfigNode f = seeds["first"]; f.defined()) first = one(f);
-    const std::int64_t count = seeds.at("count").as_int(core::in_range(1, 100000));
+    const std::int64_t count =
+        seeds.at("count").as_int(core::in_range(1, static_cast<double>(ScenarioLimits::kMaxSeeds)));
     seeds.no_other_keys();
     for (std::int64_t i = 0; i < count; ++i) out.push_back(first + static_cast<std::uint64_t>(i));
     return out;
   }
   if (!seeds.is_sequence() || seeds.size() == 0)
     seeds.fail("expected a list of seeds or {first, count}");
+  if (seeds.size() > ScenarioLimits::kMaxSeeds) {
+    seeds.fail("a list of " + std::to_string(seeds.size()) + " seeds: at most " +
+               std::to_string(ScenarioLimits::kMaxSeeds) + " (docs/security.md)");
+  }
   for (const core::ConfigNode& e : seeds.elements()) out.push_back(one(e));
   return out;
 }
@@ -123,15 +134,28 @@ void merge_config(clips::ConfigEntries& into, const clips::ConfigEntries& over) 
   }
 }
 
+/// Whether the directory `dir` holds a regular `*.clp` file (what an agent directory loads).
+bool has_clp_file(const std::string& dir) {
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    std::error_code file_ec;
+    if (it->path().extension() == ".clp" && it->is_regular_file(file_ec)) return true;
+  }
+  return false;
+}
+
 std::vector<std::string> read_agent(const core::ConfigNode& n, const std::string& dir) {
   std::vector<std::string> out;
   const std::vector<std::string> entries = string_list(n);
   for (std::size_t i = 0; i < entries.size(); ++i) {
     const std::string p = resolve(dir, entries[i]);
     std::error_code ec;
+    const core::ConfigNode at = n.is_sequence() ? n.at(static_cast<int>(i)) : n;
     if (!fs::exists(p, ec)) {
-      (n.is_sequence() ? n.at(static_cast<int>(i)) : n)
-          .fail("agent file or directory '" + entries[i] + "' not found (looked at " + p + ")");
+      at.fail("agent file or directory '" + entries[i] + "' not found (looked at " + p + ")");
+    }
+    if (fs::is_directory(p, ec) && !has_clp_file(p)) {
+      at.fail("agent directory '" + entries[i] + "' has no .clp files (looked at " + p + ")");
     }
     out.push_back(p);
   }
@@ -186,9 +210,9 @@ void read_robots(const core::ConfigNode& n, const std::string& dir, Scenario& s)
     if (const core::ConfigNode p = r["start"]; p.defined()) {
       p.require_map();
       double x = start.pose.x, y = start.pose.y, ori = start.pose.theta * 180.0 / core::kPi;
-      p.read("x", x);
-      p.read("y", y);
-      p.read("ori_deg", ori);
+      p.read("x", x, core::in_range(-1000.0, 1000.0));  // metres; the world checks the field
+      p.read("y", y, core::in_range(-1000.0, 1000.0));
+      p.read("ori_deg", ori, core::in_range(-360.0, 360.0));
       p.no_other_keys();
       start.pose = {x, y, ori * core::kPi / 180.0};
     }
@@ -232,10 +256,130 @@ void read_tests(const core::ConfigNode& n, Scenario& s) {
         by.fail("by_s works with points_at_least and deliveries_at_least");
       }
       tc.by_s = by.as_double(core::positive());
+      const double duration_s = static_cast<double>(s.duration.ns()) / 1e9;
+      if (*tc.by_s > duration_s) {
+        by.fail("must be at most the game's duration " + core::number_text(duration_s) +
+                " s (got " + core::number_text(*tc.by_s) + "): the game ends before");
+      }
     }
     tc.name = name.defined() ? name.as_string() : describe(tc);
     s.tests.push_back(std::move(tc));
   }
+}
+
+/// The node at `dotted` ("rates.skill_hz") if the document has it.
+std::optional<core::ConfigNode> find_key(const core::ConfigNode& root, std::string_view dotted) {
+  core::ConfigNode n = root;
+  while (!dotted.empty()) {
+    const std::size_t dot = dotted.find('.');
+    if (!n.is_map()) return std::nullopt;
+    n = n[dotted.substr(0, dot)];
+    if (!n.defined()) return std::nullopt;
+    dotted = dot == std::string_view::npos ? std::string_view() : dotted.substr(dot + 1);
+  }
+  return n;
+}
+
+/// The scenario keys that set a field GameConfig::validate() names, most specific first; a
+/// field is matched by prefix ("game.levels." covers every level field).
+struct GameFieldKeys {
+  std::string_view field;
+  std::array<std::string_view, 3> keys;
+};
+constexpr GameFieldKeys kGameFieldKeys[] = {
+    {"game.levels.localization.position_noise_m", {"levels.position_noise_m", "profile"}},
+    {"game.levels.localization.heading_noise_rad", {"levels.heading_noise_rad", "profile"}},
+    {"game.levels.light.error_rate", {"levels.light_error_rate", "profile"}},
+    {"game.levels.light.delay", {"levels.light_delay_s", "profile"}},
+    {"game.levels.symbolic.cruise_speed_mps", {"levels.cruise_speed_mps"}},
+    {"game.levels.", {"levels", "profile"}},
+    {"game.skill_rate_hz", {"rates.skill_hz", "rates.physics_hz", "world.physics.step_ms"}},
+    {"game.agent_rate_hz", {"rates.agent_hz", "rates.physics_hz", "world.physics.step_ms"}},
+    {"game.beacon_period", {"rates.beacon_period_s"}},
+    {"game.handling.", {"profile"}},
+    {"game.hackathon", {"hackathon"}},
+    {"physics.", {"rates.physics_hz", "world.physics", "world"}},
+};
+
+/// The node of a world.validate() error about a robot ("robots[1].jersey: duplicate ...",
+/// "robots[0]: ... is outside the field") if the scenario sets that robot in `robots.each`:
+/// the key named, else its start pose for a position, else the entry.
+std::optional<core::ConfigNode> robot_error_node(const core::ConfigNode& root,
+                                                 std::string_view what) {
+  if (!what.starts_with("robots[")) return std::nullopt;
+  const std::size_t close = what.find(']');
+  if (close == std::string_view::npos) return std::nullopt;
+  int index = -1;
+  const std::string_view digits = what.substr(7, close - 7);
+  if (std::from_chars(digits.data(), digits.data() + digits.size(), index).ec != std::errc()) {
+    return std::nullopt;
+  }
+  const std::optional<core::ConfigNode> each = find_key(root, "robots.each");
+  if (!each || !each->is_sequence() || index < 0 || index >= each->size()) return std::nullopt;
+  const core::ConfigNode entry = each->at(index);
+  if (!entry.is_map()) return entry;
+  std::string_view rest = what.substr(close + 1);
+  if (rest.starts_with('.')) {
+    rest.remove_prefix(1);
+    const std::string_view field = rest.substr(0, rest.find_first_of(".:["));
+    if (const core::ConfigNode n = entry[field]; n.defined()) return n;
+  } else if (what.find("outside the field") != std::string_view::npos ||
+             what.find("overlaps") != std::string_view::npos) {
+    if (const core::ConfigNode n = entry["start"]; n.defined()) return n;
+  }
+  return entry;
+}
+
+/// Throws GameConfig::validate()'s error `e` ("game.skill_rate_hz: must not exceed ...") at the
+/// scenario key that set the field, or at the top level if the document has none of its keys.
+[[noreturn]] void fail_at_game_key(const core::ConfigNode& root, const core::ConfigError& e) {
+  const std::string_view what = e.what();
+  // The hackathon's own errors name its keys ("hackathon.colours: no free spot ..."): the
+  // deepest of them the document has.
+  const std::size_t colon = what.find(": ");
+  const std::string reason(colon == std::string_view::npos ? what : what.substr(colon + 2));
+  const std::string field(what.substr(0, colon));
+  std::string_view key = field;
+  if (key.starts_with("game.")) key.remove_prefix(5);
+  while (key.starts_with("hackathon")) {
+    if (const std::optional<core::ConfigNode> n = find_key(root, key)) {
+      n->fail(reason + " (" + field + ")");
+    }
+    const std::size_t dot = key.rfind('.');
+    if (dot == std::string_view::npos) break;
+    key = key.substr(0, dot);
+  }
+  if (const std::optional<core::ConfigNode> n = robot_error_node(root, what)) {
+    n->fail(reason + " (" + field + ")");
+  }
+  for (const GameFieldKeys& f : kGameFieldKeys) {
+    if (!what.starts_with(f.field)) continue;
+    for (const std::string_view k : f.keys) {
+      if (k.empty()) continue;
+      if (const std::optional<core::ConfigNode> n = find_key(root, k)) {
+        n->fail(reason + " (" + field + ")");
+      }
+    }
+  }
+  root.fail("the game config is invalid: " + std::string(what));
+}
+
+/// duration / physics step within ScenarioLimits::kMaxPhysicsSteps, failing at the key that
+/// made it too many: the physics rate, the world's step or the duration.
+void check_physics_steps(const core::ConfigNode& root, const Scenario& s) {
+  const std::int64_t step = s.game.world.physics.step.ns();
+  if (step <= 0) return;  // GameConfig::validate() says it
+  const std::int64_t steps = s.duration.ns() / step;
+  if (steps <= ScenarioLimits::kMaxPhysicsSteps) return;
+  const std::string why = "the game would take " + std::to_string(steps) + " physics steps (" +
+                          core::number_text(static_cast<double>(s.duration.ns()) / 1e9) + " s at " +
+                          core::number_text(1e9 / static_cast<double>(step)) + " Hz); at most " +
+                          std::to_string(ScenarioLimits::kMaxPhysicsSteps) +
+                          " (docs/security.md, \"Scenario budgets\")";
+  for (const std::string_view key : {"rates.physics_hz", "world.physics.step_ms", "duration_s"}) {
+    if (const std::optional<core::ConfigNode> n = find_key(root, key)) n->fail(why);
+  }
+  root.fail(why);
 }
 
 Scenario read_scenario(const core::ConfigNode& root, const std::string& file) {
@@ -286,8 +430,10 @@ Scenario read_scenario(const core::ConfigNode& root, const std::string& file) {
     duration += rb.setup_duration.seconds();
   }
   if (s.game.hackathon) duration = kHackathonDefaultDuration.seconds();
-  root.read("duration_s", duration, core::positive());
+  root.read("duration_s", duration,
+            core::in_range(ScenarioLimits::kMinDurationS, ScenarioLimits::kMaxDurationS));
   s.duration = core::SimTime::from_seconds(duration);
+  check_physics_steps(root, s);
   read_robots(root["robots"], dir, s);
   if (const core::ConfigNode n = root["skills"]; n.defined()) {
     s.skills = lua::SkillEngineConfig::from_config(n, dir);  // dirs relative to the file
@@ -301,7 +447,15 @@ Scenario read_scenario(const core::ConfigNode& root, const std::string& file) {
   try {
     s.game.validate();
   } catch (const core::ConfigError& e) {
-    root.fail(std::string("the game config is invalid: ") + e.what());
+    fail_at_game_key(root, e);
+  }
+  if (s.game.hackathon) {
+    // The layout of the first seed: pucks that find no free spot are an error of the file.
+    try {
+      (void)sim::prepare_game_config(s.game);
+    } catch (const core::ConfigError& e) {
+      fail_at_game_key(root, e);
+    }
   }
   return s;
 }
@@ -347,6 +501,9 @@ Scenario read_scenario_map(const core::ConfigNode& root, const std::string& file
 }
 
 ScenarioFile load_scenario(const std::string& path) {
+  if (std::error_code ec; fs::is_directory(path, ec)) {
+    throw core::ConfigError(path + ": is a directory, expected a scenario file");
+  }
   const std::string text = read_text(path);
   // A test hook, not for users: a deliberate bug (std::logic_error) when LLSF_TEST_INTERNAL_ERROR
   // is set, so that tests/app/exit_code_test.cpp sees llsfsim tell a bug (exit code 3) from bad
@@ -364,8 +521,10 @@ ScenarioFile load_scenario(const std::string& path) {
   }
   matrix.require_map();
   if (matrix.size() == 0) matrix.fail("an empty matrix: give at least one axis or remove it");
-  // Axes and their values, in file order.
+  // Axes and their values, in file order; their product counted before any is expanded.
   std::vector<std::vector<std::string>> values;
+  std::int64_t variants = 1;
+  std::string sizes;
   for (const std::string& axis : matrix.keys()) {
     const core::ConfigNode a = matrix[axis];
     a.require_map();
@@ -373,10 +532,21 @@ ScenarioFile load_scenario(const std::string& path) {
     out.axes.push_back(axis);
     values.push_back(a.keys());
     for (const std::string& v : values.back()) a[v].require_map();
+    sizes += (sizes.empty() ? "" : " x ") + std::to_string(a.size());
+    if (variants > ScenarioLimits::kMaxVariants / a.size()) variants = -1;  // over the limit
+    if (variants > 0) variants *= a.size();
+  }
+  if (variants < 0 || variants > ScenarioLimits::kMaxVariants) {
+    matrix.fail("more than " + std::to_string(ScenarioLimits::kMaxVariants) +
+                " variants (axes of " + sizes + " values): at most " +
+                std::to_string(ScenarioLimits::kMaxVariants) +
+                " (docs/security.md, \"Scenario budgets\")");
   }
   // The cartesian product, last axis fastest; each cell re-parses the file and applies its
   // overrides (errors then point at the override's line).
   std::vector<std::size_t> idx(values.size(), 0);
+  std::map<std::string, std::vector<std::size_t>> named;  // variant name -> its value indices
+  std::int64_t games = 0;
   while (true) {
     core::ConfigNode root = core::ConfigNode::parse(text, path);
     std::string variant;
@@ -390,8 +560,25 @@ ScenarioFile load_scenario(const std::string& path) {
       }
       variant += (variant.empty() ? "" : ",") + out.axes[a] + "=" + v;
     }
+    // Names identify variants in `run --variant` and in the statistics store: unique. Values
+    // with ',' or '=' can give two variants one name.
+    if (const auto [it, fresh] = named.emplace(variant, idx); !fresh) {
+      std::size_t a = 0;
+      while (a + 1 < idx.size() && it->second[a] == idx[a]) ++a;
+      const core::ConfigNode mine = matrix[out.axes[a]][values[a][idx[a]]];
+      const core::ConfigNode other = matrix[out.axes[a]][values[a][it->second[a]]];
+      mine.fail("two variants are named '" + variant + "': this one and the one of " +
+                other.location() + " (a value with ',' or '=' makes names ambiguous)");
+    }
     Scenario s = read_scenario(root, path);
     s.variant = variant;
+    games += static_cast<std::int64_t>(s.seeds.size());
+    if (games > ScenarioLimits::kMaxGames) {
+      matrix.fail("more than " + std::to_string(ScenarioLimits::kMaxGames) +
+                  " games (the variants' seeds summed): at most " +
+                  std::to_string(ScenarioLimits::kMaxGames) +
+                  " (docs/security.md, \"Scenario budgets\")");
+    }
     out.variants.push_back(std::move(s));
     std::size_t a = values.size();
     while (a > 0) {

@@ -2,9 +2,11 @@
 #include "llsf/study/stats_store.h"
 
 #include <sqlite3.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cinttypes>
 #include <cstdio>
 #include <filesystem>
@@ -363,6 +365,21 @@ StatsStore::StatsStore(StatsStore&&) noexcept = default;
 StatsStore& StatsStore::operator=(StatsStore&&) noexcept = default;
 
 const std::string& StatsStore::path() const { return impl_->path; }
+
+void StatsStore::require_writable() const {
+  const Impl& m = *impl_;
+  if (sqlite3_db_readonly(m.db.get(), "main") == 1) {
+    throw StatsError(m.path + ": the statistics store is read-only: no run can be written to it");
+  }
+  std::error_code ec;
+  std::filesystem::path dir = std::filesystem::absolute(m.path, ec).parent_path();
+  if (ec || dir.empty()) dir = ".";
+  if (::access(dir.c_str(), W_OK | X_OK) != 0) {
+    throw StatsError(m.path + ": the statistics store's directory " + dir.string() +
+                     " is not writable (SQLite writes its journal there): " +
+                     std::error_code(errno, std::generic_category()).message());
+  }
+}
 
 std::int64_t StatsStore::open_batch(const BatchKey& key) {
   Impl& m = *impl_;

@@ -110,7 +110,7 @@ TEST_CASE("scenario: an unknown key is reported at its file:line:column with a h
         p + ":4:24: rates.skil_hz: unknown key 'skil_hz' (did you mean 'skill_hz'?)");
   // Bounds: at the value, with what was given.
   p = scenario_file("k6.yaml", "name: k\nrates: {physics_hz: -5}\n");
-  CHECK(error_of(p) == p + ":2:21: rates.physics_hz: must be > 0 (got -5)");
+  CHECK(error_of(p) == p + ":2:21: rates.physics_hz: must be in [10, 1000] (got -5)");
   p = scenario_file("k7.yaml", "name: k\nseeds: {count: 0}\n");
   CHECK(error_of(p) == p + ":2:16: seeds.count: must be in [1, 100000] (got 0)");
 }

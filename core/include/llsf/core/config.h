@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -55,14 +56,35 @@ void require(std::string_view path, double v, const Bound& bound);
 /// as messages print numbers.
 std::string number_text(double v);
 
+/// The limits of strict YAML (docs/security.md, "Strict input files"): nodes of a document once
+/// its aliases are expanded, and maps and lists inside each other.
+inline constexpr std::uint64_t kMaxYamlNodes = 1'000'000;
+inline constexpr int kMaxYamlDepth = 64;
+
+/// Throws ConfigError "<source>:<line>:<column>: <path>: <what>" unless `text` is strict YAML:
+/// UTF-8 text without NUL bytes, at most 16 MiB, no key twice in a map, at most kMaxYamlNodes
+/// nodes with aliases expanded, no alias inside its own anchor, at most kMaxYamlDepth levels.
+/// ConfigNode::parse() and load_file() check this first.
+void check_strict_yaml(std::string_view text, const std::string& source_name);
+
+/// A path of a config struct's validate() messages (`from`, e.g. "game.skill_rate_hz") and the
+/// key of the document it comes from (`to`, e.g. "rates.skill_hz"; "" for the document's root):
+/// for ConfigNode::locate_errors().
+struct PathRename {
+  std::string_view from;
+  std::string_view to;
+};
+
 /// A node of a parsed YAML document with its source name, line/column and dotted path.
 /// Cheap to copy (shares the document). Every failing accessor throws ConfigError with
 /// "<source>:<line>:<column>: <path>: <what>".
 class ConfigNode {
  public:
-  /// Parses a file; throws ConfigError naming the file (and line) if it cannot be read or parsed.
+  /// Parses a file; throws ConfigError naming the file (and line) if it cannot be read (see
+  /// read_input_file(): a regular file of at most 16 MiB) or parsed (see check_strict_yaml()).
   static ConfigNode load_file(const std::string& path);
-  /// Parses text; `source_name` appears in error messages in place of a file name.
+  /// Parses strict YAML (check_strict_yaml()); `source_name` appears in error messages in place of
+  /// a file name.
   static ConfigNode parse(std::string_view text, const std::string& source_name);
 
   ConfigNode();
@@ -167,9 +189,23 @@ class ConfigNode {
       relocate(e);
     }
   }
+  /// As locate_errors(check), for a check whose paths are not the document's keys (a config
+  /// struct's validate() names "game.skill_rate_hz" for the key rates.skill_hz): each `renames`
+  /// entry whose `from` starts the error's path (up to a '.' or '[', or ending in '[') turns it
+  /// into `to` + the rest. Of several matches, the first whose whole path is in the document
+  /// wins, else the one that reaches deepest into it; with none, the path is kept. The message
+  /// then names the renamed path at its node's file:line.
+  template <class F>
+  void locate_errors(F&& check, std::span<const PathRename> renames) const {
+    try {
+      std::forward<F>(check)();
+    } catch (const ConfigError& e) {
+      relocate(e, renames);
+    }
+  }
   /// fail_at() for a message "<relative.path>: <reason>" (a message without a leading path is
-  /// reported at this node).
-  [[noreturn]] void relocate(const ConfigError& e) const;
+  /// reported at this node), the path renamed by `renames` as for locate_errors().
+  [[noreturn]] void relocate(const ConfigError& e, std::span<const PathRename> renames = {}) const;
 
  private:
   struct Impl;

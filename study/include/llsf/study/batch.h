@@ -35,6 +35,11 @@ struct BatchOptions {
 /// list of more than one seed.
 std::vector<std::uint64_t> batch_seeds(const Scenario& s, std::optional<int> runs);
 
+/// The games a batch of `file` plays with `runs` (every variant's batch_seeds). Throws
+/// core::ConfigError as batch_seeds() does, and if they are more than ScenarioLimits::kMaxGames
+/// (docs/security.md, "Scenario budgets").
+std::int64_t batch_games(const ScenarioFile& file, std::optional<int> runs);
+
 /// Progress after a stored run.
 struct BatchProgress {
   int done = 0;            ///< runs stored by this call

@@ -76,6 +76,24 @@ struct ScenarioFile {
   std::vector<Scenario> variants;
 };
 
+/// The budgets of a scenario (docs/security.md, "Scenario budgets"): bounds that keep a game
+/// and a batch finite and their memory small, whatever a scenario file says.
+struct ScenarioLimits {
+  static constexpr double kMinDurationS = 1.0;     ///< duration_s: a game plays something
+  static constexpr double kMaxDurationS = 3600.0;  ///< duration_s: over twice the longest game
+  /// Physics steps of one game (duration / physics step): 3600 s at 1000 Hz.
+  static constexpr std::int64_t kMaxPhysicsSteps = 3'600'000;
+  static constexpr double kMinPhysicsHz = 10.0;        ///< rates.physics_hz (a step of 100 ms)
+  static constexpr double kMaxPhysicsHz = 1000.0;      ///< rates.physics_hz (a step of 1 ms)
+  static constexpr double kMinCycleHz = 0.1;           ///< rates.skill_hz and agent_hz
+  static constexpr double kMinBeaconPeriodS = 0.01;    ///< rates.beacon_period_s
+  static constexpr double kMaxBeaconPeriodS = 60.0;    ///< rates.beacon_period_s
+  static constexpr std::int64_t kMaxSeeds = 100'000;   ///< seeds of one variant
+  static constexpr std::int64_t kMaxVariants = 1'000;  ///< variants of a matrix
+  /// Games of a scenario file or a batch: its variants' seeds summed (`batch --runs` included).
+  static constexpr std::int64_t kMaxGames = 100'000;
+};
+
 /// Loads and validates a scenario file and expands its matrix. Throws core::ConfigError naming
 /// file:line:column and the key for unknown keys, wrong types, impossible values, missing agent
 /// files or directories.

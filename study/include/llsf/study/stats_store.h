@@ -97,6 +97,12 @@ class StatsStore {
   /// The file's path.
   const std::string& path() const;
 
+  /// Throws StatsError unless runs can be written: the file opened read-only (its permissions,
+  /// a read-only file system) or its directory not writable (SQLite's journal goes there). For
+  /// `run` and `batch` before the first game, so that a store that cannot take the result
+  /// costs no game.
+  void require_writable() const;
+
   /// The id of the batch with `key`'s identity (kind, scenario_hash, runs_per_variant), created
   /// if there is none.
   std::int64_t open_batch(const BatchKey& key);
