@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Benchmarks of the radio: messages per CPU second through the in-process hub with a game-like
-// traffic pattern (3 robots + refbox), and UDP forwarding throughput on 127.0.0.1.
+// traffic pattern (3 robots + refbox), UDP forwarding throughput on 127.0.0.1, and a fuzz of
+// hostile frames through the hub and the stream parser with its memory (issue #21).
 #include <arpa/inet.h>
 #include <llsf_agent_msgs/LockMessage.pb.h>
 #include <llsf_agent_msgs/Worldmodel.pb.h>
@@ -11,10 +12,14 @@
 
 #include <chrono>
 #include <cstdio>
+#include <fstream>
+#include <random>
+#include <string>
 #include <vector>
 
 #include "harness.h"
 #include "llsf/comm/hub.h"
+#include "llsf/comm/registry.h"
 #include "llsf/comm/udp_hub.h"
 
 using namespace llsf;
@@ -208,4 +213,163 @@ LLSF_BENCH(hub_inproc, "in-process hub: 3 robots + refbox, 1 ms steps, 10% per_l
 LLSF_BENCH(hub_udp, "UDP hub on 127.0.0.1: frames per wall second sender -> hub -> receiver") {
   const double fps = bench::median_of(kRepeats, [] { return udp_loopback(50000); });
   bench::report("hub_udp", "msgs_per_s", fps, "1/s");
+}
+
+// ---------------------------------------------------------------------------------------------
+// comm_fuzz: hostile frames through the hub and the stream parser
+
+namespace {
+
+/// A field of /proc/self/status in kB ("VmRSS", "VmHWM"); 0 if unreadable.
+long proc_status_kb(const std::string& key) {
+  std::ifstream f("/proc/self/status");
+  std::string line;
+  while (std::getline(f, line)) {
+    if (line.rfind(key + ":", 0) == 0) return std::stol(line.substr(key.size() + 1));
+  }
+  return 0;
+}
+
+/// Random and mutated frames from a few valid seeds: bit flips, truncation, trailing bytes,
+/// random size fields (up to 4 GiB), random (component, type) pairs, pure noise.
+class FrameFuzzer {
+ public:
+  FrameFuzzer(const MessageRegistry& reg, std::uint64_t seed) : rng_(seed) {
+    seeds_.push_back(reg.encode(lock_msg("R1", "M1")));
+    seeds_.push_back(reg.encode(lock_msg("robot2", "deliver")));
+    seeds_.push_back(reg.encode(world_model()));
+  }
+  const std::vector<std::uint8_t>& next() {
+    const auto& base = seeds_[pick(seeds_.size())];
+    out_.assign(base.begin(), base.end());
+    switch (pick(7)) {
+      case 0:  // valid as is
+        break;
+      case 1:  // byte flips
+        for (std::size_t i = 0, n = 1 + pick(4); i < n; ++i) {
+          out_[pick(out_.size())] = static_cast<std::uint8_t>(rng_());
+        }
+        break;
+      case 2:  // truncated (also below the header)
+        out_.resize(pick(out_.size()));
+        break;
+      case 3:  // trailing garbage
+        for (std::size_t i = 0, n = 1 + pick(64); i < n; ++i) {
+          out_.push_back(static_cast<std::uint8_t>(rng_()));
+        }
+        break;
+      case 4: {  // a random size field; every eighth one huge
+        const std::uint32_t size = pick(8) == 0 ? static_cast<std::uint32_t>(rng_())
+                                                : static_cast<std::uint32_t>(pick(2048));
+        out_[4] = static_cast<std::uint8_t>(size >> 24);
+        out_[5] = static_cast<std::uint8_t>(size >> 16);
+        out_[6] = static_cast<std::uint8_t>(size >> 8);
+        out_[7] = static_cast<std::uint8_t>(size);
+        break;
+      }
+      case 5:  // a random (component, type)
+        for (int i = 0; i < 4; ++i)
+          out_[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(rng_());
+        break;
+      default:  // noise
+        out_.resize(pick(1100));
+        for (auto& b : out_) b = static_cast<std::uint8_t>(rng_());
+        break;
+    }
+    return out_;
+  }
+  std::size_t pick(std::size_t n) { return n == 0 ? 0 : static_cast<std::size_t>(rng_() % n); }
+
+ private:
+  std::mt19937_64 rng_;
+  std::vector<std::vector<std::uint8_t>> seeds_;
+  std::vector<std::uint8_t> out_;
+};
+
+}  // namespace
+
+LLSF_BENCH(comm_fuzz,
+           "hostile input: 1,000,000 random/mutated frames through the hub and 1,000,000 through "
+           "the stream parser; no crash, memory flat") {
+  constexpr int kFrames = 1000000;
+  MessageRegistry reg;
+  add_agent_messages(reg);
+  const long rss_start = proc_status_kb("VmRSS");
+
+  // The hub: 4 peers on one channel, per_link loss, delay with jitter; a step every 100 frames.
+  HubConfig cfg;
+  cfg.loss_model = LossModel::kPerLink;
+  cfg.loss_probability = 0.1;
+  cfg.delay.fixed = SimTime::from_ms(2);
+  cfg.delay.jitter = SimTime::from_ms(3);
+  Hub hub(cfg, reg, core::Rng(21));
+  for (const char* name : {"robot1", "robot2", "robot3", "refbox"}) hub.add_peer(name);
+  FrameFuzzer hub_fuzz(reg, 1);
+  std::int64_t accepted = 0;
+  long rss_hub_half = 0;
+  const double t0 = bench::cpu_seconds();
+  for (int i = 0; i < kFrames; ++i) {
+    const SimTime now = SimTime::from_ns(std::int64_t{i} * 10000);  // 100 frames per ms
+    accepted += hub.broadcast_frame(PeerId(i % 4), hub_fuzz.next(), now) == FrameError::kNone;
+    if (i % 100 == 99) hub.step(now);
+    if (i == kFrames / 2) rss_hub_half = proc_status_kb("VmRSS");
+  }
+  hub.step(SimTime::from_ms(std::int64_t{1} << 30));
+  const double hub_s = bench::cpu_seconds() - t0;
+  const long rss_after_hub = proc_status_kb("VmRSS");
+
+  // The stream parser: the fuzzed frames back to back, fed in random chunks (1 to 4096 bytes, as
+  // reads return them); an oversized header ends the "connection" and a new decoder starts.
+  FrameFuzzer stream_fuzz(reg, 2);
+  std::mt19937_64 split(3);
+  auto decoder = std::make_unique<StreamDecoder>();
+  std::int64_t decoded = 0, refused = 0, closed = 0;
+  std::vector<std::uint8_t> pending;
+  long rss_stream_half = 0;
+  const double t1 = bench::cpu_seconds();
+  for (int i = 0; i < kFrames; ++i) {
+    const auto& f = stream_fuzz.next();
+    pending.insert(pending.end(), f.begin(), f.end());
+    std::size_t at = 0;
+    while (at < pending.size()) {
+      const std::size_t n = std::min<std::size_t>(pending.size() - at, 1 + split() % 4096);
+      decoder->feed(std::span<const std::uint8_t>(pending.data() + at, n));
+      at += n;
+      for (;;) {
+        const StreamDecoder::Next next = decoder->next();
+        if (next.status == StreamDecoder::Next::Status::kNeedMore) break;
+        if (next.status == StreamDecoder::Next::Status::kOversized) {
+          ++closed;
+          decoder = std::make_unique<StreamDecoder>();
+          break;
+        }
+        const MessageRegistry::Decoded d = reg.decode(next.frame);
+        if (d.error == FrameError::kNone) {
+          ++decoded;
+        } else {
+          ++refused;
+        }
+      }
+    }
+    pending.clear();
+    if (i == kFrames / 2) rss_stream_half = proc_status_kb("VmRSS");
+  }
+  const double stream_s = bench::cpu_seconds() - t1;
+  const long rss_end = proc_status_kb("VmRSS");
+
+  bench::report("comm_fuzz", "hub_frames", kFrames, "frames");
+  bench::report("comm_fuzz", "hub_accepted", static_cast<double>(accepted), "frames");
+  bench::report("comm_fuzz", "hub_frames_per_s", kFrames / hub_s, "1/s");
+  bench::report("comm_fuzz", "hub_frame_pool", hub.frame_pool_size(), "frames");
+  bench::report("comm_fuzz", "stream_frames", kFrames, "frames");
+  bench::report("comm_fuzz", "stream_decoded", static_cast<double>(decoded), "frames");
+  bench::report("comm_fuzz", "stream_refused", static_cast<double>(refused), "frames");
+  bench::report("comm_fuzz", "stream_oversized_closes", static_cast<double>(closed), "closes");
+  bench::report("comm_fuzz", "stream_frames_per_s", kFrames / stream_s, "1/s");
+  bench::report("comm_fuzz", "rss_start_kb", static_cast<double>(rss_start), "kB");
+  bench::report("comm_fuzz", "rss_hub_half_kb", static_cast<double>(rss_hub_half), "kB");
+  bench::report("comm_fuzz", "rss_after_hub_kb", static_cast<double>(rss_after_hub), "kB");
+  bench::report("comm_fuzz", "rss_stream_half_kb", static_cast<double>(rss_stream_half), "kB");
+  bench::report("comm_fuzz", "rss_end_kb", static_cast<double>(rss_end), "kB");
+  bench::report("comm_fuzz", "peak_rss_kb", static_cast<double>(proc_status_kb("VmHWM")), "kB");
 }

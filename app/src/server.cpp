@@ -12,12 +12,14 @@
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/post.hpp>
+#include <boost/asio/steady_timer.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
 #include <cerrno>
 #include <charconv>
 #include <csignal>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -111,8 +113,9 @@ namespace fs = std::filesystem;
 using tcp = asio::ip::tcp;
 using json = nlohmann::json;
 
-constexpr std::int64_t kWsChunkBytes = 256 * 1024;  // one WebSocket message at most (about)
-constexpr auto kHttpTimeout = std::chrono::seconds(60);
+constexpr std::int64_t kWsChunkBytes = 256 * 1024;        // one WebSocket message at most (about)
+constexpr auto kWriteTimeout = std::chrono::seconds(60);  // to write one response
+constexpr auto kAcceptRetry = std::chrono::milliseconds(100);  // after a failed accept (EMFILE)
 
 /// An answer before it becomes an HTTP response.
 struct Reply {
@@ -185,6 +188,28 @@ std::optional<std::vector<std::string>> split_target(std::string_view target, st
   return segments;
 }
 
+/// Whether `file`, with every symbolic link resolved, lies inside `root` (also resolved); false
+/// if either does not exist. A link inside a served folder that points out of it is refused.
+bool inside_root(const fs::path& root, const fs::path& file) {
+  std::error_code ec;
+  const fs::path r = fs::canonical(root, ec);
+  if (ec) return false;
+  const fs::path f = fs::canonical(file, ec);
+  if (ec) return false;
+  const auto [ri, fi] = std::mismatch(r.begin(), r.end(), f.begin(), f.end());
+  return ri == r.end();
+}
+
+/// "address:port" of a socket's peer, for log lines.
+std::string peer_of(const tcp::socket& socket) {
+  beast::error_code ec;
+  const tcp::endpoint ep = socket.remote_endpoint(ec);
+  return ec ? std::string("?") : ep.address().to_string() + ":" + std::to_string(ep.port());
+}
+
+/// Logs the 1st, 2nd, 4th, 8th, ... event of a kind, so that a flood cannot flood the log.
+bool log_this_one(std::int64_t count) { return count > 0 && (count & (count - 1)) == 0; }
+
 /// A positive integer id, or nullopt.
 std::optional<std::int64_t> parse_id(const std::string& s) {
   std::int64_t v = 0;
@@ -248,14 +273,26 @@ struct ServerImpl {
   ServerOptions options;
   LiveFeed* feed = nullptr;
   std::optional<study::StatsStore> store;
+  // Counted by the sessions' constructors and destructors; declared before ioc, whose
+  // destruction destroys the sessions still pending.
+  int http_connections = 0;
+  int ws_clients = 0;
+  std::int64_t refused_connections = 0;
+  std::int64_t refused_ws_clients = 0;
+  std::int64_t dropped_ws_clients = 0;
+  bool accept_failing = false;  ///< since the last successful accept (logged once)
   asio::io_context ioc{1};
   tcp::acceptor acceptor{ioc};
+  asio::steady_timer accept_retry{ioc};
   std::vector<std::weak_ptr<WsSession>> ws_sessions;
   std::atomic<bool> fan_out_pending{false};
   std::thread thread;
   std::string host;  ///< as written in the URL
 
   void accept();
+  void on_accept_error(const beast::error_code& ec);
+  void refuse(tcp::socket& socket);
+  void log(const std::string& line) const;
   void fan_out();
   Reply handle(const std::vector<std::string>& path);
   Reply handle_api(const std::vector<std::string>& path);
@@ -263,6 +300,14 @@ struct ServerImpl {
   /// The statistics store, opened on first use if its file exists (nullptr if it does not).
   study::StatsStore* stats();
 };
+
+void ServerImpl::log(const std::string& line) const {
+  if (options.log) {
+    options.log(line);
+  } else {
+    std::fprintf(stderr, "llsfsim serve: %s\n", line.c_str());
+  }
+}
 
 study::StatsStore* ServerImpl::stats() {
   if (store) return &*store;
@@ -295,6 +340,9 @@ Reply ServerImpl::serve_static(const std::vector<std::string>& path) {
                                                       file.string() + " is missing");
     }
     return error_reply(http::status::not_found, "not found");
+  }
+  if (!inside_root(options.viewer, file)) {
+    return error_reply(http::status::forbidden, "the path leads out of the viewer folder");
   }
   std::optional<std::string> body = read_file(file);
   if (!body) return error_reply(http::status::internal_server_error, "cannot read the file");
@@ -367,6 +415,11 @@ Reply ServerImpl::handle_api(const std::vector<std::string>& path) {
       file /= at(i);
       shown += (i > 2 ? "/" : "") + at(i);
     }
+    std::error_code ec;
+    if (fs::exists(file, ec) && !inside_root(options.recordings, file)) {
+      return error_reply(http::status::forbidden,
+                         "the path leads out of the recordings folder: " + shown);
+    }
     return recording_reply(file, shown);
   }
   // GET /api/live/status
@@ -388,7 +441,13 @@ Reply ServerImpl::handle_api(const std::vector<std::string>& path) {
 
 class WsSession : public std::enable_shared_from_this<WsSession> {
  public:
-  WsSession(tcp::socket&& socket, ServerImpl& server) : ws_(std::move(socket)), server_(server) {}
+  WsSession(tcp::socket&& socket, ServerImpl& server)
+      : ws_(std::move(socket)), server_(server), peer_(peer_of(ws_.next_layer().socket())) {
+    ++server_.ws_clients;
+  }
+  ~WsSession() { --server_.ws_clients; }
+  WsSession(const WsSession&) = delete;
+  WsSession& operator=(const WsSession&) = delete;
 
   void accept(http::request<http::string_body> req) {
     websocket::stream_base::timeout t =
@@ -398,6 +457,9 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     ws_.read_message_max(64 * 1024);
     ws_.async_accept(req, [self = shared_from_this()](beast::error_code ec) {
       if (ec) return;
+      // Drop the entries of clients gone since (after the game no fan_out() prunes them).
+      std::erase_if(self->server_.ws_sessions,
+                    [](const std::weak_ptr<WsSession>& w) { return w.expired(); });
       self->server_.ws_sessions.push_back(self);
       self->read();
       self->pump();
@@ -408,8 +470,15 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   void pump() {
     if (closed_) return;
     LiveFeed& feed = *server_.feed;
-    if (feed.bytes_after(next_) > server_.options.max_client_backlog_bytes) {
+    if (const std::int64_t behind = feed.bytes_after(next_);
+        behind > server_.options.max_client_backlog_bytes) {
       closed_ = true;
+      if (log_this_one(++server_.dropped_ws_clients)) {
+        server_.log(fmt::format(
+            "dropped WebSocket client {}: {} bytes behind the live game (max_client_backlog_bytes "
+            "{}); {} dropped so far",
+            peer_, behind, server_.options.max_client_backlog_bytes, server_.dropped_ws_clients));
+      }
       beast::error_code ignored;
       beast::get_lowest_layer(ws_).socket().close(ignored);
       return;
@@ -447,6 +516,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
 
   websocket::stream<beast::tcp_stream> ws_;
   ServerImpl& server_;
+  std::string peer_;
   beast::flat_buffer in_;
   std::string out_;
   std::int64_t next_ = 0;  ///< the next feed line to send
@@ -470,13 +540,18 @@ namespace {
 class HttpSession : public std::enable_shared_from_this<HttpSession> {
  public:
   HttpSession(tcp::socket&& socket, ServerImpl& server)
-      : stream_(std::move(socket)), server_(server) {}
+      : stream_(std::move(socket)), server_(server) {
+    ++server_.http_connections;
+  }
+  ~HttpSession() { --server_.http_connections; }
+  HttpSession(const HttpSession&) = delete;
+  HttpSession& operator=(const HttpSession&) = delete;
 
   void read() {
     parser_.emplace();
-    parser_->header_limit(16 * 1024);
-    parser_->body_limit(64 * 1024);
-    stream_.expires_after(kHttpTimeout);
+    parser_->header_limit(static_cast<std::uint32_t>(server_.options.max_header_bytes));
+    parser_->body_limit(static_cast<std::uint64_t>(server_.options.max_body_bytes));
+    stream_.expires_after(server_.options.request_timeout);
     http::async_read(
         stream_, buffer_, *parser_,
         [self = shared_from_this()](beast::error_code ec, std::size_t) { self->on_read(ec); });
@@ -511,6 +586,19 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     }
     const bool live_route = path->size() == 2 && (*path)[0] == "api" && (*path)[1] == "live";
     if (live_route && server_.feed != nullptr && websocket::is_upgrade(req)) {
+      if (server_.ws_clients >= server_.options.max_websocket_clients) {
+        if (log_this_one(++server_.refused_ws_clients)) {
+          server_.log(fmt::format(
+              "refused a WebSocket client {}: {} open (max_websocket_clients); {} refused so far",
+              peer_of(stream_.socket()), server_.ws_clients, server_.refused_ws_clients));
+        }
+        send(req,
+             error_reply(http::status::service_unavailable,
+                         fmt::format("too many live clients ({} at most)",
+                                     server_.options.max_websocket_clients)),
+             /*close=*/true);
+        return;
+      }
       stream_.expires_never();
       std::make_shared<WsSession>(stream_.release_socket(), server_)->accept(std::move(req));
       return;
@@ -528,7 +616,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     res->keep_alive(!close && req.keep_alive());
     res->body() = std::move(reply.body);
     res->prepare_payload();
-    stream_.expires_after(kHttpTimeout);
+    stream_.expires_after(kWriteTimeout);
     http::async_write(stream_, *res,
                       [self = shared_from_this(), res](beast::error_code ec, std::size_t) {
                         if (ec) return;
@@ -551,9 +639,43 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
 void ServerImpl::accept() {
   acceptor.async_accept([this](beast::error_code ec, tcp::socket socket) {
     if (!acceptor.is_open()) return;
-    if (!ec) std::make_shared<HttpSession>(std::move(socket), *this)->read();
+    if (ec) {
+      on_accept_error(ec);
+      return;
+    }
+    accept_failing = false;
+    if (http_connections >= options.max_connections) {
+      refuse(socket);
+    } else {
+      std::make_shared<HttpSession>(std::move(socket), *this)->read();
+    }
     accept();
   });
+}
+
+void ServerImpl::on_accept_error(const beast::error_code& ec) {
+  // Out of file descriptors (EMFILE, ENFILE) or memory, the connection stays in the listen
+  // backlog and accepting again fails at once: retry after a pause instead of spinning.
+  if (!accept_failing) {
+    accept_failing = true;
+    log(fmt::format("cannot accept a connection: {}; retrying every {} ms until it works",
+                    ec.message(), kAcceptRetry.count()));
+  }
+  accept_retry.expires_after(kAcceptRetry);
+  accept_retry.async_wait([this](beast::error_code e) {
+    if (e || !acceptor.is_open()) return;
+    accept();
+  });
+}
+
+void ServerImpl::refuse(tcp::socket& socket) {
+  ++refused_connections;
+  if (log_this_one(refused_connections)) {
+    log(fmt::format("refused a connection from {}: {} open (max_connections); {} refused so far",
+                    peer_of(socket), http_connections, refused_connections));
+  }
+  beast::error_code ignored;
+  socket.close(ignored);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -568,6 +690,13 @@ Server::Server(ServerOptions options, LiveFeed* feed) : impl_(std::make_unique<S
   const std::string& bind = m.options.bind;
   if (m.options.port < 0 || m.options.port > 65535) {
     throw core::UserError(fmt::format("bad port {}", m.options.port));
+  }
+  if (m.options.max_connections < 1 || m.options.max_websocket_clients < 0 ||
+      m.options.max_header_bytes < 1 || m.options.max_header_bytes > 0xffffffff ||
+      m.options.max_body_bytes < 0 || m.options.request_timeout.count() <= 0) {
+    throw core::UserError(
+        "bad server limits (max_connections >= 1, max_websocket_clients >= 0, header and body "
+        "sizes, request timeout > 0)");
   }
   beast::error_code ec;
   const asio::ip::address address = asio::ip::make_address(bind, ec);

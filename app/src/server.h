@@ -4,6 +4,7 @@
 // recording lines over a WebSocket (docs/llsfsim.md, "llsfsim serve").
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -58,8 +59,23 @@ struct ServerOptions {
   std::string db = "llsfsim.db";
   std::string recordings;  ///< recordings below /api/recordings/ ("" = default_recordings_dir(db))
   std::string viewer;      ///< the built front end ("" = study::viewer_dir())
-  /// A WebSocket client further behind the live game than this is dropped.
+  /// A WebSocket client further behind the live game than this is dropped (logged): the bytes
+  /// it still lacks are its send queue.
   std::int64_t max_client_backlog_bytes = std::int64_t{64} << 20;
+  /// HTTP connections open at once (WebSocket clients not counted); one more is accepted and
+  /// closed at once (logged).
+  int max_connections = 64;
+  /// WebSocket clients of /api/live at once; one more gets 503 (logged).
+  int max_websocket_clients = 32;
+  /// Largest request header (start line and fields) and body; larger requests get 400.
+  std::int64_t max_header_bytes = 16 * 1024;
+  std::int64_t max_body_bytes = 64 * 1024;
+  /// A request must arrive in full within this (a keep-alive connection's wait for the next
+  /// request too); otherwise the connection is closed.
+  std::chrono::milliseconds request_timeout{15000};
+  /// Where refusals, drops and accept errors are logged (one line, no newline; called on the
+  /// server's thread). Empty: "llsfsim serve: <line>" on standard error.
+  std::function<void(const std::string&)> log;
 };
 
 struct ServerImpl;

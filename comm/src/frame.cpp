@@ -8,6 +8,11 @@
 
 namespace llsf::comm {
 
+namespace {
+/// Buffer capacity a StreamDecoder keeps between frames (larger buffers are released).
+constexpr std::size_t kKeptCapacity = 64 * 1024;
+}  // namespace
+
 std::string_view frame_error_name(FrameError e) {
   switch (e) {
     case FrameError::kNone:
@@ -91,6 +96,8 @@ void StreamDecoder::feed(std::span<const std::uint8_t> bytes) {
   if (pos_ > 0) {
     buf_.erase(buf_.begin(), buf_.begin() + pos_);
     pos_ = 0;
+    // After a large frame, give its memory back instead of keeping it per connection.
+    if (buf_.empty() && buf_.capacity() > kKeptCapacity) std::vector<std::uint8_t>().swap(buf_);
   }
   buf_.insert(buf_.end(), bytes.begin(), bytes.end());
 }

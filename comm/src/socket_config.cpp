@@ -46,6 +46,20 @@ void SocketConfig::validate() const {
       fail(peer_path(i, "send_port"), std::to_string(p.send_port) + " is used by another peer");
     }
   }
+  // The hub forwards to recv_port: if that is a port the hub itself listens on, a frame goes
+  // round for ever (UdpHub::add_peer checks ports chosen at bind time as well).
+  for (std::size_t i = 0; i < udp_peers.size(); ++i) {
+    const int recv = udp_peers[i].recv_port;
+    if (recv == 0) continue;
+    for (std::size_t j = 0; j < udp_peers.size(); ++j) {
+      if (udp_peers[j].send_port != recv) continue;
+      fail(peer_path(i, "recv_port"),
+           std::to_string(recv) + " is where the hub listens for " +
+               (i == j ? std::string("this peer (its own send_port)")
+                       : "'" + udp_peers[j].name + "' (" + peer_path(j, "send_port") + ")") +
+               ": frames would be forwarded in a loop");
+    }
+  }
 }
 
 SocketConfig load_socket_config(const ConfigNode& node, SocketConfig base) {

@@ -61,7 +61,10 @@ bool StreamClient::connect(const std::string& address, int port,
     return false;
   }
   impl_->conn = std::make_shared<StreamConnection>(
-      std::move(st->socket), *impl_->registry, impl_->max_payload, ClientId(), &impl_->counters,
+      std::move(st->socket), *impl_->registry,
+      StreamConnection::Limits{impl_->max_payload, std::chrono::milliseconds(0),
+                               kDefaultMaxSendQueueBytes, log_to_stderr},
+      ClientId(), &impl_->counters,
       [impl = impl_.get()](StreamEvent&& e) { impl->events.push_back(std::move(e)); });
   impl_->conn->start();
   return true;

@@ -3,22 +3,34 @@
 #include "stream_connection.h"
 
 #include <boost/asio/write.hpp>
+#include <cstdio>
+
+namespace llsf::comm {
+
+void log_to_stderr(std::string_view line) {
+  std::fprintf(stderr, "llsf comm: %.*s\n", static_cast<int>(line.size()), line.data());
+}
+
+}  // namespace llsf::comm
 
 namespace llsf::comm::detail {
 
 namespace asio = boost::asio;
 
 StreamConnection::StreamConnection(asio::ip::tcp::socket socket, const MessageRegistry& registry,
-                                   std::int64_t max_payload, ClientId id, StreamCounters* counters,
-                                   Sink sink)
+                                   Limits limits, ClientId id, StreamCounters* counters, Sink sink)
     : socket_(std::move(socket)),
+      partial_timer_(socket_.get_executor()),
       registry_(&registry),
-      decoder_(max_payload),
+      limits_(std::move(limits)),
+      decoder_(limits_.max_payload),
       id_(id),
       counters_(counters),
       sink_(std::move(sink)) {
   boost::system::error_code ec;
   socket_.set_option(asio::ip::tcp::no_delay(true), ec);
+  const auto ep = socket_.remote_endpoint(ec);
+  peer_ = ec ? std::string("?") : ep.address().to_string() + ":" + std::to_string(ep.port());
 }
 
 void StreamConnection::start() { read(); }
@@ -38,13 +50,17 @@ void StreamConnection::read() {
 }
 
 void StreamConnection::on_bytes(std::size_t n) {
+  if (!open_) return;
   decoder_.feed(std::span<const std::uint8_t>(read_buffer_.data(), n));
+  bool frame_done = false;
   for (;;) {
     const StreamDecoder::Next next = decoder_.next();
-    if (next.status == StreamDecoder::Next::Status::kNeedMore) return;
+    if (next.status == StreamDecoder::Next::Status::kNeedMore) break;
+    frame_done = true;
     if (next.status == StreamDecoder::Next::Status::kOversized) {
       ++counters_->malformed[static_cast<std::size_t>(FrameError::kOversized)];
-      close();
+      close_for("oversized", "a frame header announces more than " +
+                                 std::to_string(limits_.max_payload) + " payload bytes");
       return;
     }
     MessageRegistry::Decoded d = registry_->decode(next.frame);
@@ -60,15 +76,48 @@ void StreamConnection::on_bytes(std::size_t n) {
     e.key = d.key;
     e.message = std::move(d.message);
     sink_(std::move(e));
+    if (!open_) return;  // the sink closed us
   }
+  watch_partial_frame(frame_done);
+}
+
+void StreamConnection::watch_partial_frame(bool frame_done) {
+  if (limits_.partial_frame_timeout.count() <= 0) return;
+  const bool partial = decoder_.buffered() > 0;
+  // The frame under way keeps its first deadline, however slowly its bytes come; a frame that
+  // starts after one completed gets a new one.
+  if (partial == partial_watched_ && !(partial && frame_done)) return;
+  partial_watched_ = partial;
+  ++partial_generation_;
+  if (!partial) {
+    partial_timer_.cancel();
+    return;
+  }
+  partial_timer_.expires_after(limits_.partial_frame_timeout);
+  partial_timer_.async_wait([self = shared_from_this(), generation = partial_generation_](
+                                const boost::system::error_code& ec) {
+    if (ec || !self->open_ || generation != self->partial_generation_) return;
+    self->close_for("partial_frame_timeout",
+                    "a frame stayed incomplete for " +
+                        std::to_string(self->limits_.partial_frame_timeout.count()) + " ms (" +
+                        std::to_string(self->decoder_.buffered()) + " bytes buffered)");
+  });
 }
 
 bool StreamConnection::send(const google::protobuf::Message& message) {
   if (!open_) return false;
   std::vector<std::uint8_t> frame;
   if (!registry_->encode(message, frame)) return false;
+  const auto size = static_cast<std::int64_t>(frame.size());
+  if (queued_bytes_ + size > limits_.max_send_queue_bytes) {
+    close_for("send_queue_full", std::to_string(queued_bytes_) +
+                                     " bytes not yet written, max_send_queue_bytes " +
+                                     std::to_string(limits_.max_send_queue_bytes));
+    return false;
+  }
   ++counters_->frames_out;
-  counters_->bytes_out += static_cast<std::int64_t>(frame.size());
+  counters_->bytes_out += size;
+  queued_bytes_ += size;
   write_queue_.push_back(std::move(frame));
   if (!writing_) write_next();
   return true;
@@ -82,22 +131,33 @@ void StreamConnection::write_next() {
   writing_ = true;
   asio::async_write(socket_, asio::buffer(write_queue_.front()),
                     [self = shared_from_this()](const boost::system::error_code& ec, std::size_t) {
-                      if (ec) {
+                      if (ec || !self->open_) {
                         self->close();
                         return;
                       }
+                      self->queued_bytes_ -=
+                          static_cast<std::int64_t>(self->write_queue_.front().size());
                       self->write_queue_.pop_front();
                       self->write_next();
                     });
+}
+
+void StreamConnection::close_for(const char* reason, const std::string& detail) {
+  if (!open_) return;
+  counters_->closed_for = reason;
+  if (limits_.log) limits_.log("stream " + peer_ + ": closed (" + reason + "): " + detail);
+  close();
 }
 
 void StreamConnection::close() {
   if (!open_) return;
   open_ = false;
   boost::system::error_code ec;
+  partial_timer_.cancel();
   socket_.shutdown(asio::ip::tcp::socket::shutdown_both, ec);
   socket_.close(ec);
   write_queue_.clear();
+  queued_bytes_ = 0;
   StreamEvent e;
   e.kind = StreamEvent::Kind::kDisconnected;
   e.client = id_;

@@ -3,9 +3,12 @@
 #pragma once
 
 #include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <chrono>
 #include <deque>
 #include <functional>
 #include <memory>
+#include <string>
 
 #include "llsf/comm/stream.h"
 
@@ -17,13 +20,22 @@ class StreamConnection : public std::enable_shared_from_this<StreamConnection> {
  public:
   using Sink = std::function<void(StreamEvent&&)>;
 
+  /// The connection's bounds (StreamServerOptions documents them).
+  struct Limits {
+    std::int64_t max_payload = kDefaultMaxStreamPayload;
+    std::chrono::milliseconds partial_frame_timeout{0};  ///< 0: none
+    std::int64_t max_send_queue_bytes = kDefaultMaxSendQueueBytes;
+    LogSink log;  ///< empty: no log lines
+  };
+
   /// `counters` must outlive the connection.
   StreamConnection(boost::asio::ip::tcp::socket socket, const MessageRegistry& registry,
-                   std::int64_t max_payload, ClientId id, StreamCounters* counters, Sink sink);
+                   Limits limits, ClientId id, StreamCounters* counters, Sink sink);
 
   /// Starts the read loop.
   void start();
-  /// Queues an encoded frame.
+  /// Queues an encoded frame; false (and the connection is closed) if the send queue would
+  /// exceed max_send_queue_bytes.
   bool send(const google::protobuf::Message& message);
   void close();
   bool open() const { return open_; }
@@ -33,15 +45,26 @@ class StreamConnection : public std::enable_shared_from_this<StreamConnection> {
   void read();
   void on_bytes(std::size_t n);
   void write_next();
+  /// Arms the partial-frame timer when a frame is incomplete (again when a new frame started
+  /// after `frame_done`), disarms it when none is.
+  void watch_partial_frame(bool frame_done);
+  /// Closes for a limit: logs "stream <peer>: <reason>: <detail>" and records the reason.
+  void close_for(const char* reason, const std::string& detail);
 
   boost::asio::ip::tcp::socket socket_;
+  boost::asio::steady_timer partial_timer_;
   const MessageRegistry* registry_;
+  Limits limits_;
   StreamDecoder decoder_;
   ClientId id_;
   StreamCounters* counters_;
   Sink sink_;
+  std::string peer_;  ///< "address:port" for log lines
   std::array<std::uint8_t, 4096> read_buffer_{};
   std::deque<std::vector<std::uint8_t>> write_queue_;
+  std::int64_t queued_bytes_ = 0;
+  std::int64_t partial_generation_ = 0;  ///< bumped whenever the partial-frame watch changes
+  bool partial_watched_ = false;
   bool writing_ = false;
   bool open_ = true;
 };

@@ -19,13 +19,17 @@ struct StreamServer::Impl {
   asio::io_context io;  // first: destroyed last
   tcp::acceptor acceptor{io};
   const MessageRegistry* registry;
-  std::int64_t max_payload;
+  StreamServerOptions options;
+  std::int64_t refused = 0;
   std::map<int, std::shared_ptr<StreamConnection>> open;  ///< by client id
   std::deque<StreamCounters> counters;                    ///< by client id; stable addresses
   std::vector<StreamEvent> events;
 
-  Impl(const MessageRegistry& reg, const StreamServerOptions& o)
-      : registry(&reg), max_payload(o.max_payload) {
+  Impl(const MessageRegistry& reg, const StreamServerOptions& o) : registry(&reg), options(o) {
+    if (o.max_payload < 0 || o.max_connections < 1 || o.max_send_queue_bytes < 1) {
+      throw std::runtime_error(
+          "StreamServer: max_payload must be >= 0, max_connections and max_send_queue_bytes >= 1");
+    }
     boost::system::error_code ec;
     const auto address = asio::ip::make_address(o.address, ec);
     if (ec) throw std::runtime_error("StreamServer: bad address '" + o.address + "'");
@@ -45,12 +49,16 @@ struct StreamServer::Impl {
   void accept() {
     acceptor.async_accept([this](const boost::system::error_code& ec, tcp::socket socket) {
       if (ec == asio::error::operation_aborted) return;
-      if (!ec) {
+      if (!ec && static_cast<int>(open.size()) >= options.max_connections) {
+        refuse(std::move(socket));
+      } else if (!ec) {
         const int id = static_cast<int>(counters.size());
         counters.emplace_back();
         auto conn = std::make_shared<StreamConnection>(
-            std::move(socket), *registry, max_payload, ClientId(id), &counters.back(),
-            [this](StreamEvent&& e) {
+            std::move(socket), *registry,
+            StreamConnection::Limits{options.max_payload, options.partial_frame_timeout,
+                                     options.max_send_queue_bytes, options.log},
+            ClientId(id), &counters.back(), [this](StreamEvent&& e) {
               if (e.kind == StreamEvent::Kind::kDisconnected) open.erase(e.client.value());
               events.push_back(std::move(e));
             });
@@ -63,6 +71,23 @@ struct StreamServer::Impl {
       }
       accept();
     });
+  }
+
+  /// Closes a connection beyond max_connections at once. Logs the 1st, 2nd, 4th, 8th, ...
+  /// refusal, so that a flood of connections cannot flood the log.
+  void refuse(tcp::socket socket) {
+    ++refused;
+    boost::system::error_code ec;
+    const auto ep = socket.remote_endpoint(ec);
+    socket.close(ec);
+    if ((refused & (refused - 1)) == 0 && options.log) {
+      options.log("stream server: refused a connection from " +
+                  (ep.port() ? ep.address().to_string() + ":" + std::to_string(ep.port())
+                             : std::string("?")) +
+                  ": " + std::to_string(options.max_connections) +
+                  " connections open (max_connections); " + std::to_string(refused) +
+                  " refused so far");
+    }
   }
 };
 
@@ -101,12 +126,19 @@ std::vector<StreamEvent> StreamServer::take_events() {
 
 bool StreamServer::send(ClientId client, const google::protobuf::Message& message) {
   const auto it = impl_->open.find(client.value());
-  return it != impl_->open.end() && it->second->send(message);
+  if (it == impl_->open.end()) return false;
+  const auto conn = it->second;  // a full send queue closes it, which erases it from the map
+  return conn->send(message);
 }
 
 int StreamServer::broadcast(const google::protobuf::Message& message) {
+  // A send may close its connection (send queue full), which erases it from `open`: iterate
+  // over a copy.
+  std::vector<std::shared_ptr<StreamConnection>> conns;
+  conns.reserve(impl_->open.size());
+  for (const auto& [id, conn] : impl_->open) conns.push_back(conn);
   int n = 0;
-  for (const auto& [id, conn] : impl_->open) n += conn->send(message) ? 1 : 0;
+  for (const auto& conn : conns) n += conn->send(message) ? 1 : 0;
   return n;
 }
 
@@ -118,6 +150,8 @@ void StreamServer::disconnect(ClientId client) {
 }
 
 int StreamServer::client_count() const { return static_cast<int>(impl_->open.size()); }
+
+std::int64_t StreamServer::refused_count() const { return impl_->refused; }
 
 const StreamCounters& StreamServer::counters(ClientId client) const {
   return impl_->counters.at(static_cast<std::size_t>(client.value()));

@@ -26,6 +26,7 @@ struct UdpHub::Impl {
     udp::endpoint destination;  ///< where frames for this peer go
     bool destination_known = false;
     bool learn_destination = false;
+    int bound_port = 0;  ///< where the hub listens for this peer
     std::vector<std::uint8_t> buffer = std::vector<std::uint8_t>(kReceiveBuffer);
   };
 
@@ -67,12 +68,27 @@ struct UdpHub::Impl {
 
   void on_datagram(int peer, std::size_t n) {
     Socket& s = *sockets[static_cast<std::size_t>(peer)];
-    if (s.learn_destination) {
+    const FrameError e =
+        hub.broadcast_frame(PeerId(peer), std::span<const std::uint8_t>(s.buffer.data(), n), now());
+    // The return address is learnt only from a frame the hub accepted (a malformed datagram from
+    // any local port must not redirect the peer's traffic), and never as one of the hub's own
+    // listening sockets (a frame would circulate for ever).
+    if (s.learn_destination && e == FrameError::kNone && !is_own_endpoint(s.source)) {
       s.destination = s.source;
       s.destination_known = true;
     }
-    hub.broadcast_frame(PeerId(peer), std::span<const std::uint8_t>(s.buffer.data(), n), now());
     pump();
+  }
+
+  /// Whether `ep` is one of the hub's listening sockets.
+  bool is_own_endpoint(const udp::endpoint& ep) const {
+    for (const auto& other : sockets) {
+      if (other->bound_port == ep.port() &&
+          (ep.address() == address || address.is_unspecified() || ep.address().is_loopback())) {
+        return true;
+      }
+    }
+    return false;
   }
 
   /// Delivers what is due and re-arms the timer for the next due copy.
@@ -131,6 +147,30 @@ PeerId UdpHub::add_peer(const UdpPeerConfig& peer) {
     throw std::runtime_error("UdpHub: peer '" + peer.name + "': cannot bind " +
                              impl_->address.to_string() + ":" + std::to_string(peer.send_port) +
                              ": " + ec.message());
+  }
+  // A peer's receive port must not be one of the hub's listening ports (its own or another
+  // peer's), and a new listening port must not be an earlier peer's receive port: either way a
+  // frame would be forwarded back into the hub for ever.
+  const int bound = s->socket.local_endpoint(ec).port();
+  s->bound_port = bound;
+  for (std::size_t i = 0; i < impl_->sockets.size(); ++i) {
+    const Impl::Socket& other = *impl_->sockets[i];
+    const std::string& other_name = impl_->hub.peer_name(PeerId(static_cast<int>(i)));
+    if (peer.recv_port > 0 && other.bound_port == peer.recv_port) {
+      throw std::runtime_error("UdpHub: peer '" + peer.name + "': recv_port " +
+                               std::to_string(peer.recv_port) + " is where the hub listens for '" +
+                               other_name + "' (a forwarding loop)");
+    }
+    if (other.destination_known && other.destination.port() == bound) {
+      throw std::runtime_error("UdpHub: peer '" + peer.name + "': listening port " +
+                               std::to_string(bound) + " is the recv_port of '" + other_name +
+                               "' (a forwarding loop)");
+    }
+  }
+  if (peer.recv_port > 0 && peer.recv_port == bound) {
+    throw std::runtime_error("UdpHub: peer '" + peer.name + "': recv_port " +
+                             std::to_string(peer.recv_port) +
+                             " is its own send_port (a forwarding loop)");
   }
   if (peer.recv_port > 0) {
     s->destination = udp::endpoint(impl_->address, static_cast<unsigned short>(peer.recv_port));

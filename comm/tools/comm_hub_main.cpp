@@ -1,15 +1,18 @@
 // SPDX-License-Identifier: MIT
 // llsf-comm-hub: the radio as a stand-alone UDP hub on loopback, so that agents and LLSF tools in
 // other processes can talk through the loss, delay and outage models (docs/comm.md). Prints each
-// peer's ports at start and the counters (JSON) at the end.
+// peer's ports at start and the counters (JSON) at the end. With --stream-port it also runs the
+// refbox's TCP stream server (the messages it receives are counted, not routed).
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <exception>
+#include <memory>
 
 #include "llsf/comm/hub_config.h"
 #include "llsf/comm/socket_config.h"
+#include "llsf/comm/stream.h"
 #include "llsf/comm/udp_hub.h"
 #include "llsf/core/config.h"
 #include "llsf/core/error.h"
@@ -29,6 +32,25 @@ int main(int argc, char** argv) {
   app.add_option("--seed", seed, "seed of the loss/delay streams")->capture_default_str();
   app.add_option("--seconds", seconds, "run time in seconds (0: until Ctrl-C)")
       ->capture_default_str();
+  int stream_port = -1;
+  llsf::comm::StreamServerOptions stream_opts;
+  int partial_timeout_ms = static_cast<int>(stream_opts.partial_frame_timeout.count());
+  app.add_option("--stream-port", stream_port,
+                 "also run the TCP stream server on this port (0: any free port; -1: none)")
+      ->capture_default_str()
+      ->check(CLI::Range(-1, 65535));
+  app.add_option("--stream-max-connections", stream_opts.max_connections,
+                 "stream server: connections open at once")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 100000));
+  app.add_option("--stream-max-payload", stream_opts.max_payload,
+                 "stream server: largest payload size a frame may announce, bytes")
+      ->capture_default_str()
+      ->check(CLI::Range(std::int64_t{0}, std::int64_t{0xffffffff}));
+  app.add_option("--stream-partial-timeout-ms", partial_timeout_ms,
+                 "stream server: a frame incomplete this long closes its connection")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 3600000));
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -60,15 +82,37 @@ int main(int argc, char** argv) {
                   p.name.c_str(), p.channel.c_str(), sock_cfg.address.c_str(), hub.listen_port(id),
                   p.recv_port ? std::to_string(p.recv_port).c_str() : "(learnt)");
     }
+    std::unique_ptr<llsf::comm::StreamServer> stream;
+    std::int64_t stream_messages = 0;
+    if (stream_port >= 0) {
+      stream_opts.address = sock_cfg.address;
+      stream_opts.port = stream_port;
+      stream_opts.partial_frame_timeout = std::chrono::milliseconds(partial_timeout_ms);
+      stream = std::make_unique<llsf::comm::StreamServer>(registry, stream_opts);
+      std::printf("stream server listens on %s:%d\n", sock_cfg.address.c_str(), stream->port());
+    }
     std::fflush(stdout);
 
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);
     const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
     while (!g_stop && (seconds <= 0.0 || std::chrono::steady_clock::now() < end)) {
-      hub.run_for(std::chrono::milliseconds(100));
+      if (!stream) {
+        hub.run_for(std::chrono::milliseconds(100));
+        continue;
+      }
+      hub.run_for(std::chrono::milliseconds(5));
+      stream->run_for(std::chrono::milliseconds(5));
+      for (const auto& e : stream->take_events()) {
+        if (e.kind == llsf::comm::StreamEvent::Kind::kMessage) ++stream_messages;
+      }
     }
     std::printf("%s\n", hub.hub().counters_json().c_str());
+    if (stream) {
+      std::printf("stream server: %lld messages received, %lld connections refused\n",
+                  static_cast<long long>(stream_messages),
+                  static_cast<long long>(stream->refused_count()));
+    }
     return 0;
   } catch (const llsf::core::ConfigError& e) {
     std::fprintf(stderr, "llsf-comm-hub: %s\n", e.what());

@@ -5,8 +5,13 @@
 #include "server.h"
 
 #include <doctest/doctest.h>
+#include <fcntl.h>
+#include <sys/resource.h>
+#include <time.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
 #include <boost/asio/connect.hpp>
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/tcp.hpp>
@@ -15,11 +20,16 @@
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
 #include <chrono>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <memory>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "app/cli_fixture.h"
@@ -354,4 +364,204 @@ TEST_CASE("llsfsim run --serve prints the URL first and --serve-exit ends with t
   CHECK(r.out.rfind("llsfsim serve: http://127.0.0.1:", 0) == 0);
   CHECK(!llsf::test::has(r.out, "game over"));
   CHECK(llsf::test::llsfsim({"run", scenario, "--port", "1"}).code == llsf::app::kExitBadInput);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Hostile clients (issue #21; docs/llsfsim.md "Limits")
+
+namespace {
+
+/// Log lines from the server's thread.
+struct LogLines {
+  std::mutex mutex;
+  std::vector<std::string> lines;
+  std::function<void(const std::string&)> sink() {
+    return [this](const std::string& l) {
+      const std::lock_guard lock(mutex);
+      lines.push_back(l);
+    };
+  }
+  int count(const std::string& part) {
+    const std::lock_guard lock(mutex);
+    return static_cast<int>(std::count_if(lines.begin(), lines.end(), [&](const std::string& l) {
+      return l.find(part) != std::string::npos;
+    }));
+  }
+};
+
+/// True once the server has closed `s` (EOF or an error), within `wait`.
+bool closed_by_server(tcp::socket& s, std::chrono::milliseconds wait) {
+  s.non_blocking(true);
+  const auto deadline = std::chrono::steady_clock::now() + wait;
+  while (std::chrono::steady_clock::now() < deadline) {
+    std::array<char, 4096> buf{};
+    beast::error_code ec;
+    s.read_some(asio::buffer(buf), ec);
+    if (ec && ec != asio::error::would_block) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return false;
+}
+
+tcp::socket connect_raw(asio::io_context& ioc, int port) {
+  tcp::socket s(ioc);
+  s.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(port)));
+  return s;
+}
+
+/// CPU time of this process (all threads).
+std::chrono::nanoseconds process_cpu_time() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return std::chrono::seconds(ts.tv_sec) + std::chrono::nanoseconds(ts.tv_nsec);
+}
+
+}  // namespace
+
+TEST_CASE("server: symbolic links that lead out of the served folders are refused") {
+  Fixture f;
+  const std::string outside = f.dir.file("outside");
+  write(outside + "/secret.txt", "secret");
+  fs::create_symlink(outside + "/secret.txt", f.viewer + "/link.txt");
+  fs::create_directory_symlink(outside, f.viewer + "/sub");
+  fs::copy_file(f.runs[0].recording, outside + "/game.jsonl.gz");
+  fs::create_symlink(outside + "/game.jsonl.gz", f.recordings + "/escape.jsonl.gz");
+  // A link that stays inside its folder is fine.
+  fs::create_symlink(f.viewer + "/viewer.js", f.viewer + "/alias.js");
+  llsf::app::Server server(f.options());
+  server.start();
+  const int port = server.port();
+
+  Reply r = request(port, "/link.txt");
+  CHECK(r.status == 403);
+  CHECK(r.body.find("secret") == std::string::npos);
+  CHECK(error_of(r) == "the path leads out of the viewer folder");
+  CHECK(request(port, "/sub/secret.txt").status == 403);
+  r = request(port, "/api/recordings/escape.jsonl.gz");
+  CHECK(r.status == 403);
+  CHECK(error_of(r) == "the path leads out of the recordings folder: escape.jsonl.gz");
+  r = request(port, "/alias.js");
+  CHECK(r.status == 200);
+  CHECK(r.body == "console.log(1);");
+}
+
+TEST_CASE(
+    "server: connections beyond max_connections are closed at once; slow requests time "
+    "out; header limit") {
+  Fixture f;
+  LogLines log;
+  llsf::app::ServerOptions o = f.options();
+  o.max_connections = 2;
+  o.request_timeout = std::chrono::milliseconds(300);
+  o.max_header_bytes = 1024;
+  o.log = log.sink();
+  llsf::app::Server server(o);
+  server.start();
+  const int port = server.port();
+  asio::io_context ioc;
+
+  // Two slow clients (half a request line, then nothing) take both slots.
+  tcp::socket a = connect_raw(ioc, port);
+  tcp::socket b = connect_raw(ioc, port);
+  asio::write(a, asio::buffer(std::string("GET / HTTP/1.1\r\nHost: x\r\n")));
+  asio::write(b, asio::buffer(std::string("GET /vi")));
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  tcp::socket c = connect_raw(ioc, port);
+  CHECK(closed_by_server(c, std::chrono::milliseconds(200)));
+  CHECK(log.count("max_connections") == 1);
+  // The slow ones are closed after the request timeout; then the server answers again.
+  CHECK(closed_by_server(a, std::chrono::seconds(3)));
+  CHECK(closed_by_server(b, std::chrono::seconds(3)));
+  CHECK(request(port, "/api/batches").status == 200);
+  // A header larger than max_header_bytes: 400.
+  tcp::socket d = connect_raw(ioc, port);
+  asio::write(d, asio::buffer("GET / HTTP/1.1\r\nHost: x\r\nX-Big: " + std::string(2000, 'a') +
+                              "\r\n\r\n"));
+  std::string answer(4096, '\0');
+  beast::error_code ec;
+  answer.resize(d.read_some(asio::buffer(answer), ec));
+  CHECK(answer.rfind("HTTP/1.1 400", 0) == 0);
+}
+
+TEST_CASE("server: WebSocket clients beyond max_websocket_clients get 503; a slow one is logged") {
+  Fixture f;
+  LogLines log;
+  llsf::app::LiveFeed feed;
+  llsf::app::ServerOptions o = f.options();
+  o.max_websocket_clients = 1;
+  o.max_client_backlog_bytes = 1 << 20;
+  o.log = log.sink();
+  llsf::app::Server server(o, &feed);
+  server.start();
+  feed.publish("{\"t\": 0}");
+  auto first = std::make_unique<WsClient>(server.port());
+  CHECK(first->read_lines(1).size() == 1);
+  CHECK_THROWS(WsClient(server.port()));
+  CHECK(log.count("max_websocket_clients") == 1);
+  // The first client stops reading and falls behind: it is dropped and logged, which frees its
+  // slot.
+  const std::string line = "\"" + std::string(16 * 1024, 'x') + "\"";
+  for (int i = 0; i < 2048; ++i) feed.publish(line);
+  CHECK(first->read_lines(2049).size() < 2049);
+  CHECK(log.count("dropped WebSocket client") == 1);
+  first.reset();
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  std::unique_ptr<WsClient> second;
+  while (!second && std::chrono::steady_clock::now() < deadline) {
+    try {
+      second = std::make_unique<WsClient>(server.port());
+    } catch (const std::exception&) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  }
+  CHECK(second != nullptr);
+}
+
+TEST_CASE("server: out of file descriptors, accept backs off instead of spinning") {
+  Fixture f;
+  LogLines log;
+  llsf::app::ServerOptions o = f.options();
+  o.log = log.sink();
+  llsf::app::Server server(o);
+  server.start();
+  const int port = server.port();
+  REQUIRE(request(port, "/api/batches").status == 200);
+  // Let the server close that connection, so that no descriptor comes free during the test.
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+
+  rlimit old{};
+  REQUIRE(getrlimit(RLIMIT_NOFILE, &old) == 0);
+  int open_now = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator("/proc/self/fd")) ++open_now;
+  rlimit low = old;
+  low.rlim_cur = static_cast<rlim_t>(open_now + 64);
+  REQUIRE(setrlimit(RLIMIT_NOFILE, &low) == 0);
+  asio::io_context ioc;
+  tcp::socket client(ioc);
+  client.open(tcp::v4());
+  std::vector<int> hoard;  // every descriptor left: none for the server's accept
+  for (int fd; (fd = ::open("/dev/null", O_RDONLY)) >= 0;) hoard.push_back(fd);
+  // Completes in the listen backlog.
+  client.connect(
+      tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(port)));
+
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  const auto cpu_before = process_cpu_time();
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  const auto cpu = process_cpu_time() - cpu_before;
+  const int logged = log.count("cannot accept a connection");
+  for (const int fd : hoard) ::close(fd);
+  setrlimit(RLIMIT_NOFILE, &old);
+  // A spinning accept loop burns the whole 500 ms; backing off every 100 ms takes almost none.
+  CHECK(cpu < std::chrono::milliseconds(150));
+  CHECK(logged == 1);  // once, not per retry
+
+  // With descriptors back, the waiting connection is served.
+  http::request<http::empty_body> req{http::verb::get, "/api/batches", 11};
+  req.set(http::field::host, "127.0.0.1");
+  http::write(client, req);
+  beast::flat_buffer buffer;
+  http::response<http::string_body> res;
+  http::read(client, buffer, res);
+  CHECK(res.result_int() == 200);
 }

@@ -12,8 +12,10 @@
 #include <array>
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "llsf/comm/frame.h"
@@ -34,6 +36,9 @@ struct StreamCounters {
   std::int64_t bytes_out = 0;
   /// Refused frames by FrameError (kUnknownType, kBadPayload, kOversized).
   std::array<std::int64_t, kFrameErrorCount> malformed{};
+  /// Why the connection was closed by this side for a limit ("" while open or for other causes):
+  /// "oversized", "partial_frame_timeout", "send_queue_full".
+  std::string closed_for;
   std::int64_t malformed_by(FrameError e) const { return malformed[static_cast<std::size_t>(e)]; }
 };
 
@@ -46,10 +51,32 @@ struct StreamEvent {
   std::unique_ptr<google::protobuf::Message> message;  ///< kMessage
 };
 
+/// Receives the transports' log lines (one line, no trailing newline).
+using LogSink = std::function<void(std::string_view line)>;
+/// The default LogSink: "llsf comm: <line>" on standard error.
+void log_to_stderr(std::string_view line);
+
+/// Defaults of the stream server's limits (docs/comm.md, "Network limits").
+inline constexpr int kDefaultMaxStreamConnections = 16;
+inline constexpr std::int64_t kDefaultMaxSendQueueBytes = std::int64_t{1} << 20;
+inline constexpr std::chrono::milliseconds kDefaultPartialFrameTimeout{10000};
+
 struct StreamServerOptions {
   std::string address = "127.0.0.1";  ///< loopback unless told otherwise
   int port = 4444;                    ///< 0: any free port (see StreamServer::port)
+  /// Largest payload a frame may announce; a larger size field closes the connection before
+  /// anything is allocated for it.
   std::int64_t max_payload = kDefaultMaxStreamPayload;
+  /// Connections open at once; one more is accepted and closed at once (logged).
+  int max_connections = kDefaultMaxStreamConnections;
+  /// A connection whose frame stays incomplete this long (counted from the frame's first byte)
+  /// is closed (logged). Wall-clock I/O only: game logic never depends on it.
+  std::chrono::milliseconds partial_frame_timeout = kDefaultPartialFrameTimeout;
+  /// Encoded bytes queued to one connection and not yet written; a send() beyond it closes the
+  /// connection (a client that does not read; logged).
+  std::int64_t max_send_queue_bytes = kDefaultMaxSendQueueBytes;
+  /// Where refusals and closes for a limit are logged.
+  LogSink log = log_to_stderr;
 };
 
 /// The refbox's controller server.
@@ -75,6 +102,8 @@ class StreamServer {
   /// Closes one connection.
   void disconnect(ClientId client);
   int client_count() const;
+  /// Connections refused because max_connections were open.
+  std::int64_t refused_count() const;
   /// Counters of a connection (also after it closed).
   const StreamCounters& counters(ClientId client) const;
 
