@@ -7,6 +7,7 @@
 
 #include <lua.hpp>
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -62,6 +63,8 @@ struct SkillEngine::Impl {
   /// Instructions used since the budget was armed: VM instructions counted by the hook plus the
   /// work library functions charge (charge()).
   std::int64_t used = 0;
+  /// When the armed cycle's wall-time budget ends (config.max_cycle_wall_s).
+  std::chrono::steady_clock::time_point wall_deadline;
   std::vector<SkillFile> files;
   int loads = 0;
 

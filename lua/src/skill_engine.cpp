@@ -41,23 +41,23 @@ const char* to_string(SkillStatus status) {
 
 // ---- config ------------------------------------------------------------------------------------
 
+namespace {
+// Upper bounds of the budgets: far above any skill's need (the defaults are 1,000,000
+// instructions and 64 MiB), low enough that one cycle stays seconds and the heap fits the machine.
+constexpr double kMaxInstructionBudget = 1e10;
+constexpr double kMaxMemoryBytes = 16.0 * (1LL << 30);
+}  // namespace
+
 void SkillEngineConfig::validate() const {
-  if (!(rate_hz > 0.0 && rate_hz <= 10000.0)) {
-    throw core::ConfigError("skill engine: rate_hz must be in (0, 10000], got " +
-                            std::to_string(rate_hz));
-  }
-  if (instruction_budget < 1000) {
-    throw core::ConfigError("skill engine: instruction_budget must be >= 1000, got " +
-                            std::to_string(instruction_budget));
-  }
-  if (memory_limit_bytes < (1LL << 20)) {
-    throw core::ConfigError("skill engine: memory_limit_bytes must be >= 1 MiB, got " +
-                            std::to_string(memory_limit_bytes));
-  }
-  if (allocation_budget_bytes < (1LL << 20)) {
-    throw core::ConfigError("skill engine: allocation_budget_bytes must be >= 1 MiB, got " +
-                            std::to_string(allocation_budget_bytes));
-  }
+  core::require("skill engine: rate_hz", rate_hz, core::in_range(0.1, 10000.0));
+  core::require("skill engine: instruction_budget", static_cast<double>(instruction_budget),
+                core::in_range(1000, kMaxInstructionBudget));
+  core::require("skill engine: memory_limit_bytes", static_cast<double>(memory_limit_bytes),
+                core::in_range(1 << 20, kMaxMemoryBytes));
+  core::require("skill engine: allocation_budget_bytes",
+                static_cast<double>(allocation_budget_bytes),
+                core::in_range(1 << 20, kMaxMemoryBytes));
+  core::require("skill engine: max_cycle_wall_s", max_cycle_wall_s, core::in_range(0.01, 3600.0));
   for (const std::string& dir : skill_dirs) {
     std::error_code ec;
     if (!fs::is_directory(dir, ec)) {
@@ -80,10 +80,17 @@ SkillEngineConfig SkillEngineConfig::from_config(const core::ConfigNode& node,
                                    : (fs::path(base_dir) / dir).lexically_normal().string());
     }
   }
-  node.read("rate_hz", cfg.rate_hz);
-  node.read("instruction_budget", cfg.instruction_budget);
-  node.read("memory_limit_bytes", cfg.memory_limit_bytes);
-  node.read("allocation_budget_bytes", cfg.allocation_budget_bytes);
+  // Each figure checked at its own key (validate() below repeats the checks for configs built
+  // in code).
+  node.read("rate_hz", cfg.rate_hz, core::in_range(0.1, 10000.0));
+  const auto read_int = [&](std::string_view key, std::int64_t& out, double lo, double hi) {
+    const core::ConfigNode v = node[key];
+    if (v.defined()) out = v.as_int(core::in_range(lo, hi));
+  };
+  read_int("instruction_budget", cfg.instruction_budget, 1000, kMaxInstructionBudget);
+  read_int("memory_limit_bytes", cfg.memory_limit_bytes, 1 << 20, kMaxMemoryBytes);
+  read_int("allocation_budget_bytes", cfg.allocation_budget_bytes, 1 << 20, kMaxMemoryBytes);
+  node.read("max_cycle_wall_s", cfg.max_cycle_wall_s, core::in_range(0.01, 3600.0));
   node.read("hot_reload", cfg.hot_reload);
   std::int64_t seed = 0;
   node.read("random_seed", seed);
@@ -150,10 +157,13 @@ std::int64_t hook_interval(const SkillEngineConfig& config) {
 // Count hook, every hook_interval() instructions: once the cycle used up its instruction budget,
 // an error naming the running code's file:line. The count starts again from 0, so the code that
 // catches it (the prelude) has a whole budget to unwind.
+// Also the wall-time budget: one instruction can take long where no count sees it (comparing two
+// long strings), so the clock is read at each call (about 20 ns per 1000 instructions).
 void budget_hook(lua_State* L, lua_Debug* ar) {
   SkillEngine::Impl& e = SkillEngine::Impl::of(L);
   e.used += hook_interval(e.config);
-  if (e.used < e.config.instruction_budget) return;
+  const bool out_of_time = std::chrono::steady_clock::now() > e.wall_deadline;
+  if (e.used < e.config.instruction_budget && !out_of_time) return;
   e.used = 0;
   e.budget_exhausted = true;
   // Name the skill's line: the hook may fire in the prelude's code (a library wrapper, the DSL
@@ -168,9 +178,17 @@ void budget_hook(lua_State* L, lua_Debug* ar) {
       ar = &caller;
     }
   }
-  lua_pushfstring(
-      L, "%s:%d: instruction budget exhausted (%I instructions per cycle; endless loop?)",
-      ar->short_src, ar->currentline, static_cast<LUA_INTEGER>(e.config.instruction_budget));
+  if (out_of_time) {
+    const std::string secs = core::number_text(e.config.max_cycle_wall_s);
+    lua_pushfstring(L,
+                    "%s:%d: wall-time budget exhausted (%s s per cycle; long strings compared or "
+                    "copied in a loop?)",
+                    ar->short_src, ar->currentline, secs.c_str());
+  } else {
+    lua_pushfstring(
+        L, "%s:%d: instruction budget exhausted (%I instructions per cycle; endless loop?)",
+        ar->short_src, ar->currentline, static_cast<LUA_INTEGER>(e.config.instruction_budget));
+  }
   lua_error(L);
 }
 
@@ -275,6 +293,9 @@ void SkillEngine::Impl::arm_budget() {
   heap.budget = config.allocation_budget_bytes;
   heap.exhausted = false;
   heap.limit_hit = false;
+  wall_deadline = std::chrono::steady_clock::now() +
+                  std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                      std::chrono::duration<double>(config.max_cycle_wall_s));
   lua_sethook(L, budget_hook, LUA_MASKCOUNT, static_cast<int>(hook_interval(config)));
 }
 

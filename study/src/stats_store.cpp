@@ -12,10 +12,12 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <optional>
 #include <set>
 #include <sstream>
 
 #include "llsf/core/data_dir.h"
+#include "llsf/core/input_file.h"
 #include "llsf/core/rng.h"
 #include "llsf/core/version.h"
 #include "llsf/sim/agent_brain.h"
@@ -643,11 +645,20 @@ std::int64_t StatsStore::count_rows(std::string_view table) const {
 
 // ---- Free functions --------------------------------------------------------------------------
 
+namespace {
+// An input file's bytes for a hash, read as the loaders read it (regular files only, within the
+// size limit: a named pipe among the agent files must not block the batch).
+std::string hashed_file_bytes(const std::string& path) {
+  std::string error;
+  std::optional<std::string> bytes =
+      core::try_read_input_file(path, core::kMaxSourceBytes, "input file", error);
+  if (!bytes) throw StatsError(error);
+  return std::move(*bytes);
+}
+}  // namespace
+
 std::string file_content_hash(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw StatsError(path + ": cannot read the file");
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  return hex16(core::fnv1a(std::string_view(bytes)));
+  return hex16(core::fnv1a(std::string_view(hashed_file_bytes(path))));
 }
 
 std::string batch_identity_hash(const std::string& scenario_path, const ScenarioFile& file) {
@@ -668,18 +679,13 @@ std::string batch_identity_hash(const std::string& scenario_path, const Scenario
       }
     }
   }
-  auto bytes_of = [](const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw StatsError(path + ": cannot read the file");
-    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  };
-  std::uint64_t h = core::fnv1a(std::string_view(bytes_of(scenario_path)));
+  std::uint64_t h = core::fnv1a(std::string_view(hashed_file_bytes(scenario_path)));
   for (const std::string& f : files) {
     // The name relative to the data directory when inside it (a moved checkout keeps its ids).
     const std::string data = core::data_dir() + "/";
     const std::string name = f.starts_with(data) ? f.substr(data.size()) : f;
     h = core::fnv1a(std::string_view(name), h);
-    h = core::fnv1a(std::string_view(bytes_of(f)), h);
+    h = core::fnv1a(std::string_view(hashed_file_bytes(f)), h);
   }
   return hex16(h);
 }

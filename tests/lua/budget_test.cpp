@@ -406,3 +406,30 @@ TEST_CASE("the bounded pattern functions give Lua's results") {
   CHECK(differences == 0);
   CHECK(printed.size() == expected.size());
 }
+
+TEST_CASE("comparing long strings in a loop is stopped by the wall-time budget") {
+  // One `==` of two equal-length 4 MB strings is one VM instruction that compares 4 MB: 200,000
+  // instructions of it take minutes, and no count sees the work. The wall budget ends it.
+  TempDir dir("llsf_budget");
+  dir.write("probe.lua", probe_skill("  local a = string.rep('x', 4000000)\n"
+                                     "  local b = string.rep('x', 3999999) .. 'y'\n"
+                                     "  local n = 0\n"
+                                     "  while true do if a == b then n = n + 1 end end"));
+  FakeRobot robot;
+  lua::SkillEngineConfig cfg = budget_config(dir);
+  cfg.instruction_budget = 100'000'000;
+  cfg.max_cycle_wall_s = 0.2;
+  lua::SkillEngine engine(cfg, robot);
+  REQUIRE(engine.exec("probe{}"));
+  CHECK(engine.cycle() == SkillStatus::kFailed);
+  const std::string error = without_dir(engine.error(), dir);
+  CHECK_MESSAGE(contains(error, "probe.lua:7: wall-time budget exhausted (0.2 s per cycle"), error);
+}
+
+TEST_CASE("max_cycle_wall_s is validated") {
+  lua::SkillEngineConfig cfg;
+  cfg.max_cycle_wall_s = 0.0;
+  CHECK_THROWS_WITH_AS(cfg.validate(),
+                       doctest::Contains("max_cycle_wall_s: must be in [0.01, 3600]"),
+                       core::ConfigError);
+}

@@ -317,8 +317,22 @@ TEST_CASE("bad configurations throw ConfigError naming the field") {
   cfg = config();
   cfg.allocation_budget_bytes = 1000;
   CHECK_THROWS_WITH_AS(lua::SkillEngine(cfg, robot),
-                       doctest::Contains("allocation_budget_bytes must be >= 1 MiB"),
+                       doctest::Contains("allocation_budget_bytes: must be in [1048576, "),
                        core::ConfigError);
+
+  // Each bad figure of a YAML map is named at its own key's line.
+  for (const auto& [line, key] : std::vector<std::pair<std::string, std::string>>{
+           {"rate_hz: 0.0001", "rate_hz"},
+           {"instruction_budget: 100000000000", "instruction_budget"},
+           {"memory_limit_bytes: 10", "memory_limit_bytes"},
+           {"max_cycle_wall_s: 1e300", "max_cycle_wall_s"}}) {
+    const core::ConfigNode bad =
+        core::ConfigNode::parse("skills:\n  hot_reload: false\n  " + line + "\n", "bad.yaml");
+    CHECK_THROWS_WITH_AS(lua::SkillEngineConfig::from_config(bad["skills"]),
+                         doctest::Contains("bad.yaml:3:"), core::ConfigError);
+    CHECK_THROWS_WITH_AS(lua::SkillEngineConfig::from_config(bad["skills"]),
+                         doctest::Contains("skills." + key + ": must be in"), core::ConfigError);
+  }
 
   const core::ConfigNode node = core::ConfigNode::parse(
       "skills:\n  skill_dirs: [" + test::example_skills_dir() +

@@ -41,6 +41,11 @@ struct SkillEngineConfig {
   /// Bytes one cycle (or loading one file) may allocate in all (freed memory counts too): bounds
   /// the time spent copying big strings, e.g. `s .. s` or `s:upper()` in a loop.
   std::int64_t allocation_budget_bytes = 256LL << 20;
+  /// Wall-clock seconds one cycle (or loading one file) may take, checked every 1000 VM
+  /// instructions: bounds work inside one instruction that no count sees (comparing two long
+  /// strings, `==` on 15 MB strings in a loop). Only a runaway skill reaches it; a game that
+  /// reaches it is no longer deterministic, as with the agents' wall budget.
+  double max_cycle_wall_s = 10.0;
   /// Reload skill files that changed (mtime or size) when a new skill string is executed.
   bool hot_reload = true;
   /// Seed of `math.random` inside the interpreter (e.g. from rng.stream("lua/robot1")).
@@ -54,9 +59,10 @@ struct SkillEngineConfig {
   /// Throws core::ConfigError naming the bad field.
   void validate() const;
   /// Reads `skill_dirs`, `rate_hz`, `instruction_budget`, `memory_limit_bytes`,
-  /// `allocation_budget_bytes`, `hot_reload`, `random_seed` from a map node (unknown keys are
-  /// errors). Relative dirs are taken relative to `base_dir` (e.g. the scenario file's directory);
-  /// with no `base_dir` they stay as written (relative to the working directory).
+  /// `allocation_budget_bytes`, `max_cycle_wall_s`, `hot_reload`, `random_seed` from a map node
+  /// (unknown keys are errors). Relative dirs are taken relative to `base_dir` (e.g. the scenario
+  /// file's directory); with no `base_dir` they stay as written (relative to the working
+  /// directory).
   static SkillEngineConfig from_config(const core::ConfigNode& node,
                                        const std::string& base_dir = {});
 };
