@@ -32,13 +32,28 @@ namespace {
 
 std::string num(double v) { return core::number_text(v); }
 
+// Upper bounds (docs/comm.md, "Bounds"), checked at each key before any conversion to the
+// clock and again by validate() for configs built in code.
+/// A burst of 1,000 lost copies in a row is a dead link for many seconds; longer ones are
+/// outages (`outages:`), and L / (L + 1) stays distinguishable from 1.
+constexpr double kMaxMeanBurstLength = 1000.0;
+/// A radio delay over a minute is an outage, not a delay; ms that fit the game clock.
+constexpr double kMaxDelayMs = 60000.0;
+/// Outage times: a day, far beyond a game (at most 3600 s) and inside the game clock.
+constexpr double kMaxOutageS = 86400.0;
+
+constexpr core::Bound kBurstLength = core::in_range(1.0, kMaxMeanBurstLength);
+constexpr core::Bound kDelayMs = core::in_range(0.0, kMaxDelayMs);
+constexpr core::Bound kOutageS = core::in_range(0.0, kMaxOutageS);
+constexpr core::Bound kFrameBytes = core::in_range(kHeaderSize, 65507);
+
 [[noreturn]] void fail(const std::string& path, const std::string& reason) {
   throw ConfigError(path + ": " + reason);
 }
 
-/// A delay given in ms (the key says so) must not be negative.
+/// A delay given in ms (the key says so): 0 .. kMaxDelayMs.
 void require_delay(const std::string& path, SimTime t) {
-  core::require(path, t.seconds() * 1e3, core::non_negative());
+  core::require(path, static_cast<double>(t.ns()) / 1e6, kDelayMs);  // exact for whole ms
 }
 
 /// In the burst model a link with long-run loss p and mean burst length L enters the bad state
@@ -59,13 +74,13 @@ std::string indexed(const char* list, std::size_t i) {
 
 void HubConfig::validate() const {
   core::require("loss.probability", loss_probability, core::probability());
-  core::require("loss.mean_burst_length", mean_burst_length, core::at_least(1.0));
+  core::require("loss.mean_burst_length", mean_burst_length, kBurstLength);
   if (loss_model == LossModel::kBurst) {
     require_burst_feasible("loss.probability", loss_probability, mean_burst_length);
   }
   require_delay("delay.fixed_ms", delay.fixed);
   require_delay("delay.jitter_ms", delay.jitter);
-  core::require("max_frame_bytes", max_frame_bytes, core::in_range(kHeaderSize, 65507));
+  core::require("max_frame_bytes", max_frame_bytes, kFrameBytes);
   for (std::size_t i = 0; i < links.size(); ++i) {
     const LinkConfig& l = links[i];
     const std::string p = indexed("links", i);
@@ -91,7 +106,8 @@ void HubConfig::validate() const {
     const std::string p = indexed("outages", i);
     if (o.peer.empty()) fail(p + ".peer", "must name a peer");
     if (o.other == o.peer) fail(p + ".other", "must differ from 'peer' (" + o.peer + ")");
-    if (o.from.ns() < 0) fail(p + ".from_s", "must be >= 0");
+    core::require(p + ".from_s", static_cast<double>(o.from.ns()) / 1e9, kOutageS);
+    core::require(p + ".until_s", static_cast<double>(o.until.ns()) / 1e9, kOutageS);
     if (!(o.until > o.from)) fail(p + ".until_s", "must be after from_s");
   }
 }
@@ -117,18 +133,16 @@ void HubConfig::validate_peer_names(const std::vector<std::string>& peer_names) 
 
 namespace {
 
+/// Checked at the key against kDelayMs before the conversion to the clock.
 void read_ms(const ConfigNode& n, std::string_view key, SimTime& out) {
   if (!n[key].defined()) return;
-  const double ms = n[key].as_double();
-  if (!std::isfinite(ms)) n[key].fail("expected a finite number of milliseconds");
-  out = SimTime::from_seconds(ms * 1e-3);
+  out = SimTime::from_seconds(n[key].as_double(kDelayMs) * 1e-3);
 }
 
+/// Checked at the key against kOutageS before the conversion to the clock.
 void read_s(const ConfigNode& n, std::string_view key, SimTime& out) {
   if (!n[key].defined()) return;
-  const double s = n[key].as_double();
-  if (!std::isfinite(s)) n[key].fail("expected a finite number of seconds");
-  out = SimTime::from_seconds(s);
+  out = SimTime::from_seconds(n[key].as_double(kOutageS));
 }
 
 LossModel parse_loss_model(const ConfigNode& n) {
@@ -150,8 +164,8 @@ HubConfig load_hub_config(const ConfigNode& node, HubConfig base) {
   if (const ConfigNode loss = node["loss"]; loss.defined()) {
     loss.require_map();
     if (loss["model"].defined()) c.loss_model = parse_loss_model(loss["model"]);
-    loss.read("probability", c.loss_probability);
-    loss.read("mean_burst_length", c.mean_burst_length);
+    loss.read("probability", c.loss_probability, core::probability());
+    loss.read("mean_burst_length", c.mean_burst_length, kBurstLength);
     loss.no_other_keys();
   }
   if (const ConfigNode delay = node["delay"]; delay.defined()) {
@@ -160,7 +174,7 @@ HubConfig load_hub_config(const ConfigNode& node, HubConfig base) {
     read_ms(delay, "jitter_ms", c.delay.jitter);
     delay.no_other_keys();
   }
-  node.read("max_frame_bytes", c.max_frame_bytes);
+  node.read("max_frame_bytes", c.max_frame_bytes, kFrameBytes);
   node.read("forward_unregistered", c.forward_unregistered);
 
   if (const ConfigNode links = node["links"]; links.defined()) {
@@ -171,7 +185,9 @@ HubConfig load_hub_config(const ConfigNode& node, HubConfig base) {
       lc.from = l.at("from").as_string();
       lc.to = l.at("to").as_string();
       l.read("symmetric", lc.symmetric);
-      if (l["loss_probability"].defined()) lc.loss_probability = l["loss_probability"].as_double();
+      if (l["loss_probability"].defined()) {
+        lc.loss_probability = l["loss_probability"].as_double(core::probability());
+      }
       if (l["fixed_ms"].defined()) read_ms(l, "fixed_ms", lc.delay_fixed.emplace());
       if (l["jitter_ms"].defined()) read_ms(l, "jitter_ms", lc.delay_jitter.emplace());
       l.no_other_keys();

@@ -163,6 +163,121 @@ bool circles_overlap(const Vec2& a, double ra, const Vec2& b, double rb) {
   return (a - b).norm() < ra + rb - kEps;
 }
 
+// ---- Bounds (docs/world-config.md, "Bounds") ----
+// Every figure has a finite upper bound, checked at its key by the loader (before anything is
+// computed from it) and again by validate() for worlds built in code.
+constexpr double kMaxLengthM = 100.0;       ///< the 2013 field is 5.6 m across
+constexpr double kMaxCoordinateM = 1000.0;  ///< as a scenario's robot start; then the field
+constexpr double kMaxMassKg = 1000.0;
+constexpr double kMaxFriction = 10.0;  ///< a Coulomb coefficient; rubber on concrete is ~1
+constexpr double kMaxSpeedMps = 10.0;  ///< ten times a 2013 robot's 1 m/s
+constexpr double kMaxOmegaRps = 20.0;  ///< about three turns a second
+constexpr double kMaxAccelMps2 = 100.0;
+constexpr double kMaxAlphaRps2 = 200.0;
+constexpr double kMinRateHz = 0.01;    ///< a reading at least every 100 s: a period of the clock
+constexpr double kMaxRateHz = 1000.0;  ///< the fastest physics rate (1 ms steps)
+constexpr double kMaxNoise = 10.0;     ///< a noise figure (per metre, per rad, rad/s)
+constexpr int kMaxIterations = 1000;   ///< solver iterations per physics step
+
+constexpr core::Bound positive_at_most(double hi) {
+  return {core::Bound::Kind::kOpenClosed, 0.0, hi};
+}
+constexpr core::Bound kLength = positive_at_most(kMaxLengthM);
+constexpr core::Bound kGap = core::in_range(0.0, kMaxLengthM);
+constexpr core::Bound kOffset = core::in_range(-kMaxLengthM, kMaxLengthM);
+constexpr core::Bound kCoordinate = core::in_range(-kMaxCoordinateM, kMaxCoordinateM);
+constexpr core::Bound kMass = positive_at_most(kMaxMassKg);
+constexpr core::Bound kFriction = core::in_range(0.0, kMaxFriction);
+constexpr core::Bound kRate = core::in_range(kMinRateHz, kMaxRateHz);
+constexpr core::Bound kNoise = core::in_range(0.0, kMaxNoise);
+constexpr core::Bound kIterations = core::in_range(1, kMaxIterations);
+constexpr core::Bound kOriDeg = core::in_range(-720.0, 720.0);
+constexpr core::Bound kOriRad = core::in_range(-4.0 * core::kPi, 4.0 * core::kPi);
+
+/// A number of a config struct `T` with its key and bound.
+template <class T>
+struct Key {
+  const char* key;
+  double T::*field;
+  core::Bound bound;
+};
+
+template <class T, std::size_t N>
+void require_keys(const std::string& prefix, const T& obj, const Key<T> (&keys)[N]) {
+  for (const Key<T>& k : keys) core::require(prefix + k.key, obj.*k.field, k.bound);
+}
+
+constexpr Key<FieldConfig> kFieldKeys[] = {
+    {"width_m", &FieldConfig::width_m, kLength},
+    {"height_m", &FieldConfig::height_m, kLength},
+    {"wall_thickness_m", &FieldConfig::wall_thickness_m, kLength},
+};
+constexpr Key<DeviceConfig> kDeviceKeys[] = {
+    {"body_depth_m", &DeviceConfig::body_depth_m, kLength},
+    {"body_width_m", &DeviceConfig::body_width_m, kLength},
+    {"body_offset_m", &DeviceConfig::body_offset_m, kOffset},
+    {"rfid_offset_m", &DeviceConfig::rfid_offset_m, kOffset},
+};
+constexpr Key<PuckModelConfig> kPuckKeys[] = {
+    {"radius_m", &PuckModelConfig::radius_m, kLength},
+    {"mass_kg", &PuckModelConfig::mass_kg, kMass},
+    {"floor_friction", &PuckModelConfig::floor_friction, kFriction},
+    {"contact_friction", &PuckModelConfig::contact_friction, kFriction},
+    {"restitution", &PuckModelConfig::restitution, core::probability()},
+};
+constexpr Key<RobotModelConfig> kRobotKeys[] = {
+    {"radius_m", &RobotModelConfig::radius_m, kLength},
+    {"mass_kg", &RobotModelConfig::mass_kg, kMass},
+    {"max_speed_mps", &RobotModelConfig::max_speed_mps, positive_at_most(kMaxSpeedMps)},
+    {"max_omega_rps", &RobotModelConfig::max_omega_rps, positive_at_most(kMaxOmegaRps)},
+    {"max_accel_mps2", &RobotModelConfig::max_accel_mps2, positive_at_most(kMaxAccelMps2)},
+    {"max_alpha_rps2", &RobotModelConfig::max_alpha_rps2, positive_at_most(kMaxAlphaRps2)},
+    {"contact_friction", &RobotModelConfig::contact_friction, kFriction},
+};
+// inner_width_m: at most kMaxLengthM here, wider than a puck in validate_robots().
+constexpr Key<HolderConfig> kHolderKeys[] = {
+    {"inner_width_m", &HolderConfig::inner_width_m, kLength},
+    {"arm_length_m", &HolderConfig::arm_length_m, kLength},
+    {"arm_thickness_m", &HolderConfig::arm_thickness_m, kLength},
+    {"arm_friction", &HolderConfig::arm_friction, kFriction},
+    {"release_backing_speed_mps", &HolderConfig::release_backing_speed_mps,
+     core::in_range(0.0, kMaxSpeedMps)},
+};
+constexpr Key<OdometryConfig> kOdometryKeys[] = {
+    {"rate_hz", &OdometryConfig::rate_hz, kRate},
+    {"trans_noise_per_m", &OdometryConfig::trans_noise_per_m, kNoise},
+    {"rot_noise_per_rad", &OdometryConfig::rot_noise_per_rad, kNoise},
+    {"accel_noise_per_mps", &OdometryConfig::accel_noise_per_mps, kNoise},
+    {"accel_rot_noise_per_rps", &OdometryConfig::accel_rot_noise_per_rps, kNoise},
+};
+constexpr Key<GyroConfig> kGyroKeys[] = {
+    {"rate_hz", &GyroConfig::rate_hz, kRate},
+    {"noise_std_rps", &GyroConfig::noise_std_rps, kNoise},
+    {"bias_rps", &GyroConfig::bias_rps, core::in_range(-kMaxNoise, kMaxNoise)},
+};
+constexpr Key<IrConfig> kIrKeys[] = {
+    {"rate_hz", &IrConfig::rate_hz, kRate},
+    {"range_m", &IrConfig::range_m, kLength},
+    {"noise_std_m", &IrConfig::noise_std_m, kGap},
+    {"threshold_m", &IrConfig::threshold_m, kLength},
+};
+constexpr Key<OpticalConfig> kOpticalKeys[] = {
+    {"rate_hz", &OpticalConfig::rate_hz, kRate},
+    {"range_m", &OpticalConfig::range_m, kLength},
+    {"miss_probability", &OpticalConfig::miss_probability, core::probability()},
+};
+constexpr Key<GroundTruthConfig> kGroundTruthKeys[] = {
+    {"rate_hz", &GroundTruthConfig::rate_hz, kRate},
+};
+constexpr Key<LaserConfig> kLaserKeys[] = {
+    {"rate_hz", &LaserConfig::rate_hz, kRate},
+    {"min_range_m", &LaserConfig::min_range_m, kGap},
+    {"max_range_m", &LaserConfig::max_range_m, kLength},
+    {"noise_std_m", &LaserConfig::noise_std_m, kGap},
+    {"mount_x_m", &LaserConfig::mount_x_m, kOffset},
+    {"mount_y_m", &LaserConfig::mount_y_m, kOffset},
+};
+
 std::string device_path(int i) { return "devices." + std::string(kDeviceNames[i]); }
 std::string indexed(const char* list, std::size_t i) {
   return std::string(list) + "[" + std::to_string(i) + "]";
@@ -173,24 +288,17 @@ std::string field_size(const FieldConfig& f) {
   return "field.width_m x field.height_m = " + num(f.width_m) + " x " + num(f.height_m);
 }
 
-void validate_field(const FieldConfig& f) {
-  core::require("field.width_m", f.width_m, core::positive());
-  core::require("field.height_m", f.height_m, core::positive());
-  core::require("field.wall_thickness_m", f.wall_thickness_m, core::positive());
-}
+void validate_field(const FieldConfig& f) { require_keys("field.", f, kFieldKeys); }
 
 void validate_devices(const WorldConfig& c) {
   const FieldConfig& f = c.field;
   for (int i = 0; i < kDeviceCount; ++i) {
     const DeviceConfig& d = c.devices[i];
     const std::string p = device_path(i);
-    core::require(p + ".x", d.pose.x, core::finite());
-    core::require(p + ".y", d.pose.y, core::finite());
+    core::require(p + ".x", d.pose.x, kCoordinate);
+    core::require(p + ".y", d.pose.y, kCoordinate);
     core::require(p + ".ori", d.pose.theta, core::finite());
-    core::require(p + ".body_depth_m", d.body_depth_m, core::positive());
-    core::require(p + ".body_width_m", d.body_width_m, core::positive());
-    core::require(p + ".body_offset_m", d.body_offset_m, core::finite());
-    core::require(p + ".rfid_offset_m", d.rfid_offset_m, core::finite());
+    require_keys(p + ".", d, kDeviceKeys);
     if (!(d.rfid_radius_m > 0.0 && d.rfid_radius_m <= kRfidMaxRange)) {
       fail(p + ".rfid_radius_m", "must be > 0 and <= " + num(kRfidMaxRange) +
                                      " (the RFID reader range) (got " + num(d.rfid_radius_m) + ")");
@@ -255,11 +363,7 @@ void validate_obstacles(const WorldConfig& c) {
 
 void validate_pucks(const WorldConfig& c) {
   const PuckModelConfig& m = c.puck;
-  core::require("puck.radius_m", m.radius_m, core::positive());
-  core::require("puck.mass_kg", m.mass_kg, core::positive());
-  core::require("puck.floor_friction", m.floor_friction, core::non_negative());
-  core::require("puck.contact_friction", m.contact_friction, core::non_negative());
-  core::require("puck.restitution", m.restitution, core::in_range(0.0, 1.0));
+  require_keys("puck.", m, kPuckKeys);
 
   const double r = m.radius_m;
   std::map<int, std::size_t> seen_ids;
@@ -271,8 +375,8 @@ void validate_pucks(const WorldConfig& c) {
       fail(p + ".id", "duplicate puck id " + std::to_string(pk.id) + " (also used by " +
                           indexed("pucks", it->second) + ")");
     }
-    core::require(p + ".x", pk.position.x(), core::finite());
-    core::require(p + ".y", pk.position.y(), core::finite());
+    core::require(p + ".x", pk.position.x(), kCoordinate);
+    core::require(p + ".y", pk.position.y(), kCoordinate);
     const std::string what = "puck " + std::to_string(pk.id) + " at " + at_xy(pk.position);
     if (!circle_inside_field(pk.position, r, c.field)) {
       fail(p, what + " is outside the field (the whole circle of puck.radius_m = " + num(r) +
@@ -295,25 +399,15 @@ void validate_pucks(const WorldConfig& c) {
 
 void validate_robots(const WorldConfig& c) {
   const RobotModelConfig& m = c.robot;
-  core::require("robot.radius_m", m.radius_m, core::positive());
-  core::require("robot.mass_kg", m.mass_kg, core::positive());
-  core::require("robot.max_speed_mps", m.max_speed_mps, core::positive());
-  core::require("robot.max_omega_rps", m.max_omega_rps, core::positive());
-  core::require("robot.max_accel_mps2", m.max_accel_mps2, core::positive());
-  core::require("robot.max_alpha_rps2", m.max_alpha_rps2, core::positive());
-  core::require("robot.contact_friction", m.contact_friction, core::non_negative());
+  require_keys("robot.", m, kRobotKeys);
 
   const HolderConfig& h = m.holder;
-  if (!(h.inner_width_m > 2.0 * c.puck.radius_m) || !std::isfinite(h.inner_width_m)) {
+  require_keys("robot.holder.", h, kHolderKeys);
+  if (!(h.inner_width_m > 2.0 * c.puck.radius_m)) {
     fail("robot.holder.inner_width_m",
          "must be wider than the puck diameter 2 * puck.radius_m = " + num(2.0 * c.puck.radius_m) +
              " (got " + num(h.inner_width_m) + ")");
   }
-  core::require("robot.holder.arm_length_m", h.arm_length_m, core::positive());
-  core::require("robot.holder.arm_thickness_m", h.arm_thickness_m, core::positive());
-  core::require("robot.holder.arm_friction", h.arm_friction, core::non_negative());
-  core::require("robot.holder.release_backing_speed_mps", h.release_backing_speed_mps,
-                core::non_negative());
 
   const double r = m.radius_m;
   std::map<std::string, std::size_t> seen_names;
@@ -334,8 +428,8 @@ void validate_robots(const WorldConfig& c) {
       fail(p + ".name", "duplicate robot name '" + rs.name + "' (also used by " +
                             indexed("robots", it->second) + ")");
     }
-    core::require(p + ".x", rs.pose.x, core::finite());
-    core::require(p + ".y", rs.pose.y, core::finite());
+    core::require(p + ".x", rs.pose.x, kCoordinate);
+    core::require(p + ".y", rs.pose.y, kCoordinate);
     core::require(p + ".ori", rs.pose.theta, core::finite());
     const Vec2 pos = rs.pose.position();
     const std::string what = "robot '" + rs.name + "' at " + at_xy(pos);
@@ -365,65 +459,32 @@ void validate_robots(const WorldConfig& c) {
 }
 
 void validate_sensors(const SensorsConfig& s) {
-  core::require("sensors.odometry.rate_hz", s.odometry.rate_hz, core::positive());
-  core::require("sensors.odometry.trans_noise_per_m", s.odometry.trans_noise_per_m,
-                core::non_negative());
-  core::require("sensors.odometry.rot_noise_per_rad", s.odometry.rot_noise_per_rad,
-                core::non_negative());
-  core::require("sensors.odometry.accel_noise_per_mps", s.odometry.accel_noise_per_mps,
-                core::non_negative());
-  core::require("sensors.odometry.accel_rot_noise_per_rps", s.odometry.accel_rot_noise_per_rps,
-                core::non_negative());
-
-  core::require("sensors.gyro.rate_hz", s.gyro.rate_hz, core::positive());
-  core::require("sensors.gyro.noise_std_rps", s.gyro.noise_std_rps, core::non_negative());
-  core::require("sensors.gyro.bias_rps", s.gyro.bias_rps, core::finite());
-
-  core::require("sensors.ir.rate_hz", s.ir.rate_hz, core::positive());
-  core::require("sensors.ir.range_m", s.ir.range_m, core::positive());
-  core::require("sensors.ir.noise_std_m", s.ir.noise_std_m, core::non_negative());
-  core::require("sensors.ir.threshold_m", s.ir.threshold_m, core::positive());
+  require_keys("sensors.odometry.", s.odometry, kOdometryKeys);
+  require_keys("sensors.gyro.", s.gyro, kGyroKeys);
+  require_keys("sensors.ir.", s.ir, kIrKeys);
   if (s.ir.threshold_m > s.ir.range_m) {
     fail("sensors.ir.threshold_m", "must be <= sensors.ir.range_m " + num(s.ir.range_m) + " (got " +
                                        num(s.ir.threshold_m) + ")");
   }
 
-  core::require("sensors.optical.rate_hz", s.optical.rate_hz, core::positive());
-  core::require("sensors.optical.range_m", s.optical.range_m, core::positive());
-  core::require("sensors.optical.miss_probability", s.optical.miss_probability,
-                core::probability());
-
-  core::require("sensors.ground_truth.rate_hz", s.ground_truth.rate_hz, core::positive());
+  require_keys("sensors.optical.", s.optical, kOpticalKeys);
+  require_keys("sensors.ground_truth.", s.ground_truth, kGroundTruthKeys);
 
   const LaserConfig& l = s.laser;
-  if (l.beams < 1 || l.beams > kMaxBeams) {
-    fail("sensors.laser.beams",
-         "must be in 1.." + std::to_string(kMaxBeams) + " (got " + std::to_string(l.beams) + ")");
-  }
-  core::require("sensors.laser.rate_hz", l.rate_hz, core::positive());
-  core::require("sensors.laser.min_range_m", l.min_range_m, core::non_negative());
-  core::require("sensors.laser.max_range_m", l.max_range_m, core::positive());
+  core::require("sensors.laser.beams", l.beams, core::in_range(1, kMaxBeams));
+  require_keys("sensors.laser.", l, kLaserKeys);
   if (!(l.min_range_m < l.max_range_m)) {
     fail("sensors.laser.min_range_m", "must be < sensors.laser.max_range_m " + num(l.max_range_m) +
                                           " (got " + num(l.min_range_m) + ")");
   }
-  core::require("sensors.laser.noise_std_m", l.noise_std_m, core::non_negative());
-  core::require("sensors.laser.mount_x_m", l.mount_x_m, core::finite());
-  core::require("sensors.laser.mount_y_m", l.mount_y_m, core::finite());
 }
 
 void validate_physics(const PhysicsConfig& p) {
   if (p.step <= SimTime() || p.step > SimTime::from_ms(100)) {
     fail("physics.step_ms", "must be > 0 and <= 100 (got " + num(p.step.seconds() * 1000.0) + ")");
   }
-  if (p.velocity_iterations < 1) {
-    fail("physics.velocity_iterations",
-         "must be >= 1 (got " + std::to_string(p.velocity_iterations) + ")");
-  }
-  if (p.position_iterations < 1) {
-    fail("physics.position_iterations",
-         "must be >= 1 (got " + std::to_string(p.position_iterations) + ")");
-  }
+  core::require("physics.velocity_iterations", p.velocity_iterations, kIterations);
+  core::require("physics.position_iterations", p.position_iterations, kIterations);
 }
 
 }  // namespace
@@ -477,6 +538,11 @@ class Loader {
   static void element(const ConfigNode& e, const char* what) {
     if (!e.is_map()) e.fail(std::string("expected a map ") + what);
   }
+  /// Each number checked at its own key against its bound.
+  template <class T, std::size_t N>
+  static void read_keys(const ConfigNode& n, T& obj, const Key<T> (&keys)[N]) {
+    for (const Key<T>& k : keys) n.read(k.key, obj.*k.field, k.bound);
+  }
 
   /// `ori` (radians) or `ori_deg` (degrees), normalised to (-pi, pi].
   static void read_orientation(const ConfigNode& m, double& theta) {
@@ -486,17 +552,15 @@ class Loader {
       deg.fail("give either 'ori' (radians) or 'ori_deg' (degrees), not both");
     }
     if (rad.defined()) {
-      theta = core::normalize_angle(rad.as_double());
+      theta = core::normalize_angle(rad.as_double(kOriRad));
     } else if (deg.defined()) {
-      theta = core::normalize_angle(core::deg_to_rad(deg.as_double()));
+      theta = core::normalize_angle(core::deg_to_rad(deg.as_double(kOriDeg)));
     }
   }
 
   void read_field(FieldConfig& f) {
     const ConfigNode n = section(root_, "field");
-    n.read("width_m", f.width_m);
-    n.read("height_m", f.height_m);
-    n.read("wall_thickness_m", f.wall_thickness_m);
+    read_keys(n, f, kFieldKeys);
     n.no_other_keys();
   }
 
@@ -511,13 +575,10 @@ class Loader {
       }
       d.require_map();
       DeviceConfig& dev = c.devices[id->value()];
-      d.read("x", dev.pose.x);
-      d.read("y", dev.pose.y);
+      d.read("x", dev.pose.x, kCoordinate);
+      d.read("y", dev.pose.y, kCoordinate);
       read_orientation(d, dev.pose.theta);
-      d.read("body_depth_m", dev.body_depth_m);
-      d.read("body_width_m", dev.body_width_m);
-      d.read("body_offset_m", dev.body_offset_m);
-      d.read("rfid_offset_m", dev.rfid_offset_m);
+      read_keys(d, dev, kDeviceKeys);
       d.read("rfid_radius_m", dev.rfid_radius_m);
       d.no_other_keys();
     }
@@ -525,11 +586,7 @@ class Loader {
 
   void read_puck_model(PuckModelConfig& m) {
     const ConfigNode n = section(root_, "puck");
-    n.read("radius_m", m.radius_m);
-    n.read("mass_kg", m.mass_kg);
-    n.read("floor_friction", m.floor_friction);
-    n.read("contact_friction", m.contact_friction);
-    n.read("restitution", m.restitution);
+    read_keys(n, m, kPuckKeys);
     n.no_other_keys();
   }
 
@@ -545,8 +602,8 @@ class Loader {
       e.at("x");
       e.at("y");
       e.read("id", p.id);
-      e.read("x", p.position.x());
-      e.read("y", p.position.y());
+      e.read("x", p.position.x(), kCoordinate);
+      e.read("y", p.position.y(), kCoordinate);
       e.no_other_keys();
       c.pucks.push_back(p);
     }
@@ -554,24 +611,14 @@ class Loader {
 
   void read_robot_model(RobotModelConfig& m) {
     const ConfigNode n = section(root_, "robot");
-    n.read("radius_m", m.radius_m);
-    n.read("mass_kg", m.mass_kg);
-    n.read("max_speed_mps", m.max_speed_mps);
-    n.read("max_omega_rps", m.max_omega_rps);
-    n.read("max_accel_mps2", m.max_accel_mps2);
-    n.read("max_alpha_rps2", m.max_alpha_rps2);
-    n.read("contact_friction", m.contact_friction);
+    read_keys(n, m, kRobotKeys);
 
     HolderConfig& h = m.holder;
     const ConfigNode hn = section(n, "holder");
     hn.read_enum("mode", h.mode,
                  {{"physical", HolderMode::kPhysical}, {"assisted", HolderMode::kAssisted}},
                  "holder mode");
-    hn.read("inner_width_m", h.inner_width_m);
-    hn.read("arm_length_m", h.arm_length_m);
-    hn.read("arm_thickness_m", h.arm_thickness_m);
-    hn.read("arm_friction", h.arm_friction);
-    hn.read("release_backing_speed_mps", h.release_backing_speed_mps);
+    read_keys(hn, h, kHolderKeys);
     hn.no_other_keys();
     n.no_other_keys();
   }
@@ -585,8 +632,8 @@ class Loader {
       element(e, "{name, x, y, ori_deg, jersey}");
       RobotStart r;
       r.name = e.at("name").as_string();
-      r.pose.x = e.at("x").as_double();
-      r.pose.y = e.at("y").as_double();
+      r.pose.x = e.at("x").as_double(kCoordinate);
+      r.pose.y = e.at("y").as_double(kCoordinate);
       read_orientation(e, r.pose.theta);
       e.read("jersey", r.jersey);
       e.no_other_keys();
@@ -598,45 +645,29 @@ class Loader {
     const ConfigNode n = section(root_, "sensors");
 
     const ConfigNode odo = section(n, "odometry");
-    odo.read("rate_hz", s.odometry.rate_hz);
-    odo.read("trans_noise_per_m", s.odometry.trans_noise_per_m);
-    odo.read("rot_noise_per_rad", s.odometry.rot_noise_per_rad);
-    odo.read("accel_noise_per_mps", s.odometry.accel_noise_per_mps);
-    odo.read("accel_rot_noise_per_rps", s.odometry.accel_rot_noise_per_rps);
+    read_keys(odo, s.odometry, kOdometryKeys);
     odo.no_other_keys();
 
     const ConfigNode gyro = section(n, "gyro");
-    gyro.read("rate_hz", s.gyro.rate_hz);
-    gyro.read("noise_std_rps", s.gyro.noise_std_rps);
-    gyro.read("bias_rps", s.gyro.bias_rps);
+    read_keys(gyro, s.gyro, kGyroKeys);
     gyro.no_other_keys();
 
     const ConfigNode ir = section(n, "ir");
-    ir.read("rate_hz", s.ir.rate_hz);
-    ir.read("range_m", s.ir.range_m);
-    ir.read("noise_std_m", s.ir.noise_std_m);
-    ir.read("threshold_m", s.ir.threshold_m);
+    read_keys(ir, s.ir, kIrKeys);
     ir.no_other_keys();
 
     const ConfigNode opt = section(n, "optical");
-    opt.read("rate_hz", s.optical.rate_hz);
-    opt.read("range_m", s.optical.range_m);
-    opt.read("miss_probability", s.optical.miss_probability);
+    read_keys(opt, s.optical, kOpticalKeys);
     opt.no_other_keys();
 
     const ConfigNode gt = section(n, "ground_truth");
-    gt.read("rate_hz", s.ground_truth.rate_hz);
+    read_keys(gt, s.ground_truth, kGroundTruthKeys);
     gt.no_other_keys();
 
     const ConfigNode las = section(n, "laser");
     las.read("enabled", s.laser.enabled);
-    las.read("beams", s.laser.beams);
-    las.read("rate_hz", s.laser.rate_hz);
-    las.read("min_range_m", s.laser.min_range_m);
-    las.read("max_range_m", s.laser.max_range_m);
-    las.read("noise_std_m", s.laser.noise_std_m);
-    las.read("mount_x_m", s.laser.mount_x_m);
-    las.read("mount_y_m", s.laser.mount_y_m);
+    las.read("beams", s.laser.beams, core::in_range(1, kMaxBeams));
+    read_keys(las, s.laser, kLaserKeys);
     las.no_other_keys();
     n.no_other_keys();
   }
@@ -649,8 +680,8 @@ class Loader {
       if (!(ms > 0.0 && ms <= 100.0)) step.fail("must be > 0 and <= 100 (got " + num(ms) + ")");
       p.step = SimTime::from_seconds(ms / 1000.0);
     }
-    n.read("velocity_iterations", p.velocity_iterations);
-    n.read("position_iterations", p.position_iterations);
+    n.read("velocity_iterations", p.velocity_iterations, kIterations);
+    n.read("position_iterations", p.position_iterations, kIterations);
     n.no_other_keys();
   }
 

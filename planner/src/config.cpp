@@ -19,69 +19,135 @@ std::string num(double v) { return core::number_text(v); }
   throw ConfigError(path + ": " + reason);
 }
 
+// Upper bounds of every figure (docs/planner.md, "Bounds"): far above any robot on a 5.6 m
+// field, low enough that distances, times and their products stay finite and a wait stays a
+// wait. Each is checked at its key by the loader and again by validate() for configs built in
+// code.
+constexpr double kMaxDistanceM = 100.0;  ///< the field is 5.6 m across
+constexpr double kMaxSpeedMps = 10.0;    ///< as the world's robot.max_speed_mps
+constexpr double kMaxOmegaRps = 20.0;
+constexpr double kMaxAccelMps2 = 100.0;
+constexpr double kMaxAlphaRps2 = 200.0;
+constexpr double kMaxWaitS = 60.0;       ///< a wait over a minute is a stuck robot
+constexpr double kMaxTimeoutS = 3600.0;  ///< a game's longest duration
+constexpr double kMaxAcceptRatio = 100.0;
+constexpr double kMaxCoordinateM = 1000.0;  ///< as a scenario's robot start
+constexpr int kMaxShortcutSteps = 10000;
+
+constexpr core::Bound positive_at_most(double hi) {
+  return {core::Bound::Kind::kOpenClosed, 0.0, hi};
+}
+
+struct DoubleKey {
+  const char* key;
+  double ControllerConfig::*field;
+  core::Bound bound;
+};
+
+// The controller's figures; accel_fraction + turn_accel_fraction <= 1 and backoff_max_s >=
+// backoff_min_s are checked after them.
+constexpr DoubleKey kControllerKeys[] = {
+    {"max_speed_mps", &ControllerConfig::max_speed_mps, positive_at_most(kMaxSpeedMps)},
+    {"max_omega_rps", &ControllerConfig::max_omega_rps, positive_at_most(kMaxOmegaRps)},
+    {"max_accel_mps2", &ControllerConfig::max_accel_mps2, positive_at_most(kMaxAccelMps2)},
+    {"max_alpha_rps2", &ControllerConfig::max_alpha_rps2, positive_at_most(kMaxAlphaRps2)},
+    {"accel_fraction", &ControllerConfig::accel_fraction, core::fraction()},
+    {"turn_accel_fraction", &ControllerConfig::turn_accel_fraction, core::fraction()},
+    {"position_tolerance_m", &ControllerConfig::position_tolerance_m,
+     positive_at_most(kMaxDistanceM)},
+    {"angle_tolerance_rad", &ControllerConfig::angle_tolerance_rad, positive_at_most(core::kPi)},
+    {"corner_deviation_m", &ControllerConfig::corner_deviation_m, positive_at_most(kMaxDistanceM)},
+    {"robot_margin_m", &ControllerConfig::robot_margin_m, core::in_range(0.0, kMaxDistanceM)},
+    {"obstacle_lookahead_m", &ControllerConfig::obstacle_lookahead_m,
+     positive_at_most(kMaxDistanceM)},
+    {"stop_buffer_m", &ControllerConfig::stop_buffer_m, core::in_range(0.0, kMaxDistanceM)},
+    {"wait_before_replan_s", &ControllerConfig::wait_before_replan_s,
+     core::in_range(0.0, kMaxWaitS)},
+    {"replan_jitter_s", &ControllerConfig::replan_jitter_s, core::in_range(0.0, kMaxWaitS)},
+    {"replan_margin_m", &ControllerConfig::replan_margin_m, core::in_range(0.0, kMaxDistanceM)},
+    {"prediction_horizon_s", &ControllerConfig::prediction_horizon_s,
+     core::in_range(0.0, kMaxWaitS)},
+    {"backoff_distance_m", &ControllerConfig::backoff_distance_m,
+     core::in_range(0.0, kMaxDistanceM)},
+    {"backoff_min_s", &ControllerConfig::backoff_min_s, core::in_range(0.0, kMaxWaitS)},
+    {"backoff_max_s", &ControllerConfig::backoff_max_s, core::in_range(0.0, kMaxWaitS)},
+    {"blocked_timeout_s", &ControllerConfig::blocked_timeout_s, positive_at_most(kMaxTimeoutS)},
+    {"stuck_timeout_s", &ControllerConfig::stuck_timeout_s, positive_at_most(kMaxTimeoutS)},
+    {"progress_m", &ControllerConfig::progress_m, positive_at_most(kMaxDistanceM)},
+};
+
+struct PlannerKey {
+  const char* key;
+  double PlannerConfig::*field;
+  core::Bound bound;
+};
+
+constexpr PlannerKey kPlannerKeys[] = {
+    {"robot_radius_m", &PlannerConfig::robot_radius_m, positive_at_most(kMaxDistanceM)},
+    {"safety_margin_m", &PlannerConfig::safety_margin_m, core::in_range(0.0, kMaxDistanceM)},
+    {"rrt_range_m", &PlannerConfig::rrt_range_m, positive_at_most(kMaxDistanceM)},
+    {"accept_ratio", &PlannerConfig::accept_ratio, core::in_range(1.0, kMaxAcceptRatio)},
+    {"accept_extra_m", &PlannerConfig::accept_extra_m, core::in_range(0.0, kMaxDistanceM)},
+    {"start_escape_m", &PlannerConfig::start_escape_m, core::in_range(0.0, kMaxDistanceM)},
+};
+constexpr core::Bound kMaxIterations = core::in_range(10, 1000000);
+constexpr core::Bound kMaxAttempts = core::in_range(1, 100);
+constexpr core::Bound kShortcutSteps = core::in_range(0, kMaxShortcutSteps);
+
+struct PlacesKey {
+  const char* key;
+  double PlacesConfig::*field;
+  core::Bound bound;
+};
+
+constexpr PlacesKey kPlacesKeys[] = {
+    {"held_puck_offset_m", &PlacesConfig::held_puck_offset_m, positive_at_most(kMaxDistanceM)},
+    {"side_offset_m", &PlacesConfig::side_offset_m, positive_at_most(kMaxDistanceM)},
+    {"look_distance_m", &PlacesConfig::look_distance_m, positive_at_most(kMaxDistanceM)},
+    {"storage_pickup_depth_m", &PlacesConfig::storage_pickup_depth_m,
+     core::in_range(0.0, kMaxDistanceM)},
+    {"wait_distance_m", &PlacesConfig::wait_distance_m, core::in_range(0.0, kMaxDistanceM)},
+    {"wait_lateral_m", &PlacesConfig::wait_lateral_m,
+     core::in_range(-kMaxDistanceM, kMaxDistanceM)},
+};
+constexpr core::Bound kStoragePickups = core::in_range(1, 100);
+constexpr core::Bound kCoordinate = core::in_range(-kMaxCoordinateM, kMaxCoordinateM);
+constexpr core::Bound kThetaDeg = core::in_range(-360.0, 360.0);
+
 }  // namespace
 
 void PlacesConfig::validate() const {
   const std::string p = "planner.places.";
-  core::require(p + "held_puck_offset_m", held_puck_offset_m, core::positive());
-  core::require(p + "side_offset_m", side_offset_m, core::positive());
-  core::require(p + "look_distance_m", look_distance_m, core::positive());
-  core::require(p + "storage_pickups", storage_pickups, core::in_range(1, 100));
-  core::require(p + "storage_pickup_depth_m", storage_pickup_depth_m, core::non_negative());
-  core::require(p + "wait_distance_m", wait_distance_m, core::non_negative());
-  core::require(p + "wait_lateral_m", wait_lateral_m, core::finite());
+  for (const PlacesKey& k : kPlacesKeys) core::require(p + k.key, this->*k.field, k.bound);
+  core::require(p + "storage_pickups", storage_pickups, kStoragePickups);
   std::set<std::string> names;
   for (std::size_t i = 0; i < extra.size(); ++i) {
     const std::string e = p + "extra[" + std::to_string(i) + "]";
     if (extra[i].name.empty()) fail(e + ".name", "must not be empty");
     if (!names.insert(extra[i].name).second) fail(e + ".name", "duplicate name " + extra[i].name);
-    core::require(e + ".x", extra[i].pose.x, core::finite());
-    core::require(e + ".y", extra[i].pose.y, core::finite());
+    core::require(e + ".x", extra[i].pose.x, kCoordinate);
+    core::require(e + ".y", extra[i].pose.y, kCoordinate);
     core::require(e + ".theta", extra[i].pose.theta, core::finite());
   }
 }
 
 void PlannerConfig::validate() const {
-  core::require("planner.robot_radius_m", robot_radius_m, core::positive());
-  core::require("planner.safety_margin_m", safety_margin_m, core::non_negative());
-  core::require("planner.rrt_range_m", rrt_range_m, core::positive());
-  core::require("planner.max_iterations", max_iterations, core::in_range(10, 1000000));
-  core::require("planner.accept_ratio", accept_ratio, core::at_least(1.0));
-  core::require("planner.accept_extra_m", accept_extra_m, core::non_negative());
-  core::require("planner.max_attempts", max_attempts, core::in_range(1, 100));
-  core::require("planner.shortcut_steps", shortcut_steps, core::non_negative());
-  core::require("planner.start_escape_m", start_escape_m, core::non_negative());
+  for (const PlannerKey& k : kPlannerKeys)
+    core::require("planner." + std::string(k.key), this->*k.field, k.bound);
+  core::require("planner.max_iterations", max_iterations, kMaxIterations);
+  core::require("planner.max_attempts", max_attempts, kMaxAttempts);
+  core::require("planner.shortcut_steps", shortcut_steps, kShortcutSteps);
   places.validate();
 }
 
 void ControllerConfig::validate() const {
   const std::string p = "controller.";
-  core::require(p + "max_speed_mps", max_speed_mps, core::positive());
-  core::require(p + "max_omega_rps", max_omega_rps, core::positive());
-  core::require(p + "max_accel_mps2", max_accel_mps2, core::positive());
-  core::require(p + "max_alpha_rps2", max_alpha_rps2, core::positive());
-  core::require(p + "accel_fraction", accel_fraction, core::fraction());
-  core::require(p + "turn_accel_fraction", turn_accel_fraction, core::fraction());
+  for (const DoubleKey& k : kControllerKeys) core::require(p + k.key, this->*k.field, k.bound);
   if (accel_fraction + turn_accel_fraction > 1.0 + 1e-12)
     fail(p + "turn_accel_fraction", "accel_fraction + turn_accel_fraction must be <= 1 (got " +
                                         num(accel_fraction + turn_accel_fraction) + ")");
-  core::require(p + "position_tolerance_m", position_tolerance_m, core::positive());
-  core::require(p + "angle_tolerance_rad", angle_tolerance_rad, core::positive());
-  core::require(p + "corner_deviation_m", corner_deviation_m, core::positive());
-  core::require(p + "robot_margin_m", robot_margin_m, core::non_negative());
-  core::require(p + "obstacle_lookahead_m", obstacle_lookahead_m, core::positive());
-  core::require(p + "stop_buffer_m", stop_buffer_m, core::non_negative());
-  core::require(p + "wait_before_replan_s", wait_before_replan_s, core::non_negative());
-  core::require(p + "replan_jitter_s", replan_jitter_s, core::non_negative());
-  core::require(p + "replan_margin_m", replan_margin_m, core::non_negative());
-  core::require(p + "prediction_horizon_s", prediction_horizon_s, core::non_negative());
-  core::require(p + "backoff_distance_m", backoff_distance_m, core::non_negative());
-  core::require(p + "backoff_min_s", backoff_min_s, core::non_negative());
-  if (!(backoff_max_s >= backoff_min_s) || !std::isfinite(backoff_max_s))
+  if (!(backoff_max_s >= backoff_min_s))
     fail(p + "backoff_max_s", "must be >= backoff_min_s (got " + num(backoff_max_s) + ")");
-  core::require(p + "blocked_timeout_s", blocked_timeout_s, core::positive());
-  core::require(p + "stuck_timeout_s", stuck_timeout_s, core::positive());
-  core::require(p + "progress_m", progress_m, core::positive());
 }
 
 void NavigationConfig::validate() const {
@@ -96,13 +162,8 @@ void NavigationConfig::validate() const {
 namespace {
 
 void read_places(const ConfigNode& pl, PlacesConfig& c) {
-  pl.read("held_puck_offset_m", c.held_puck_offset_m);
-  pl.read("side_offset_m", c.side_offset_m);
-  pl.read("look_distance_m", c.look_distance_m);
-  pl.read("storage_pickups", c.storage_pickups);
-  pl.read("storage_pickup_depth_m", c.storage_pickup_depth_m);
-  pl.read("wait_distance_m", c.wait_distance_m);
-  pl.read("wait_lateral_m", c.wait_lateral_m);
+  for (const PlacesKey& k : kPlacesKeys) pl.read(k.key, c.*k.field, k.bound);
+  pl.read("storage_pickups", c.storage_pickups, kStoragePickups);
   if (const ConfigNode ex = pl["extra"]; ex.defined()) {
     if (!ex.is_sequence()) ex.fail("expected a list of {name, x, y, theta_deg}");
     c.extra.clear();
@@ -110,10 +171,10 @@ void read_places(const ConfigNode& pl, PlacesConfig& c) {
       e.require_map();
       UserPlace u;
       u.name = e.at("name").as_string();
-      u.pose.x = e.at("x").as_double();
-      u.pose.y = e.at("y").as_double();
+      u.pose.x = e.at("x").as_double(kCoordinate);
+      u.pose.y = e.at("y").as_double(kCoordinate);
       double deg = 0.0;
-      e.read("theta_deg", deg);
+      e.read("theta_deg", deg, kThetaDeg);
       u.pose.theta = core::normalize_angle(core::deg_to_rad(deg));
       e.no_other_keys();
       c.extra.push_back(std::move(u));
@@ -123,15 +184,10 @@ void read_places(const ConfigNode& pl, PlacesConfig& c) {
 }
 
 void read_planner(const ConfigNode& p, PlannerConfig& c) {
-  p.read("robot_radius_m", c.robot_radius_m);
-  p.read("safety_margin_m", c.safety_margin_m);
-  p.read("rrt_range_m", c.rrt_range_m);
-  p.read("max_iterations", c.max_iterations);
-  p.read("accept_ratio", c.accept_ratio);
-  p.read("accept_extra_m", c.accept_extra_m);
-  p.read("max_attempts", c.max_attempts);
-  p.read("shortcut_steps", c.shortcut_steps);
-  p.read("start_escape_m", c.start_escape_m);
+  for (const PlannerKey& k : kPlannerKeys) p.read(k.key, c.*k.field, k.bound);
+  p.read("max_iterations", c.max_iterations, kMaxIterations);
+  p.read("max_attempts", c.max_attempts, kMaxAttempts);
+  p.read("shortcut_steps", c.shortcut_steps, kShortcutSteps);
   if (const ConfigNode pl = p["places"]; pl.defined()) {
     pl.require_map();
     read_places(pl, c.places);
@@ -140,28 +196,8 @@ void read_planner(const ConfigNode& p, PlannerConfig& c) {
 }
 
 void read_controller(const ConfigNode& k, ControllerConfig& cc) {
-  k.read("max_speed_mps", cc.max_speed_mps);
-  k.read("max_omega_rps", cc.max_omega_rps);
-  k.read("max_accel_mps2", cc.max_accel_mps2);
-  k.read("max_alpha_rps2", cc.max_alpha_rps2);
-  k.read("accel_fraction", cc.accel_fraction);
-  k.read("turn_accel_fraction", cc.turn_accel_fraction);
-  k.read("position_tolerance_m", cc.position_tolerance_m);
-  k.read("angle_tolerance_rad", cc.angle_tolerance_rad);
-  k.read("corner_deviation_m", cc.corner_deviation_m);
-  k.read("robot_margin_m", cc.robot_margin_m);
-  k.read("obstacle_lookahead_m", cc.obstacle_lookahead_m);
-  k.read("stop_buffer_m", cc.stop_buffer_m);
-  k.read("wait_before_replan_s", cc.wait_before_replan_s);
-  k.read("replan_jitter_s", cc.replan_jitter_s);
-  k.read("replan_margin_m", cc.replan_margin_m);
-  k.read("prediction_horizon_s", cc.prediction_horizon_s);
-  k.read("backoff_distance_m", cc.backoff_distance_m);
-  k.read("backoff_min_s", cc.backoff_min_s);
-  k.read("backoff_max_s", cc.backoff_max_s);
-  k.read("blocked_timeout_s", cc.blocked_timeout_s);
-  k.read("stuck_timeout_s", cc.stuck_timeout_s);
-  k.read("progress_m", cc.progress_m);
+  // Each figure checked at its own key, as validate() checks it.
+  for (const DoubleKey& d : kControllerKeys) k.read(d.key, cc.*d.field, d.bound);
   k.no_other_keys();
 }
 

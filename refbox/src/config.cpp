@@ -17,6 +17,10 @@ using core::ConfigNode;
 
 namespace {
 
+// The longest phases (docs/refbox.md, "Configuration"): the refbox's own schedule.
+constexpr int kMaxSetupS = 300;
+constexpr int kMaxExplorationS = 180;
+
 /// Reports a bad field: `field` is relative to the refbox map ("production_s", "pucks[3]").
 using FailFn = std::function<void(const std::string& field, const std::string& reason)>;
 
@@ -41,8 +45,8 @@ void check_config(const RefboxConfig& c, const FailFn& fail) {
       fail(field, "must be > 0 and <= " + seconds_text(max) + " (got " + seconds_text(d) + ")");
     }
   };
-  check_duration("setup_s", c.setup_duration, SimTime::from_sec(300));
-  check_duration("exploration_s", c.exploration_duration, SimTime::from_sec(180));
+  check_duration("setup_s", c.setup_duration, SimTime::from_sec(kMaxSetupS));
+  check_duration("exploration_s", c.exploration_duration, SimTime::from_sec(kMaxExplorationS));
   check_duration("production_s", c.production_duration, SimTime::from_sec(kPlanProductionS));
   check_duration("overtime_s", c.overtime_duration, SimTime::from_sec(kOvertimeS));
   std::set<int> seen;
@@ -73,19 +77,17 @@ void check_config(const RefboxConfig& c, const FailFn& fail) {
 
 // --- YAML -------------------------------------------------------------------------------------
 
-SimTime read_seconds(const ConfigNode& n, const char* key, SimTime def) {
+/// A phase's length in seconds, checked at its key against (0, max_s] before the conversion to
+/// the game clock (1e300 s used to overflow it into a garbled figure in the message).
+SimTime read_seconds(const ConfigNode& n, const char* key, SimTime def, int max_s) {
   const ConfigNode v = n[key];
   if (!v.defined()) return def;
-  const double s = v.as_double();
-  if (!std::isfinite(s)) v.fail("must be a finite number of seconds");
+  const double s =
+      v.as_double(core::Bound{core::Bound::Kind::kOpenClosed, 0.0, static_cast<double>(max_s)});
   return SimTime::from_seconds(s);
 }
 
-int read_int(const ConfigNode& v) {
-  const std::int64_t x = v.as_int();
-  if (x < -1000000000 || x > 1000000000) v.fail("out of range");
-  return static_cast<int>(x);
-}
+int read_int(const ConfigNode& v) { return static_cast<int>(v.as_int(core::in_range(-1e9, 1e9))); }
 
 DeviceId read_device(const ConfigNode& v) {
   const std::string name = v.as_string();
@@ -197,9 +199,11 @@ RefboxConfig load_refbox_config(const ConfigNode& node) {
   }
   node.read("team", c.team);
   node.read("skip_setup", c.skip_setup);
-  c.setup_duration = read_seconds(node, "setup_s", c.setup_duration);
-  c.exploration_duration = read_seconds(node, "exploration_s", c.exploration_duration);
-  c.production_duration = read_seconds(node, "production_s", c.production_duration);
+  c.setup_duration = read_seconds(node, "setup_s", c.setup_duration, kMaxSetupS);
+  c.exploration_duration =
+      read_seconds(node, "exploration_s", c.exploration_duration, kMaxExplorationS);
+  c.production_duration =
+      read_seconds(node, "production_s", c.production_duration, kPlanProductionS);
   if (node["pucks"].defined()) {
     c.pucks.clear();
     for (const ConfigNode& e : node["pucks"].elements()) c.pucks.push_back(read_int(e));
@@ -213,7 +217,7 @@ RefboxConfig load_refbox_config(const ConfigNode& node) {
     if (!m) v.fail("must be standalone, master or slave (got '" + v.as_string() + "')");
     c.mode = *m;
   }
-  c.overtime_duration = read_seconds(node, "overtime_s", c.overtime_duration);
+  c.overtime_duration = read_seconds(node, "overtime_s", c.overtime_duration, kOvertimeS);
   if (node["params"].defined() && !node["params"].is_null()) c.params = read_params(node["params"]);
   node.no_other_keys();
   check_config(

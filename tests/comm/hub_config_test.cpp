@@ -100,9 +100,9 @@ TEST_CASE("bad input names file, line and field") {
                  "hub.yaml:3:16: loss.probability: a long-run loss of 0.9 is impossible with "
                  "mean_burst_length 2"));
   CHECK(contains(error_of("loss:\n  mean_burst_length: 0.5\n"),
-                 "hub.yaml:2:22: loss.mean_burst_length: must be >= 1"));
+                 "hub.yaml:2:22: loss.mean_burst_length: must be in [1, 1000] (got 0.5)"));
   CHECK(contains(error_of("delay:\n  fixed_ms: -1\n"),
-                 "hub.yaml:2:13: delay.fixed_ms: must be >= 0"));
+                 "hub.yaml:2:13: delay.fixed_ms: must be in [0, 60000] (got -1)"));
   CHECK(contains(error_of("links:\n  - {from: a, to: b, loss_probability: 0.5}\n"),
                  "links[0].loss_probability: is only used with loss.model per_link or burst"));
   CHECK(contains(error_of("links:\n  - {from: a, to: b, loss_probability: 0.5}\n"), "hub.yaml:2:"));
@@ -114,9 +114,40 @@ TEST_CASE("bad input names file, line and field") {
   CHECK(error_of("outages:\n  - {peer: r1, from_s: 5, until_s: 4}\n") ==
         "hub.yaml:2:36: outages[0].until_s: must be after from_s");
   CHECK(error_of("loss: {model: per_link}\nlinks:\n  - {from: a, to: b, jitter_ms: -2}\n") ==
-        "hub.yaml:3:33: links[0].jitter_ms: must be >= 0 (got -2)");
+        "hub.yaml:3:33: links[0].jitter_ms: must be in [0, 60000] (got -2)");
   CHECK(contains(error_of("max_frame_bytes: 4\n"), "hub.yaml:1:18: max_frame_bytes: must be in"));
   CHECK(contains(error_of("bogus: 1\n"), "bogus"));
+}
+
+TEST_CASE("every number has an upper bound, checked at its key before the clock conversion") {
+  // Each of these used to load (1e300 ms overflowed the clock; a burst of 1e300 copies).
+  CHECK(error_of("loss:\n  model: burst\n  mean_burst_length: 1e300\n") ==
+        "hub.yaml:3:22: loss.mean_burst_length: must be in [1, 1000] (got 1e+300)");
+  CHECK(error_of("delay:\n  fixed_ms: 1e300\n") ==
+        "hub.yaml:2:13: delay.fixed_ms: must be in [0, 60000] (got 1e+300)");
+  CHECK(error_of("delay:\n  jitter_ms: 60001\n") ==
+        "hub.yaml:2:14: delay.jitter_ms: must be in [0, 60000] (got 60001)");
+  CHECK(error_of("loss: {model: per_link}\nlinks:\n  - {from: a, to: b, fixed_ms: 1e300}\n") ==
+        "hub.yaml:3:32: links[0].fixed_ms: must be in [0, 60000] (got 1e+300)");
+  CHECK(error_of("loss: {model: per_link}\nlinks:\n  - {from: a, to: b, loss_probability: 7}\n") ==
+        "hub.yaml:3:40: links[0].loss_probability: must be in [0, 1] (got 7)");
+  CHECK(error_of("outages:\n  - {peer: r1, from_s: 0, until_s: 1e300}\n") ==
+        "hub.yaml:2:36: outages[0].until_s: must be in [0, 86400] (got 1e+300)");
+  CHECK(error_of("outages:\n  - {peer: r1, from_s: -1, until_s: 4}\n") ==
+        "hub.yaml:2:24: outages[0].from_s: must be in [0, 86400] (got -1)");
+  // The bounds themselves load.
+  const HubConfig c = parse(
+      "loss: {model: burst, probability: 0.5, mean_burst_length: 1000}\n"
+      "delay: {fixed_ms: 60000, jitter_ms: 0}\n"
+      "outages:\n  - {peer: r1, from_s: 0, until_s: 86400}\n");
+  CHECK(c.mean_burst_length == 1000.0);
+  CHECK(c.delay.fixed == SimTime::from_sec(60));
+  CHECK(c.outages.at(0).until == SimTime::from_sec(86400));
+  // validate() applies the same bounds to a config built in code.
+  HubConfig d;
+  d.mean_burst_length = 1e300;
+  CHECK_THROWS_WITH_AS(d.validate(), "loss.mean_burst_length: must be in [1, 1000] (got 1e+300)",
+                       ConfigError);
 }
 
 TEST_CASE("validate() without YAML names the field") {

@@ -287,7 +287,7 @@ TEST_CASE("validate() names the field") {
   };
   WorldConfig c = WorldConfig::default_2013();
   c.devices[2].body_width_m = -0.2;
-  CHECK(message(c) == "devices.M3.body_width_m: must be > 0 (got -0.2)");
+  CHECK(message(c) == "devices.M3.body_width_m: must be in (0, 100] (got -0.2)");
 
   c = WorldConfig::default_2013();
   c.devices[3].pose = c.devices[7].pose;
@@ -347,7 +347,57 @@ TEST_CASE("validate() names the field") {
 
   c = WorldConfig::default_2013();
   c.physics.position_iterations = 0;
-  CHECK(message(c) == "physics.position_iterations: must be >= 1 (got 0)");
+  CHECK(message(c) == "physics.position_iterations: must be in [1, 1000] (got 0)");
+
+  c = WorldConfig::default_2013();
+  c.robot.max_speed_mps = 1e300;
+  CHECK(message(c) == "robot.max_speed_mps: must be in (0, 10] (got 1e+300)");
+  c = WorldConfig::default_2013();
+  c.sensors.laser.max_range_m = 1e300;
+  CHECK(message(c) == "sensors.laser.max_range_m: must be in (0, 100] (got 1e+300)");
+}
+
+TEST_CASE("every world figure has an upper bound, reported at its key") {
+  const auto error_of = [](const std::string& text) -> std::string {
+    try {
+      load_text(text);
+    } catch (const ConfigError& e) {
+      return e.what();
+    }
+    return "(no error)";
+  };
+  // Each of these used to load (or fail far from the key).
+  CHECK(error_of("robot:\n  max_speed_mps: 1e300\n") ==
+        "test.yaml:2:18: robot.max_speed_mps: must be in (0, 10] (got 1e+300)");
+  CHECK(error_of("robot:\n  max_omega_rps: 21\n") ==
+        "test.yaml:2:18: robot.max_omega_rps: must be in (0, 20] (got 21)");
+  CHECK(error_of("robot:\n  max_accel_mps2: 1e300\n") ==
+        "test.yaml:2:19: robot.max_accel_mps2: must be in (0, 100] (got 1e+300)");
+  CHECK(error_of("robot:\n  holder: {release_backing_speed_mps: 1e300}\n") ==
+        "test.yaml:2:39: robot.holder.release_backing_speed_mps: must be in [0, 10] (got 1e+300)");
+  CHECK(error_of("sensors:\n  laser:\n    max_range_m: 1e300\n") ==
+        "test.yaml:3:18: sensors.laser.max_range_m: must be in (0, 100] (got 1e+300)");
+  CHECK(error_of("sensors:\n  laser:\n    rate_hz: 1e300\n") ==
+        "test.yaml:3:14: sensors.laser.rate_hz: must be in [0.01, 1000] (got 1e+300)");
+  CHECK(error_of("sensors:\n  laser:\n    noise_std_m: 1e300\n") ==
+        "test.yaml:3:18: sensors.laser.noise_std_m: must be in [0, 100] (got 1e+300)");
+  CHECK(error_of("sensors:\n  laser:\n    mount_x_m: -1e300\n") ==
+        "test.yaml:3:16: sensors.laser.mount_x_m: must be in [-100, 100] (got -1e+300)");
+  CHECK(error_of("sensors:\n  odometry:\n    rate_hz: 1e-300\n") ==
+        "test.yaml:3:14: sensors.odometry.rate_hz: must be in [0.01, 1000] (got 1e-300)");
+  CHECK(error_of("puck:\n  mass_kg: 1e300\n") ==
+        "test.yaml:2:12: puck.mass_kg: must be in (0, 1000] (got 1e+300)");
+  CHECK(error_of("field:\n  width_m: 1e300\n") ==
+        "test.yaml:2:12: field.width_m: must be in (0, 100] (got 1e+300)");
+  CHECK(error_of("robots:\n  - {name: r, x: 1e300, y: 1}\n") ==
+        "test.yaml:2:18: robots[0].x: must be in [-1000, 1000] (got 1e+300)");
+  CHECK(error_of("devices:\n  M1: {ori_deg: 1e300}\n") ==
+        "test.yaml:2:17: devices.M1.ori_deg: must be in [-720, 720] (got 1e+300)");
+  CHECK(error_of("physics:\n  velocity_iterations: 1000000000\n") ==
+        "test.yaml:2:24: physics.velocity_iterations: must be in [1, 1000] (got 1000000000)");
+  // The bounds themselves load.
+  CHECK(error_of("robot:\n  max_speed_mps: 10\n  max_omega_rps: 20\n"
+                 "sensors:\n  laser: {rate_hz: 1000, max_range_m: 100}\n") == "(no error)");
 }
 
 TEST_CASE("bad config files fail with file, line, field path and reason") {
@@ -401,13 +451,13 @@ TEST_CASE("bad config files fail with file, line, field path and reason") {
     const std::string m =
         load_error("size.yaml", "devices:\n  M3:\n    x: 2.8\n    body_width_m: -0.2\n", &file);
     CHECK(contains(m, file + ":4:"));
-    CHECK(contains(m, "devices.M3.body_width_m: must be > 0 (got -0.2)"));
+    CHECK(contains(m, "devices.M3.body_width_m: must be in (0, 100] (got -0.2)"));
   }
   SUBCASE("negative robot radius") {
     const std::string m =
         load_error("radius.yaml", "robot:\n  mass_kg: 20\n  radius_m: -1\n", &file);
     CHECK(contains(m, file + ":3:"));
-    CHECK(contains(m, "robot.radius_m: must be > 0 (got -1)"));
+    CHECK(contains(m, "robot.radius_m: must be in (0, 100] (got -1)"));
   }
   SUBCASE("puck outside the field") {
     const std::string m = load_error("puck_out.yaml",
@@ -471,7 +521,7 @@ TEST_CASE("bad config files fail with file, line, field path and reason") {
     const std::string m =
         load_error("beams.yaml", "sensors:\n  laser:\n    rate_hz: 5\n    beams: 0\n", &file);
     CHECK(contains(m, file + ":4:"));
-    CHECK(contains(m, "sensors.laser.beams: must be in 1..10000 (got 0)"));
+    CHECK(contains(m, "sensors.laser.beams: must be in [1, 10000] (got 0)"));
   }
   SUBCASE("both ori and ori_deg") {
     const std::string m =

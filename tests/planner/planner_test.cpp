@@ -400,7 +400,7 @@ TEST_CASE("the YAML loader reads both sections and reports bad values at their l
   CHECK(c.planner.places.extra[0].pose.theta == doctest::Approx(core::kPi / 2));
   CHECK_THROWS_WITH_AS(load_navigation_config(
                            core::ConfigNode::parse("controller:\n  max_speed_mps: -1\n", "n.yaml")),
-                       "n.yaml:2:18: controller.max_speed_mps: must be > 0 (got -1)",
+                       "n.yaml:2:18: controller.max_speed_mps: must be in (0, 10] (got -1)",
                        core::ConfigError);
   CHECK_THROWS_WITH_AS(
       load_navigation_config(core::ConfigNode::parse("planner:\n  safety_margn_m: 1\n", "n.yaml")),
@@ -415,5 +415,46 @@ TEST_CASE("the YAML loader reads both sections and reports bad values at their l
   CHECK_THROWS_WITH_AS(load_navigation_config(core::ConfigNode::parse(
                            "controller:\n  backoff_min_s: 2\n  backoff_max_s: 1\n", "n.yaml")),
                        "n.yaml:3:18: controller.backoff_max_s: must be >= backoff_min_s (got 1)",
+                       core::ConfigError);
+}
+
+TEST_CASE("every navigation figure has an upper bound, reported at its key") {
+  const auto error_of = [](const std::string& yaml) -> std::string {
+    try {
+      load_navigation_config(core::ConfigNode::parse(yaml, "n.yaml"));
+    } catch (const core::ConfigError& e) {
+      return e.what();
+    }
+    return "(no error)";
+  };
+  // Each of these used to load.
+  CHECK(error_of("controller:\n  wait_before_replan_s: 1e300\n") ==
+        "n.yaml:2:25: controller.wait_before_replan_s: must be in [0, 60] (got 1e+300)");
+  CHECK(error_of("controller:\n  max_speed_mps: 1e300\n") ==
+        "n.yaml:2:18: controller.max_speed_mps: must be in (0, 10] (got 1e+300)");
+  CHECK(error_of("controller:\n  replan_jitter_s: 61\n") ==
+        "n.yaml:2:20: controller.replan_jitter_s: must be in [0, 60] (got 61)");
+  CHECK(error_of("controller:\n  backoff_max_s: 1e300\n") ==
+        "n.yaml:2:18: controller.backoff_max_s: must be in [0, 60] (got 1e+300)");
+  CHECK(error_of("controller:\n  blocked_timeout_s: 1e300\n") ==
+        "n.yaml:2:22: controller.blocked_timeout_s: must be in (0, 3600] (got 1e+300)");
+  CHECK(error_of("controller:\n  obstacle_lookahead_m: 1e300\n") ==
+        "n.yaml:2:25: controller.obstacle_lookahead_m: must be in (0, 100] (got 1e+300)");
+  CHECK(error_of("planner:\n  rrt_range_m: 1e300\n") ==
+        "n.yaml:2:16: planner.rrt_range_m: must be in (0, 100] (got 1e+300)");
+  CHECK(error_of("planner:\n  accept_ratio: 1e300\n") ==
+        "n.yaml:2:17: planner.accept_ratio: must be in [1, 100] (got 1e+300)");
+  CHECK(error_of("planner:\n  places:\n    wait_lateral_m: -1e300\n") ==
+        "n.yaml:3:21: planner.places.wait_lateral_m: must be in [-100, 100] (got -1e+300)");
+  CHECK(error_of("planner:\n  places:\n    extra:\n      - {name: P, x: 1e300, y: 1}\n") ==
+        "n.yaml:4:22: planner.places.extra[0].x: must be in [-1000, 1000] (got 1e+300)");
+  // The bounds themselves load.
+  CHECK(error_of("controller:\n  wait_before_replan_s: 60\n  max_speed_mps: 10\n"
+                 "  blocked_timeout_s: 3600\n  backoff_max_s: 60\n") == "(no error)");
+  // validate() applies them to a config built in code.
+  ControllerConfig c;
+  c.wait_before_replan_s = 1e300;
+  CHECK_THROWS_WITH_AS(c.validate(),
+                       "controller.wait_before_replan_s: must be in [0, 60] (got 1e+300)",
                        core::ConfigError);
 }

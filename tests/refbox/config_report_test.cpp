@@ -97,9 +97,24 @@ TEST_CASE("YAML loader: values, params and file:line errors") {
 
   CHECK(load_error("rulez: x\n").find("rb.yaml:1:8: rulez: unknown key 'rulez'") == 0);
   CHECK(load_error("rules: nope\n").find("rb.yaml:1:8: rules: unknown rules variant") == 0);
-  CHECK(load_error("production_s: 0\n").find("rb.yaml:1:15: production_s: must be > 0") == 0);
+  CHECK(load_error("production_s: 0\n") ==
+        "rb.yaml:1:15: production_s: must be in (0, 900] (got 0)");
   CHECK(load_error("pucks: [1, 2, 1]\n").find("rb.yaml:1:15: pucks[2]: duplicate puck id 1") == 0);
   CHECK(load_error("production_s: fast\n").find("rb.yaml:1:15") == 0);
+  // The phase times are checked at their key before the conversion to the game clock: 1e300 s
+  // used to overflow it into "got -9223372036.854 s".
+  CHECK(load_error("exploration_s: 1e300\n") ==
+        "rb.yaml:1:16: exploration_s: must be in (0, 180] (got 1e+300)");
+  CHECK(load_error("setup_s: 301\n") == "rb.yaml:1:10: setup_s: must be in (0, 300] (got 301)");
+  CHECK(load_error("production_s: 1e19\n") ==
+        "rb.yaml:1:15: production_s: must be in (0, 900] (got 1e+19)");
+  CHECK(load_error("overtime_s: -1e300\n") ==
+        "rb.yaml:1:13: overtime_s: must be in (0, 300] (got -1e+300)");
+  CHECK(load_error("pucks: [1, 10000000000]\n") ==
+        "rb.yaml:1:12: pucks[1]: must be in [-1000000000, 1000000000] (got 10000000000)");
+  // The bounds themselves load.
+  CHECK(
+      load_error("setup_s: 300\nexploration_s: 180\nproduction_s: 900\novertime_s: 300\n").empty());
   std::string bad = kParams;
   bad.replace(bad.find("T5: RY"), 6, "T5: RX");
   CHECK(load_error(bad).find("light code letters are R, Y, G") != std::string::npos);
