@@ -116,10 +116,11 @@ TEST_CASE("the multifield budget stops create$, insert$, replace$, replace-membe
       {"mf-member", "[LLSF1] replace-member$: the result would have up to 1048576 fields"},
       {"explode", "[LLSF1] explode$: the result would have up to 16385 fields"},
   };
-  for (const auto& [rule, message] : cases) {
+  for (const auto& c : cases) {
+    const std::string rule = c.first;
     CAPTURE(rule);
     CHECK(fire(f, rule).runtime_errors == 1);
-    CHECK(f.logged(message));
+    CHECK(f.logged(c.second));
   }
 }
 

@@ -330,8 +330,9 @@ TEST_CASE("bad configurations throw ConfigError naming the field") {
         core::ConfigNode::parse("skills:\n  hot_reload: false\n  " + line + "\n", "bad.yaml");
     CHECK_THROWS_WITH_AS(lua::SkillEngineConfig::from_config(bad["skills"]),
                          doctest::Contains("bad.yaml:3:"), core::ConfigError);
+    const std::string expected = "skills." + key + ": must be in";
     CHECK_THROWS_WITH_AS(lua::SkillEngineConfig::from_config(bad["skills"]),
-                         doctest::Contains("skills." + key + ": must be in"), core::ConfigError);
+                         doctest::Contains(expected.c_str()), core::ConfigError);
   }
 
   const core::ConfigNode node = core::ConfigNode::parse(
