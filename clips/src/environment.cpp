@@ -730,16 +730,17 @@ namespace {
 
 // CLIPS' allocator calls this when malloc fails; returning would hand CLIPS a null pointer (or,
 // returning FALSE, retry forever), so the process ends here with a clear word instead of CLIPS'
-// silent exit(1). The memory budget (max_memory_bytes) is meant to stop an agent long before.
+// silent exit(1): exit code 1, the run failed (an agent's doing, not a bug of llsfsim's). The
+// memory budget (max_memory_bytes) is meant to stop an agent long before.
 int out_of_memory(void* clips_env, size_t size) {
   char text[320];
   const int n = std::snprintf(text, sizeof text,
                               "llsfsim: fatal: out of memory: CLIPS could not allocate %zu bytes "
-                              "(this agent's environment holds %ld bytes); exiting with code 3 "
-                              "(docs/clips.md, \"Budgets\")\n",
+                              "(this agent's environment holds %ld bytes); exiting with code 1: "
+                              "the run fails (docs/clips.md, \"Budgets\")\n",
                               size, EnvMemUsed(clips_env));
   if (n > 0) (void)!::write(2, text, std::min(static_cast<std::size_t>(n), sizeof text - 1));
-  std::_Exit(3);
+  std::_Exit(1);
 }
 
 }  // namespace

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // The size budgets of an agent (docs/clips.md, "Budgets"): strings, multifields, CLIPS' memory,
-// log lines, and CLIPS running out of memory for real (a clear word and exit code 3).
+// log lines, and CLIPS running out of memory for real (a clear word and exit code 1).
 #include <doctest/doctest.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -183,7 +183,7 @@ TEST_CASE("output without a newline is logged in lines of at most max_string_len
   CHECK(lines == 3);
 }
 
-TEST_CASE("CLIPS out of memory for real: a clear message and exit code 3") {
+TEST_CASE("CLIPS out of memory for real: a clear message and exit code 1") {
   // In a child process with a small address space and the budgets lifted; stderr into a pipe.
   int pipe_fds[2];
   REQUIRE(::pipe(pipe_fds) == 0);
@@ -222,9 +222,9 @@ TEST_CASE("CLIPS out of memory for real: a clear message and exit code 3") {
   int status = 0;
   REQUIRE(::waitpid(pid, &status, 0) == pid);
   REQUIRE(WIFEXITED(status));
-  CHECK(WEXITSTATUS(status) == 3);
+  CHECK(WEXITSTATUS(status) == 1);
   CHECK(err.find("llsfsim: fatal: out of memory: CLIPS could not allocate ") == 0);
-  CHECK(err.find("exiting with code 3") != std::string::npos);
+  CHECK(err.find("exiting with code 1: the run fails") != std::string::npos);
 }
 
 TEST_CASE("printout to a logical name no router takes reports it once, as CLIPS does") {
