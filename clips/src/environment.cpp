@@ -427,6 +427,7 @@ struct Environment::SizeGuard {
     kFields,         // create$, insert$, replace$, mv-append, mv-replace: the fields of all args
     kExplode,        // explode$, str-explode: at most one field per two characters
     kReplaceMember,  // replace-member$: each field may become the whole replacement
+    kCompare,        // subsetp, member$, delete-member$: fields of the first x fields of the rest
   };
   struct Builder {
     Environment* self;
@@ -439,14 +440,20 @@ struct Environment::SizeGuard {
   std::deque<Builder> builders;  // stable addresses: the definitions' contexts point at them
 
   static constexpr std::pair<const char*, Kind> kFunctions[] = {
-      {"str-cat", Kind::kConcat},      {"sym-cat", Kind::kConcat},
-      {"implode$", Kind::kImplode},    {"str-implode", Kind::kImplode},
-      {"format", Kind::kFormat},       {"printout", Kind::kPrint},
-      {"create$", Kind::kFields},      {"mv-append", Kind::kFields},
-      {"insert$", Kind::kFields},      {"replace$", Kind::kFields},
-      {"mv-replace", Kind::kFields},   {"explode$", Kind::kExplode},
-      {"str-explode", Kind::kExplode}, {"replace-member$", Kind::kReplaceMember},
+      {"str-cat", Kind::kConcat},         {"sym-cat", Kind::kConcat},
+      {"implode$", Kind::kImplode},       {"str-implode", Kind::kImplode},
+      {"format", Kind::kFormat},          {"printout", Kind::kPrint},
+      {"create$", Kind::kFields},         {"mv-append", Kind::kFields},
+      {"insert$", Kind::kFields},         {"replace$", Kind::kFields},
+      {"mv-replace", Kind::kFields},      {"explode$", Kind::kExplode},
+      {"str-explode", Kind::kExplode},    {"replace-member$", Kind::kReplaceMember},
+      {"subsetp", Kind::kCompare},        {"member$", Kind::kCompare},
+      {"delete-member$", Kind::kCompare},
   };
+  // Field comparisons one kCompare call may make, per field of the multifield budget: with the
+  // default budget 10^8 comparisons (well under a second); subsetp of two 1,000,000-field
+  // multifields (10^12) ran for many minutes inside one call, where no step is counted.
+  static constexpr std::int64_t kComparesPerField = 100;
 
   void install(Environment& self, void* clips_env) {
     for (const auto& [name, kind] : kFunctions) guard(self, clips_env, name, kind);
@@ -459,6 +466,9 @@ struct Environment::SizeGuard {
     switch (fd->returnValueType) {
       case 'v':
         evaluator = reinterpret_cast<int (*)(void)>(reinterpret_cast<void (*)()>(&call_print));
+        break;
+      case 'b':
+        evaluator = reinterpret_cast<int (*)(void)>(reinterpret_cast<void (*)()>(&call_bool));
         break;
       case 's':
       case 'w':
@@ -533,7 +543,7 @@ struct Environment::SizeGuard {
   // The result's size in characters (`chars`) or fields; false if it is past a budget (then the
   // error has been reported).
   static bool within_budget(const Builder& b, void* clips_env, const DATA_OBJECT* args, int n) {
-    std::int64_t chars = -1, count = -1;
+    std::int64_t chars = -1, count = -1, compares = -1;
     switch (b.kind) {
       case Kind::kConcat:
       case Kind::kPrint:  // (call_print checks its own sum)
@@ -560,11 +570,23 @@ struct Environment::SizeGuard {
       case Kind::kReplaceMember:
         count = n >= 2 ? fields(args[0]) * std::max<std::int64_t>(1, fields(args[1])) : 0;
         break;
+      case Kind::kCompare: {
+        std::int64_t rest = 0;
+        for (int i = 1; i < n; ++i) rest += fields(args[i]);
+        compares = n >= 1 ? fields(args[0]) * rest : 0;
+        break;
+      }
     }
     Environment& self = *b.self;
     const SizeLimits& limits = self.limits_;
     std::string why;
-    if (chars >= 0 && limits.string_length > 0 && chars > limits.string_length) {
+    if (compares >= 0) {
+      const std::int64_t max = limits.multifield_length * kComparesPerField;
+      if (limits.multifield_length > 0 && compares > max)
+        why = "up to " + std::to_string(compares) + " field comparisons, more than " +
+              std::to_string(max) + " (" + std::to_string(kComparesPerField) +
+              " x max_multifield_length)";
+    } else if (chars >= 0 && limits.string_length > 0 && chars > limits.string_length) {
       why = (b.kind == Kind::kPrint ? "would print up to " : "the result would have up to ") +
             std::to_string(chars) + " characters, more than the string budget of " +
             std::to_string(limits.string_length) + " (max_string_length)";
@@ -713,6 +735,14 @@ struct Environment::SizeGuard {
           reinterpret_cast<void* (*)(void*)>(reinterpret_cast<void (*)()>(b->original))(clips_env);
     });
     return called ? result : EnvAddSymbol(clips_env, "");
+  }
+  static int call_bool(void* clips_env) {
+    int result = FALSE;
+    const bool called = guarded(clips_env, [clips_env, &result](Builder* b) {
+      result =
+          reinterpret_cast<int (*)(void*)>(reinterpret_cast<void (*)()>(b->original))(clips_env);
+    });
+    return called ? result : FALSE;
   }
   static void call_value(void* clips_env, DATA_OBJECT* rv) {
     const bool called = guarded(clips_env, [clips_env, rv](Builder* b) {

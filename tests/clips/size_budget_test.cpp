@@ -240,3 +240,32 @@ TEST_CASE("printout to a logical name no router takes reports it once, as CLIPS 
   CHECK(reports == 1);
   CHECK(f.logged("runtime error in rule badname (name.clp:1): [ROUTER1] Logical name nosuch"));
 }
+
+TEST_CASE("subsetp, member$ and delete-member$ are bounded in their comparisons") {
+  // 2,000 x 2,000 fields = 4,000,000 comparisons, more than 100 x the multifield budget of 10,000;
+  // with 1,000,000-field multifields (10^12 comparisons) one call ran for many minutes.
+  AgentFixture f(small_budgets());
+  f.load(
+      "(deffunction seq (?n) (bind ?r (create$))\n"
+      "  (loop-for-count (?i 1 ?n) (bind ?r (create$ ?r ?i))) ?r)\n"
+      "(defrule subset-big (go subset-big) => (subsetp (seq 2000) (seq 2000)))\n"
+      "(defrule member-big (go member-big) => (member$ (seq 2000) (seq 2000)))\n"
+      "(defrule delete-big (go delete-big) => (delete-member$ (seq 2000) (seq 1000) (seq 1000)))\n"
+      "(defrule small (go small) =>\n"
+      "  (printout t (subsetp (seq 500) (seq 600)) \" \" (member$ 7 (seq 900)) \" \"\n"
+      "    (length$ (delete-member$ (seq 900) (seq 100))) crlf))\n",
+      "compare.clp");
+  f.step();
+  CHECK(fire(f, "subset-big").runtime_errors == 1);
+  CHECK(
+      f.logged("runtime error in rule subset-big (compare.clp:3): [LLSF1] subsetp: up to "
+               "4000000 field comparisons, more than 1000000 (100 x max_multifield_length); the "
+               "game goes on"));
+  CHECK(fire(f, "member-big").runtime_errors == 1);
+  CHECK(f.logged("[LLSF1] member$: up to 4000000 field comparisons"));
+  CHECK(fire(f, "delete-big").runtime_errors == 1);
+  CHECK(f.logged("[LLSF1] delete-member$: up to 4000000 field comparisons"));
+  // Within the bound: CLIPS' own results.
+  CHECK(fire(f, "small").runtime_errors == 0);
+  CHECK(f.logged("TRUE 7 800"));
+}
