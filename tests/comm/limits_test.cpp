@@ -14,12 +14,14 @@
 #include <string>
 #include <vector>
 
+#include "comm/loopback.h"
 #include "llsf/comm/socket_config.h"
 #include "llsf/comm/stream.h"
 #include "llsf/comm/udp_hub.h"
 #include "llsf/core/error.h"
 
 using namespace llsf::comm;
+using namespace llsf::comm::test;
 namespace asio = boost::asio;
 using asio::ip::tcp;
 using asio::ip::udp;
@@ -27,44 +29,6 @@ using Clock = std::chrono::steady_clock;
 using std::chrono::milliseconds;
 
 namespace {
-
-const auto kLoopback = asio::ip::make_address("127.0.0.1");
-
-MessageRegistry registry() {
-  MessageRegistry r;
-  add_agent_messages(r);
-  return r;
-}
-
-llsf_agent_msgs::LockMessage lock(int n) {
-  llsf_agent_msgs::LockMessage m;
-  m.set_type(llsf_agent_msgs::LockMessage::GET);
-  m.set_agent("R1");
-  m.set_resource("M" + std::to_string(n));
-  return m;
-}
-
-struct UdpEndpoint {
-  explicit UdpEndpoint(asio::io_context& io) : socket(io, udp::endpoint(kLoopback, 0)) {
-    socket.non_blocking(true);
-  }
-  void send(const std::vector<std::uint8_t>& bytes, int to_port) {
-    socket.send_to(asio::buffer(bytes),
-                   udp::endpoint(kLoopback, static_cast<unsigned short>(to_port)));
-  }
-  int received() {
-    int n = 0;
-    for (;;) {
-      std::array<std::uint8_t, 2048> buf{};
-      udp::endpoint from;
-      boost::system::error_code ec;
-      socket.receive_from(asio::buffer(buf), from, 0, ec);
-      if (ec) return n;
-      ++n;
-    }
-  }
-  udp::socket socket;
-};
 
 std::string socket_config_error(const std::string& yaml) {
   try {
@@ -96,7 +60,7 @@ bool closed_by_peer(tcp::socket& s, Pump pump, milliseconds wait) {
 TEST_CASE("UDP: a malformed datagram from another port does not steal a peer's return address") {
   const MessageRegistry reg = registry();
   asio::io_context io;
-  UdpEndpoint robot(io), refbox(io), attacker(io);
+  Endpoint robot(io), refbox(io), attacker(io);
   HubConfig cfg;
   cfg.delay.fixed = SimTime::from_ms(0);
   UdpHub hub(cfg, reg, llsf::core::Rng(1));
@@ -110,7 +74,7 @@ TEST_CASE("UDP: a malformed datagram from another port does not steal a peer's r
   refbox.send(reg.encode(lock(2)), hub.listen_port(pb));
   while (to_robot.delivered < 1 && Clock::now() < deadline) hub.run_for(milliseconds(2));
   REQUIRE(to_robot.delivered == 1);
-  CHECK(robot.received() == 1);
+  CHECK(static_cast<int>(robot.drain().size()) == 1);
 
   // The attacker sends 3 bytes (and a frame of an unknown type) to the robot's hub port.
   attacker.send({1, 2, 3}, hub.listen_port(pr));
@@ -126,10 +90,10 @@ TEST_CASE("UDP: a malformed datagram from another port does not steal a peer's r
   int at_robot = 0;
   while (at_robot == 0 && Clock::now() < deadline) {
     hub.run_for(milliseconds(2));
-    at_robot += robot.received();
+    at_robot += static_cast<int>(robot.drain().size());
   }
   CHECK(at_robot == 1);
-  CHECK(attacker.received() == 0);
+  CHECK(static_cast<int>(attacker.drain().size()) == 0);
   CHECK(to_robot.delivered == 2);
 }
 

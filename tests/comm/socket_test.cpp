@@ -15,64 +15,17 @@
 #include <cmath>
 #include <set>
 
+#include "comm/loopback.h"
 #include "llsf/comm/stream.h"
 #include "llsf/comm/udp_hub.h"
 
 using namespace llsf::comm;
+using namespace llsf::comm::test;
 namespace asio = boost::asio;
 using asio::ip::tcp;
 using asio::ip::udp;
 using Clock = std::chrono::steady_clock;
 using std::chrono::milliseconds;
-
-namespace {
-
-const auto kLoopback = asio::ip::make_address("127.0.0.1");
-
-MessageRegistry registry() {
-  MessageRegistry r;
-  add_agent_messages(r);
-  return r;
-}
-
-llsf_agent_msgs::LockMessage lock(int n) {
-  llsf_agent_msgs::LockMessage m;
-  m.set_type(llsf_agent_msgs::LockMessage::GET);
-  m.set_agent("R1");
-  std::string resource = "M";
-  resource += std::to_string(n);
-  m.set_resource(resource);
-  return m;
-}
-
-/// An external program's UDP socket on 127.0.0.1 (non-blocking receive).
-struct Endpoint {
-  explicit Endpoint(asio::io_context& io) : socket(io, udp::endpoint(kLoopback, 0)) {
-    socket.non_blocking(true);
-  }
-  int port() const { return socket.local_endpoint().port(); }
-  void send(const std::vector<std::uint8_t>& frame, int to_port) {
-    socket.send_to(asio::buffer(frame),
-                   udp::endpoint(kLoopback, static_cast<unsigned short>(to_port)));
-  }
-  /// All datagrams waiting now.
-  std::vector<std::vector<std::uint8_t>> drain() {
-    std::vector<std::vector<std::uint8_t>> out;
-    for (;;) {
-      std::vector<std::uint8_t> buf(2048);
-      udp::endpoint from;
-      boost::system::error_code ec;
-      const std::size_t n = socket.receive_from(asio::buffer(buf), from, 0, ec);
-      if (ec) break;
-      buf.resize(n);
-      out.push_back(std::move(buf));
-    }
-    return out;
-  }
-  udp::socket socket;
-};
-
-}  // namespace
 
 TEST_CASE("UDP: round trip through the hub on 127.0.0.1 with 50 % loss") {
   const MessageRegistry reg = registry();
