@@ -139,6 +139,10 @@ class Environment {
 
   /// Looks up a deftemplate; throws std::logic_error if it does not exist.
   Template find_template(const std::string& name);
+  /// The implied (ordered) deftemplate `name`, created as a fact or pattern `(name ...)` would
+  /// create it if no construct has yet; throws std::logic_error if `name` is a deftemplate with
+  /// slots.
+  Template implied_template(const std::string& name);
   /// Asserts a fact of `t` with `values` in slot order (kVoid keeps the slot's default); for an
   /// ordered template, `values` are the fields. The handle keeps the fact for retract().
   FactHandle assert_fact(const Template& t, std::span<const Value> values);

@@ -67,8 +67,17 @@ LockManager::LockManager(std::string agent, LockConfig config, std::uint64_t see
 
 LockManager::Own& LockManager::own(std::string_view resource) {
   auto it = own_.find(resource);
-  if (it == own_.end()) it = own_.emplace(std::string(resource), Own{}).first;
+  if (it == own_.end()) {
+    it = own_.emplace(std::string(resource), Own{}).first;
+    ++states_version_;
+  }
   return it->second;
+}
+
+void LockManager::set_state(Own& o, LockState state) {
+  if (o.state == state) return;
+  o.state = state;
+  ++states_version_;
 }
 
 SimTime LockManager::draw_backoff() {
@@ -85,7 +94,7 @@ void LockManager::request(std::string_view resource) {
       return;  // idempotent
     case LockState::kReleasing:
       if (!o.release_sent) {  // still here and still ours: take it back
-        o.state = LockState::kAccepted;
+        set_state(o, LockState::kAccepted);
         o.release_pose.reset();
         return;
       }
@@ -97,7 +106,7 @@ void LockManager::request(std::string_view resource) {
   // A new request. Its GET waits 2 max_delay after our last RELEASE of the resource: by then
   // every RELEASE of ours has reached the master, and every confirmation the master sent before
   // it processed our RELEASE has arrived here (and been ignored).
-  o.state = LockState::kRequested;
+  set_state(o, LockState::kRequested);
   o.get_sent = false;
   o.was_held = false;
   o.last_get.reset();
@@ -114,17 +123,17 @@ void LockManager::release(std::string_view resource) {
   Own& o = it->second;
   switch (o.state) {
     case LockState::kAccepted:
-      o.state = LockState::kReleasing;
+      set_state(o, LockState::kReleasing);
       o.release_sent = false;
       o.release_pose = pose_;  // the RELEASE waits until we are release_distance_m away
       return;
     case LockState::kRefused:
     case LockState::kRequested:
       if (!o.get_sent) {  // nobody heard of it
-        o.state = LockState::kNone;
+        set_state(o, LockState::kNone);
         return;
       }
-      o.state = LockState::kReleasing;
+      set_state(o, LockState::kReleasing);
       o.release_sent = false;
       // Held once (a lost lease): the robot may still be at the resource.
       o.release_pose = o.was_held ? pose_ : std::nullopt;
@@ -179,7 +188,7 @@ void LockManager::confirm_own(std::string_view resource, SimTime at) {
   switch (o.state) {
     case LockState::kRequested:
       if (!o.get_sent) return;  // may be older than our request: ignore
-      o.state = LockState::kAccepted;
+      set_state(o, LockState::kAccepted);
       o.was_held = true;
       o.confirmed_at = at;
       ++stats_.accepted;
@@ -251,7 +260,7 @@ bool LockManager::receive(const google::protobuf::Message& message, std::string_
           Own& o = own(m->resource());
           // While ACCEPTED a REFUSE is stale (the lease decides); while REQUESTED it answers.
           if (o.state == LockState::kRequested && o.get_sent) {
-            o.state = LockState::kRefused;
+            set_state(o, LockState::kRefused);
             ++stats_.refused;
           }
         }
@@ -261,7 +270,7 @@ bool LockManager::receive(const google::protobuf::Message& message, std::string_
           Own& o = own(m->resource());
           o.stray = false;
           if (o.state == LockState::kReleasing && o.release_sent) {
-            o.state = LockState::kNone;
+            set_state(o, LockState::kNone);
             ++stats_.released;
           }
         }
@@ -444,12 +453,12 @@ void LockManager::run_own(SimTime now, Out& out) {
           if ((holder != table_.end() && holder->second == agent_) ||
               (holder == table_.end() && may_grant(r, agent_, now))) {
             table_[r] = agent_;
-            o.state = LockState::kAccepted;
+            set_state(o, LockState::kAccepted);
             o.was_held = true;
             o.confirmed_at = now;
             ++stats_.accepted;
           } else {
-            o.state = LockState::kRefused;
+            set_state(o, LockState::kRefused);
             ++stats_.refused;
           }
         } else if (now >= o.get_not_before && resend_due(o.last_get)) {
@@ -486,7 +495,7 @@ void LockManager::run_own(SimTime now, Out& out) {
           if (holder != table_.end() && holder->second == agent_) table_.erase(holder);
           auto lc = last_confirm_.find(r);
           if (lc != last_confirm_.end() && lc->second.agent == agent_) last_confirm_.erase(lc);
-          o.state = LockState::kNone;
+          set_state(o, LockState::kNone);
           o.release_sent = false;
           ++stats_.released;
         } else if (!o.release_sent || resend_due(o.last_release)) {
@@ -522,7 +531,7 @@ Out LockManager::step(SimTime now) {
   // Leases: ACCEPTED only while confirmed within the lease.
   for (auto& [r, o] : own_) {
     if (o.state == LockState::kAccepted && now >= o.confirmed_at + config_.lease) {
-      o.state = LockState::kRefused;
+      set_state(o, LockState::kRefused);
       ++stats_.lease_expired;
     }
   }

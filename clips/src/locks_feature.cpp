@@ -11,6 +11,7 @@
 // manager steps and its messages are broadcast, and the facts follow the manager's states. After
 // the run the manager steps again (same time) to send what the rules asked for at once.
 #include <map>
+#include <optional>
 
 #include "feature.h"
 #include "llsf/clips/lock_manager.h"
@@ -79,6 +80,7 @@ class LocksFeature final : public Feature {
       env.release(sh.refuse);
     }
     shown_.clear();
+    synced_version_.reset();
     env.release(role_fact_);
     if (!s_.config.locks) return;
     mgr_.emplace(s_.config.robot_name, s_.config.lock_config,
@@ -161,6 +163,9 @@ class LocksFeature final : public Feature {
   // until the next request, RELEASE_RVCD when a release is done.
   void sync(Environment& env) {
     set_role(env);
+    // Nothing new since the last walk (most cycles): the facts already show every state.
+    if (synced_version_ && *synced_version_ == mgr_->states_version()) return;
+    synced_version_ = mgr_->states_version();
     // One sorted walk over the manager's resources and shown_ (both ordered by name): shown_
     // gains every resource with a state, and each entry is updated in name order, as a look-up
     // per entry would.
@@ -210,6 +215,7 @@ class LocksFeature final : public Feature {
   Template lock_, role_;
   FactHandle role_fact_;
   bool role_master_ = false;
+  std::optional<std::uint64_t> synced_version_;  // the manager's states_version() shown
   std::map<std::string, Shown, std::less<>> shown_;
 };
 

@@ -54,18 +54,22 @@ class TimeFeature final : public Feature {
     });
   }
 
-  void bind(Environment& env) override { time_ = env.find_template("time"); }
+  // (time sec usec) is an ordered fact: its template is the implied one.
+  void bind(Environment& env) override { time_ = env.implied_template("time"); }
 
   void after_reset(Environment& env) override { env.release(fact_); }
 
   void before_run(Environment& env) override {
-    // Normally the time-retract rule removed last cycle's fact; not if the run was cut short.
-    env.retract(fact_);
+    env.retract(fact_);  // (after_run removed it already unless the cycle was cut short)
     const std::int64_t ns = s_.now.ns();
     values_[0].integer = ns / kNsPerSec;
     values_[1].integer = (ns % kNsPerSec) / 1000;
     fact_ = env.assert_fact(time_, values_);
   }
+
+  // The cycle's time fact goes when its rules have run (as Fawkes' time-retract rule at salience
+  // -10000 did, without a rule firing and its activation in every cycle).
+  void after_run(Environment& env) override { env.retract(fact_); }
 
  private:
   static bool read_times(Args& a, double& t1, double& t2) {

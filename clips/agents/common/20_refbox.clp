@@ -46,7 +46,8 @@
   =>
   (retract ?pf)
   (foreach ?n (pb-field-list ?p "reported_machines")
-    (do-for-fact ((?m machine)) (and (eq ?m:name (sym-cat ?n)) (eq ?m:explored FALSE))
+    (bind ?m (fact-by-slot machine name (sym-cat ?n)))
+    (if (and ?m (eq (fact-slot-value ?m explored) FALSE)) then
       (modify ?m (explored TRUE))))
 )
 
@@ -60,7 +61,8 @@
       (bind ?type (sym-cat (pb-field-value ?e "type")))
       (bind ?name (sym-cat (pb-field-value ?e "name")))
       (if (member$ ?type (create$ T1 T2 T3 T4 T5)) then
-        (do-for-fact ((?m machine)) (and (eq ?m:name ?name) (neq ?m:mtype ?type))
+        (bind ?m (fact-by-slot machine name ?name))
+        (if (and ?m (neq (fact-slot-value ?m mtype) ?type)) then
           (modify ?m (mtype ?type))))))
 )
 
@@ -76,9 +78,10 @@
     (bind ?del (pb-field-value ?o "quantity_delivered"))
     (bind ?b (pb-field-value ?o "delivery_period_begin"))
     (bind ?e (pb-field-value ?o "delivery_period_end"))
-    (if (any-factp ((?x order)) (eq ?x:id ?id))
+    (bind ?x (fact-by-slot order id ?id))
+    (if ?x
      then
-      (do-for-fact ((?x order)) (and (eq ?x:id ?id) (neq ?x:delivered ?del))
+      (if (neq (fact-slot-value ?x delivered) ?del) then
         (modify ?x (delivered ?del)))
      else
       (assert (order (id ?id) (product ?product) (requested ?req) (delivered ?del)

@@ -18,11 +18,11 @@
   =>
   (modify ?t (time ?now) (seq (+ ?seq 1)))
   (bind ?wm (pb-create "llsf_agent_msgs.Worldmodel"))
-  (pb-set-field ?wm "sender" (str-cat ?*ROBOT-NAME*))
+  (pb-set-field ?wm "sender" ?*ROBOT-NAME*)   ; (a symbol or string fills a string field)
   (pb-set-field ?wm "seq" (+ ?seq 1))
   (do-for-all-facts ((?m machine)) (> ?m:updated-at 0.0)
     (bind ?ms (pb-create "llsf_agent_msgs.MachineState"))
-    (pb-set-field ?ms "name" (str-cat ?m:name))
+    (pb-set-field ?ms "name" ?m:name)
     (foreach ?l ?m:loaded-with (pb-add-list ?ms "loaded_with" ?l))
     (pb-set-field ?ms "junk" ?m:consumed)
     (pb-set-field ?ms "out_of_order_until" ?m:down-until)
@@ -39,9 +39,10 @@
   =>
   (retract ?pf)
   (foreach ?ms (pb-field-list ?p "machines")
-    (bind ?name (sym-cat (pb-field-value ?ms "name")))
+    ; (fact-by-slot: the machine fact by its name, without a do-for-fact over all machines)
+    (bind ?m (fact-by-slot machine name (sym-cat (pb-field-value ?ms "name"))))
     (bind ?at (pb-field-value ?ms "updated_at"))
-    (do-for-fact ((?m machine)) (and (eq ?m:name ?name) (> ?at ?m:updated-at))
+    (if (and ?m (> ?at (fact-slot-value ?m updated-at))) then
       (modify ?m (loaded-with (pb-field-list ?ms "loaded_with"))
                  (consumed (pb-field-value ?ms "junk"))
                  (down-until (pb-field-value ?ms "out_of_order_until"))

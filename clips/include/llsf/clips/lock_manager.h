@@ -123,6 +123,9 @@ class LockManager {
   void for_each_state(F&& f) const {
     for (const auto& [r, o] : own_) f(r, o.state);
   }
+  /// Changes whenever for_each_state() would show something new (a state changed or a resource
+  /// was added): a caller that showed the states at one version need not walk them again.
+  std::uint64_t states_version() const { return states_version_; }
   /// True while this robot claims mastership (announces itself).
   bool is_master() const { return endorsee_ == agent_; }
   /// True while this robot is master with a majority's endorsement (it may confirm locks).
@@ -161,6 +164,7 @@ class LockManager {
   };
 
   Own& own(std::string_view resource);
+  void set_state(Own& o, LockState state);  ///< (every change of a state goes through here)
   void advance(core::SimTime t);
   void step_down(core::SimTime t);
   void update_election(core::SimTime now);
@@ -183,6 +187,7 @@ class LockManager {
   bool started_ = false;
 
   std::map<std::string, Own, std::less<>> own_;
+  std::uint64_t states_version_ = 0;  ///< states_version()
 
   // Election: whom we endorse, our promise, who announced themselves.
   std::string endorsee_;
