@@ -238,8 +238,12 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
       played.game.external_peers = sockets->external_peers();
       played.game.validate();
     } catch (const core::UserError& e) {
+      // The game names its external peers by the sockets file's udp_peers, in the same order.
+      std::string what = e.what();
+      const std::string field = "game.external_peers[";
+      if (what.starts_with(field)) what = "udp_peers[" + what.substr(field.size());
       err << "llsfsim run: --refbox-sockets"
-          << (o.sockets_file.empty() ? std::string() : " " + o.sockets_file) << ": " << e.what()
+          << (o.sockets_file.empty() ? std::string() : " " + o.sockets_file) << ": " << what
           << "\n";
       return kExitBadInput;
     }
@@ -583,7 +587,8 @@ Action add_run_command(CLI::App& app) {
       "seed of a scenario file's content) and writes a recording of it.\n"
       "Exit code: 0 all test cases passed, 1 one failed (or, with --strict, an agent made a "
       "mistake), 2 bad input (scenario, agent, skill "
-      "file, a path that cannot be written), 3 internal error (a bug: please report it).");
+      "file, a path that cannot be written, a --refbox-sockets file or a port that cannot be "
+      "bound), 3 internal error (a bug: please report it).");
   return [o, sockets_opt](std::ostream& out, std::ostream& err) {
     o->refbox_sockets = sockets_opt->count() > 0;
     if (o->refbox_sockets && o->live.speed <= 0.0) o->live.realtime = true;

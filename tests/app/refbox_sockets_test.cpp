@@ -169,7 +169,7 @@ TEST_CASE("run --refbox-sockets: bad socket configs are refused before the game"
   SUBCASE("a peer named like a robot") {
     const Run r = run_with("stream: {port: 0}\nudp_peers:\n  - {name: robot1}\n");
     CHECK(r.code == llsf::app::kExitBadInput);
-    CHECK(has(r.err, "'robot1' is the name of another radio peer"));
+    CHECK(has(r.err, "udp_peers[0].name: 'robot1' is the name of another radio peer"));
   }
   SUBCASE("a port that is taken") {
     boost::asio::io_context io;
