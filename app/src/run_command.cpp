@@ -26,6 +26,8 @@
 #include "live.h"
 #include "llsf/app/cli.h"
 #include "llsf/clips/agent.h"
+#include "llsf/comm/socket_config.h"
+#include "llsf/core/config.h"
 #include "llsf/core/error.h"
 #include "llsf/core/input_file.h"
 #include "llsf/core/text.h"
@@ -35,6 +37,7 @@
 #include "llsf/study/runner.h"
 #include "llsf/study/scenario.h"
 #include "llsf/study/stats_store.h"
+#include "refbox_sockets.h"
 #include "server.h"
 
 namespace llsf::app {
@@ -57,6 +60,8 @@ struct RunOptions {
   std::string trace_file;          ///< "" = stderr
   bool no_record_agents = false;   ///< no facts/fact/rules lines in the recording
   LiveOptions live;                ///< --speed, --realtime, --serve, --port, --serve-exit
+  bool refbox_sockets = false;     ///< --refbox-sockets given
+  std::string sockets_file;        ///< its SOCKETS.yaml ("" = the defaults)
 };
 
 /// Why a file cannot be created or replaced at `path` ("" if it can): checked before a game, so
@@ -215,6 +220,34 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
       return kExitBadInput;
     }
   }
+  // --refbox-sockets: the config read and every socket bound before anything is played or
+  // written; the UDP peers become radio peers of the game.
+  std::unique_ptr<RefboxSockets> sockets;
+  study::Scenario played = *s;
+  played.strict = played.strict || o.strict;
+  if (o.refbox_sockets) {
+    try {
+      comm::SocketConfig sc;
+      if (!o.sockets_file.empty()) {
+        sc = comm::load_socket_config(core::ConfigNode::load_file(o.sockets_file));
+      }
+      sockets = std::make_unique<RefboxSockets>(sc, [&err](std::string_view line) {
+        err << "llsfsim run: " << line << "\n";
+        err.flush();
+      });
+      played.game.external_peers = sockets->external_peers();
+      played.game.validate();
+    } catch (const core::UserError& e) {
+      // The game names its external peers by the sockets file's udp_peers, in the same order.
+      std::string what = e.what();
+      const std::string field = "game.external_peers[";
+      if (what.starts_with(field)) what = "udp_peers[" + what.substr(field.size());
+      err << "llsfsim run: --refbox-sockets"
+          << (o.sockets_file.empty() ? std::string() : " " + o.sockets_file) << ": " << what
+          << "\n";
+      return kExitBadInput;
+    }
+  }
   study::RunHooks hooks;
   // --trace: checked before anything is played or written.
   std::unique_ptr<std::ofstream> trace_file;
@@ -259,9 +292,20 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
   // Paced mode: sleep between ticks so that game time runs `speed` times as fast as the wall
   // clock (the wall clock only paces; it never enters the game).
   if (o.live.pace() > 0.0) {
-    hooks.tick = [pacer = Pacer(o.live.pace())](const sim::Game& g) {
-      pacer.wait(g.time().seconds());
-    };
+    if (sockets) {
+      // Served: the tick's messages go out, then the pause, then what arrived goes in (for the
+      // next tick). Socket I/O happens only here, between ticks, on the game's thread.
+      hooks.attach = [&sockets](sim::Game& g) { sockets->attach(g); };
+      hooks.tick = [pacer = Pacer(o.live.pace()), &sockets](const sim::Game& g) {
+        sockets->send_tick();
+        pacer.wait(g.time().seconds());
+        sockets->receive();
+      };
+    } else {
+      hooks.tick = [pacer = Pacer(o.live.pace())](const sim::Game& g) {
+        pacer.wait(g.time().seconds());
+      };
+    }
     // Live editing: changed CLIPS files are reloaded (docs/llsfsim.md, "Editing while it plays").
     hooks.reload_agents = !o.no_reload;
     hooks.note = [&err](core::SimTime t, const std::string& robot, const std::string& text) {
@@ -283,6 +327,12 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
     return kExitBadInput;
   }
   if (server) hooks.record_sink = [&feed](std::string_view line) { feed.publish(line); };
+  if (sockets) {
+    for (const std::string& line : sockets->describe()) {
+      note << "llsfsim run: refbox sockets: " << line << "\n";
+    }
+    note.flush();
+  }
   // (No progress line between trace lines on stderr.)
   const bool tty = isatty(STDERR_FILENO) != 0 && !o.quiet && !o.json &&
                    (hooks.trace.empty() || trace_file != nullptr);
@@ -297,8 +347,6 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
   }
   study::RunResult r;
   try {
-    study::Scenario played = *s;
-    played.strict = played.strict || o.strict;
     r = study::run_game(played, seed, hooks);
   } catch (const clips::AgentLoadError& e) {
     err << "llsfsim run: agent error:\n" << e.what() << "\n";
@@ -525,14 +573,27 @@ Action add_run_command(CLI::App& app) {
   add_live_options(app, o->live,
                    "Serve the browser viewer with this game live (like `llsfsim serve`; best with "
                    "--speed or --realtime)");
+  auto* sockets_opt =
+      app.add_option("--refbox-sockets", o->sockets_file,
+                     "Serve the simulated refbox on sockets as the 2013 refbox does: controllers "
+                     "(llsf-refbox-shell, ...) on TCP 127.0.0.1:4444, UDP peers as in SOCKETS.yaml "
+                     "(docs/refbox-protocol.md, \"Attaching 2013 tools\"); times on the wire are "
+                     "Unix time. Paced: implies --realtime unless --speed is given")
+          ->type_name("[SOCKETS.yaml]")
+          ->expected(0, 1);
   app.footer(
       "Plays one game headless and prints a summary and the test-case verdicts; stores the run "
       "in the statistics store (--db, default llsfsim.db; the latest game of each variant and "
       "seed of a scenario file's content) and writes a recording of it.\n"
       "Exit code: 0 all test cases passed, 1 one failed (or, with --strict, an agent made a "
       "mistake), 2 bad input (scenario, agent, skill "
-      "file, a path that cannot be written), 3 internal error (a bug: please report it).");
-  return [o](std::ostream& out, std::ostream& err) { return run(*o, out, err); };
+      "file, a path that cannot be written, a --refbox-sockets file or a port that cannot be "
+      "bound), 3 internal error (a bug: please report it).");
+  return [o, sockets_opt](std::ostream& out, std::ostream& err) {
+    o->refbox_sockets = sockets_opt->count() > 0;
+    if (o->refbox_sockets && o->live.speed <= 0.0) o->live.realtime = true;
+    return run(*o, out, err);
+  };
 }
 
 Action add_check_command(CLI::App& app) {

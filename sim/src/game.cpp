@@ -136,6 +136,7 @@ Game::Game(GameConfig config)
   std::vector<std::string> names;
   names.emplace_back(kRefboxPeer);
   for (const auto& r : config_.world.robots) names.push_back(r.name);
+  for (const ExternalPeerConfig& e : config_.external_peers) names.push_back(e.name);
   config_.hub.validate_peer_names(names);
   hub_ = std::make_unique<comm::Hub>(config_.hub, registry_, rng_);
   refbox_peer_ = hub_->add_peer(std::string(kRefboxPeer), std::string(comm::kAllChannels));
@@ -167,6 +168,11 @@ Game::Game(GameConfig config)
     beacon_seq_.push_back(0);
   }
   beacon_ = std::make_unique<llsf_msgs::BeaconSignal>();
+  // Peers outside the simulation (served sockets) after the robots, so that a game without
+  // them has the same peer ids and draws as ever.
+  for (const ExternalPeerConfig& e : config_.external_peers) {
+    external_peers_.push_back({hub_->add_peer(e.name, e.channel), "", 0});
+  }
 
   skill_period_ = SimTime::period_of_hz(config_.skill_rate_hz);
   agent_period_ = SimTime::period_of_hz(config_.agent_rate_hz);
@@ -203,6 +209,27 @@ refbox::ReceiveResult Game::controller_command(const google::protobuf::Message& 
   refbox::ReceiveResult r = protocol_->receive(message, refbox::Origin::stream(0));
   if (r.status == refbox::ReceiveStatus::kRejected) ++controller_rejected_;
   return r;
+}
+
+refbox::ReceiveResult Game::controller_command(const google::protobuf::Message& message, int client,
+                                               const std::string& host, int port) {
+  LLSF_DEMAND(client >= 1);
+  refbox::ReceiveResult r = protocol_->receive(message, refbox::Origin::stream(client, host, port));
+  if (r.status == refbox::ReceiveStatus::kRejected) ++controller_rejected_;
+  return r;
+}
+
+void Game::controller_connected(int client) {
+  LLSF_DEMAND(client >= 1);
+  protocol_->client_connected(client);
+}
+
+void Game::controller_disconnected(int client) { protocol_->client_disconnected(client); }
+
+void Game::set_external_origin(int index, std::string host, int port) {
+  ExternalPeer& e = external_peers_.at(static_cast<std::size_t>(index));
+  e.host = std::move(host);
+  e.port = port;
 }
 
 void Game::start(refbox::GamePhase phase) {
@@ -401,11 +428,21 @@ void Game::step() {
         registry_.key_at(d.type_index).component_id != comm::kRefboxComponentId) {
       continue;
     }
-    const std::unique_ptr<google::protobuf::Message> msg = hub_->decode(d);
     const int from = robot_of(d.from);
-    if (from < 0) continue;  // (only robots are peers of the simulated radio)
-    const refbox::ReceiveResult r =
-        protocol_->receive(*msg, refbox::Origin::peer(robot_host(from), kRobotPort));
+    refbox::Origin origin;
+    if (from >= 0) {
+      origin = refbox::Origin::peer(robot_host(from), kRobotPort);
+    } else {
+      // A peer outside the simulation (served sockets), once its address is known.
+      const ExternalPeer* e = nullptr;
+      for (const ExternalPeer& x : external_peers_) {
+        if (x.peer == d.from) e = &x;
+      }
+      if (e == nullptr || e->host.empty()) continue;
+      origin = refbox::Origin::peer(e->host, e->port);
+    }
+    const std::unique_ptr<google::protobuf::Message> msg = hub_->decode(d);
+    const refbox::ReceiveResult r = protocol_->receive(*msg, origin);
     if (r.status == refbox::ReceiveStatus::kRejected) {
       ++refbox_rejected_;
     } else {

@@ -90,6 +90,17 @@ void GameConfig::validate() const {
   require_game("handling.jam_zone_m", handling.jam_zone_m, core::non_negative());
   require_game("handling.jam_recovery_s", handling.jam_recovery_s, core::non_negative());
   require_game("handling.align_min_drive_m", handling.align_min_drive_m, core::non_negative());
+  // External radio peers: names unique among the hub's peers (refbox, robots, each other).
+  for (std::size_t i = 0; i < external_peers.size(); ++i) {
+    const ExternalPeerConfig& e = external_peers[i];
+    const std::string field = "external_peers[" + std::to_string(i) + "]";
+    if (e.name.empty()) fail(field + ".name", "must not be empty");
+    if (e.channel.empty()) fail(field + ".channel", "must not be empty");
+    bool taken = e.name == "refbox";
+    for (const kinematic::RobotStart& r : world.robots) taken = taken || r.name == e.name;
+    for (std::size_t j = 0; j < i; ++j) taken = taken || external_peers[j].name == e.name;
+    if (taken) fail(field + ".name", "'" + e.name + "' is the name of another radio peer");
+  }
   // The modules' own configs.
   world.validate();
   refbox.validate();

@@ -521,6 +521,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   };
 
   game.enable_profile(hooks.profile);
+  if (hooks.attach) hooks.attach(game);
   driver.start(start_phase(scenario.start));
   const core::SimTime end = scenario.duration;
   core::SimTime next_progress = hooks.progress_every;

@@ -13,6 +13,7 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -125,6 +126,28 @@ class Game {
   /// A controller command (as if sent over the refbox's TCP port): applied at the next tick's
   /// refbox step. Returns the adapter's verdict.
   refbox::ReceiveResult controller_command(const google::protobuf::Message& message);
+
+  // --- The outside world (served sockets; call between ticks) ----------------------------------
+  /// A command of stream client `client` (>= 1; 0 is the game's own start()) from `host`:`port`,
+  /// checked with the 2013 channel rules and applied at the next tick's refbox step.
+  refbox::ReceiveResult controller_command(const google::protobuf::Message& message, int client,
+                                           const std::string& host, int port);
+  /// Stream client `client` (>= 1) connected: VersionInfo and GameInfo go to it at the next
+  /// tick, the stream messages' timers restart (RefboxProtocol::client_connected).
+  void controller_connected(int client);
+  /// Stream client `client` went away.
+  void controller_disconnected(int client);
+  /// The refbox's messages of the last tick (those for stream clients included; the game itself
+  /// only broadcasts the peers' ones on the hub). Valid until the next step().
+  std::span<const refbox::Outgoing> refbox_outgoing() const { return protocol_->outgoing(); }
+  /// The hub peer of GameConfig::external_peers[index].
+  comm::PeerId external_peer(int index) const {
+    return external_peers_.at(static_cast<std::size_t>(index)).peer;
+  }
+  /// Where the refbox sees external peer `index` come from (robots are keyed by (host, port),
+  /// spec §10): its socket's source address. Until set, the refbox ignores its messages (the
+  /// robots and other peers still hear them).
+  void set_external_origin(int index, std::string host, int port);
   /// Starts the game as a controller would: SetGamePhase(`phase`) unless the refbox is in that
   /// phase already, then SetGameState(RUNNING); they take effect at the next tick's refbox step
   /// (kPreGame: the refbox runs from PRE_GAME through the setup as in a real game). Throws
@@ -187,6 +210,12 @@ class Game {
   std::vector<std::unique_ptr<RobotStack>> stacks_;
   std::vector<comm::PeerId> robot_peers_;
   std::vector<int> robot_of_peer_;  // by PeerId value: robot index, -1 for other peers
+  struct ExternalPeer {
+    comm::PeerId peer;
+    std::string host;  // "": origin not known yet
+    int port = 0;
+  };
+  std::vector<ExternalPeer> external_peers_;  // by GameConfig::external_peers index
   std::function<void(const Game&)> tick_hook_;
 
   const kinematic::WorldEvents* events_ = nullptr;

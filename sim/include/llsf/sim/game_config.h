@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "llsf/comm/hub_config.h"
 #include "llsf/core/sim_time.h"
@@ -132,6 +133,16 @@ struct RobotLevelsConfig {
   SymbolicConfig symbolic;
 };
 
+/// A radio peer outside the simulation (a 2013 tool on a served UDP socket, `llsfsim run
+/// --refbox-sockets`): a hub peer like a robot, with the hub's loss, delay and outage models
+/// (links and outages may name it), whose frames the caller puts into the hub between ticks.
+struct ExternalPeerConfig {
+  std::string name;
+  /// The hub channel: "team" hears and is heard by the robots and the refbox; any other name
+  /// (e.g. "public") only by the refbox and the peers of that channel.
+  std::string channel = "team";
+};
+
 /// Everything a Game is built from. Aggregate with defaults; validate() (the Game constructor
 /// calls it) throws core::ConfigError naming the field.
 struct GameConfig {
@@ -163,6 +174,9 @@ struct GameConfig {
   /// The hackathon variant's puck layout for `seed`, drawn and applied to `world` and
   /// `planner` by prepare_game_config() before a Game is built (never set it by hand).
   std::optional<HackathonLayout> hackathon_layout;
+  /// Radio peers outside the simulation (none unless the game is served on sockets); added to
+  /// the hub after the refbox and the robots, in this order.
+  std::vector<ExternalPeerConfig> external_peers;
 
   /// Throws core::ConfigError "game.<field>: reason" for the first bad field (the world,
   /// refbox, protocol, hub and navigation configs are validated by their own validate()).

@@ -160,6 +160,10 @@ void check_trace_requests(const Scenario& scenario, const std::vector<TraceReque
 struct RunHooks {
   std::function<void(const sim::Game&)> progress;
   core::SimTime progress_every = core::SimTime::from_sec(30);
+  /// Called once with the game before its first tick, after the brains are plugged in and
+  /// before the refbox is started (a caller that serves the game on sockets keeps the game to
+  /// act on it between ticks from `tick`). May throw core::UserError (nothing played yet).
+  std::function<void(sim::Game&)> attach;
   /// Called at every tick after step 9 (recorders, live viewers).
   std::function<void(const sim::Game&)> tick;
   /// Called with every skill status change of every robot.
