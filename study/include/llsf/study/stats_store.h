@@ -134,8 +134,8 @@ class StatsStore {
   /// batch holds one already: with the same result hash, nothing is written and its id returned
   /// (a retried task, a merged shard: never a second copy); with another result, `replace`
   /// deletes it in the same transaction and writes `r` (the latest game counts: `llsfsim run`),
-  /// else that is an error. With `replace` the run is always written anew (new id, measurements
-  /// and recording). On any error nothing of the run is written (StatsError).
+  /// else that is an error. With `replace` the run is always written anew (measurements,
+  /// recording; its id may change). On any error nothing of the run is written (StatsError).
   std::int64_t add_run(std::int64_t batch_id, const RunResult& r, bool replace = false);
 
   /// The runs of a batch, by id.
