@@ -165,8 +165,8 @@ ConnInfo parse_url(const std::string& url, const std::string& shown) {
     std::string why = error != nullptr ? error : "out of memory";
     PQfreemem(error);
     while (!why.empty() && (why.back() == '\n' || why.back() == ' ')) why.pop_back();
-    throw StatsError(shown + ": not a valid PostgreSQL URL (postgresql://USER@HOST:PORT/DB): " +
-                     why);
+    throw StatsError(shown +
+                     ": not a valid PostgreSQL URL (postgresql://USER@HOST:PORT/DB): " + why);
   }
   ConnInfo info;
   bool timeout = std::getenv("PGCONNECT_TIMEOUT") != nullptr;
@@ -245,21 +245,21 @@ class PostgresBackend final : public StatsBackend {
     const std::string kind = key.kind == BatchKey::Kind::kBatch ? "batch" : "run";
     return with_retry("opening the batch", [&](pqxx::connection& c) {
       pqxx::work w(c);
-      const pqxx::result found = w.exec_prepared("find_batch", kind, key.scenario_hash,
-                                                 key.runs_per_variant);
+      const pqxx::result found =
+          w.exec_prepared("find_batch", kind, key.scenario_hash, key.runs_per_variant);
       if (!found.empty()) return found[0][0].as<std::int64_t>();
       // Two writers may create the same batch at once: one inserts, the other finds it.
-      const pqxx::result made = w.exec_prepared(
-          "insert_batch", kind, key.scenario_file, key.scenario_name, key.scenario_hash,
-          key.runs_per_variant, std::max(1, key.variants), join_seeds(key.seeds),
-          std::string(llsfsim_version()));
+      const pqxx::result made =
+          w.exec_prepared("insert_batch", kind, key.scenario_file, key.scenario_name,
+                          key.scenario_hash, key.runs_per_variant, std::max(1, key.variants),
+                          join_seeds(key.seeds), std::string(llsfsim_version()));
       if (!made.empty()) {
         const auto id = made[0][0].as<std::int64_t>();
         w.commit();
         return id;
       }
-      const pqxx::result again = w.exec_prepared("find_batch", kind, key.scenario_hash,
-                                                 key.runs_per_variant);
+      const pqxx::result again =
+          w.exec_prepared("find_batch", kind, key.scenario_hash, key.runs_per_variant);
       if (again.empty()) throw RetryTransaction{};  // deleted meanwhile: start over
       return again[0][0].as<std::int64_t>();
     });
@@ -289,10 +289,9 @@ class PostgresBackend final : public StatsBackend {
       pqxx::work w(c);
       if (replace) w.exec_prepared("delete_run", batch_id, r.variant, rows.seed);
       const pqxx::result inserted = w.exec_prepared(
-          "insert_run", batch_id, r.scenario, r.variant, rows.seed,
-          std::string(llsfsim_version()), rows.result_hash, r.passed() ? 1 : 0, r.points,
-          real_literal_text(r.game_time_s), real_literal_text(r.cpu_s),
-          real_literal_text(r.real_time_factor), recording);
+          "insert_run", batch_id, r.scenario, r.variant, rows.seed, std::string(llsfsim_version()),
+          rows.result_hash, r.passed() ? 1 : 0, r.points, real_literal_text(r.game_time_s),
+          real_literal_text(r.cpu_s), real_literal_text(r.real_time_factor), recording);
       if (inserted.empty()) {
         // The key is taken (ON CONFLICT DO NOTHING waited for the writer that took it).
         if (replace) throw RetryTransaction{};  // stored after our delete: delete it again
@@ -351,13 +350,12 @@ class PostgresBackend final : public StatsBackend {
                    q(a.reason) + ", " + or_null(a.device) + ", " + int_or_null(a.order) + ", " +
                    int_or_null(a.puck);
           });
-      insert_rows(
-          "INSERT INTO events (run_id, idx, time_s, kind, name, value, detail) VALUES",
-          rows.events.size(), [&](std::size_t i) {
-            const RunEvent& e = rows.events[i];
-            return id + ", " + num(i) + ", " + real_literal(e.time_s) + ", " + q(e.kind) + ", " +
-                   q(e.name) + ", " + real_literal(e.value) + ", " + q(e.detail);
-          });
+      insert_rows("INSERT INTO events (run_id, idx, time_s, kind, name, value, detail) VALUES",
+                  rows.events.size(), [&](std::size_t i) {
+                    const RunEvent& e = rows.events[i];
+                    return id + ", " + num(i) + ", " + real_literal(e.time_s) + ", " + q(e.kind) +
+                           ", " + q(e.name) + ", " + real_literal(e.value) + ", " + q(e.detail);
+                  });
       w.commit();
       return run_id;
     });
@@ -426,8 +424,17 @@ class PostgresBackend final : public StatsBackend {
         what.replace(p, info_.password.size(), "***");
       }
     }
-    while (!what.empty() && (what.back() == '\n' || what.back() == ' ')) what.pop_back();
-    return what;
+    // One line: libpq's messages continue on indented lines.
+    std::string line;
+    for (const char c : what) {
+      if (c == '\n' || c == '\t' || c == '\r') {
+        if (!line.empty() && line.back() != ' ') line += ' ';
+      } else {
+        line += c;
+      }
+    }
+    while (!line.empty() && line.back() == ' ') line.pop_back();
+    return line;
   }
 
   void connect() const {
@@ -475,8 +482,7 @@ class PostgresBackend final : public StatsBackend {
       if (std::chrono::steady_clock::now() + pause > deadline) {
         throw StatsError(path_ + ": " + what + ": lost the connection to the PostgreSQL server " +
                          "and could not reconnect within " +
-                         std::to_string(window_.count() / 1000) +
-                         " s (LLSF_DB_RETRY_S): " + lost);
+                         std::to_string(window_.count() / 1000) + " s (LLSF_DB_RETRY_S): " + lost);
       }
       std::this_thread::sleep_for(pause);
       pause = std::min(pause * 2, std::chrono::milliseconds(2000));
@@ -597,8 +603,8 @@ class PostgresBackend final : public StatsBackend {
         s.game_time_s = q[9].as<double>();
         s.cpu_s = q[10].as<double>();
         s.real_time_factor = q[11].as<double>();
-        s.recording =
-            q[12].is_null() ? std::string() : resolved_recording_path(path_, q[12].as<std::string>());
+        s.recording = q[12].is_null() ? std::string()
+                                      : resolved_recording_path(path_, q[12].as<std::string>());
       }
       return out;
     });

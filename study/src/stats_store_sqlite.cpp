@@ -294,9 +294,7 @@ class SqliteBackend final : public StatsBackend {
     return id;
   }
 
-  void finish_batch(std::int64_t batch_id) override {
-    finish_batch_->start().bind(batch_id).run();
-  }
+  void finish_batch(std::int64_t batch_id) override { finish_batch_->start().bind(batch_id).run(); }
 
   std::optional<StoredBatch> batch(std::int64_t batch_id) const override {
     Statement& q = *get_batch_;
@@ -500,10 +498,9 @@ class SqliteBackend final : public StatsBackend {
   // before the table (versions 1 and 2).
   void migrate() {
     Transaction t(db_.get(), path_);
-    const bool has_migrations =
-        single_int(
-            "SELECT count(*) FROM sqlite_schema WHERE type = 'table' AND "
-            "name = 'schema_migrations'") != 0;
+    const bool has_migrations = single_int(
+                                    "SELECT count(*) FROM sqlite_schema WHERE type = 'table' AND "
+                                    "name = 'schema_migrations'") != 0;
     const int version =
         static_cast<int>(has_migrations ? single_int("SELECT max(version) FROM schema_migrations")
                                         : single_int("PRAGMA user_version"));
@@ -547,8 +544,8 @@ class SqliteBackend final : public StatsBackend {
         "SELECT id, kind, created, coalesce(finished, ''), scenario_file, scenario_name, "
         "scenario_hash, runs_per_variant, variants, seeds FROM batches WHERE id = ?");
     list_batches_ = prep("SELECT id FROM batches ORDER BY id");
-    find_run_ = prep(
-        "SELECT id, result_hash FROM runs WHERE batch_id = ? AND variant = ? AND seed = ?");
+    find_run_ =
+        prep("SELECT id, result_hash FROM runs WHERE batch_id = ? AND variant = ? AND seed = ?");
     delete_run_ = prep("DELETE FROM runs WHERE id = ?");
     insert_run_ = prep(
         "INSERT INTO runs (batch_id, scenario, variant, seed, llsfsim_version, result_hash, "
@@ -600,8 +597,8 @@ class SqliteBackend final : public StatsBackend {
   DbHandle db_;
   // Prepared once, used for every run.
   std::unique_ptr<Statement> find_batch_, insert_batch_, finish_batch_, get_batch_, list_batches_,
-      find_run_, delete_run_, insert_run_, insert_stat_, insert_order_, insert_test_,
-      insert_award_, insert_event_, select_runs_, select_run_, select_stats_, select_awards_;
+      find_run_, delete_run_, insert_run_, insert_stat_, insert_order_, insert_test_, insert_award_,
+      insert_event_, select_runs_, select_run_, select_stats_, select_awards_;
 };
 
 }  // namespace

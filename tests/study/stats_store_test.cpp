@@ -296,7 +296,7 @@ TEST_CASE_TEMPLATE("StatsStore: a run is written whole or not at all, and once",
   CHECK(runs[0].id == replaced);
   CHECK(runs[0].points == 99);
   CHECK(runs[0].result_hash == 0x1234);
-  CHECK(store.count_rows("awards") == 2);  // the old run's children went with it
+  CHECK(store.count_rows("awards") == 2);    // the old run's children went with it
   CHECK(run_rows(store) == before - 1 - 1);  // one award and one award event fewer
   // Replacing with the same result writes it anew as well (the latest game counts).
   changed.cpu_s = 3.0;
@@ -340,10 +340,11 @@ TEST_CASE_TEMPLATE("StatsStore keeps recording paths", B, BACKENDS) {
     CHECK(runs[3].recording == cwd_relative);
     CHECK(PgCluster::shared().psql(db_name(db), "SELECT recording FROM runs ORDER BY id LIMIT 1") ==
           inside.recording);
-    CHECK(PgCluster::shared().psql(db_name(db), "SELECT count(*) FROM runs WHERE recording IS NULL") ==
-          "1");
+    CHECK(PgCluster::shared().psql(db_name(db),
+                                   "SELECT count(*) FROM runs WHERE recording IS NULL") == "1");
   } else {
-    CHECK(fs::path(runs[3].recording).lexically_normal() == fs::path(cwd_relative).lexically_normal());
+    CHECK(fs::path(runs[3].recording).lexically_normal() ==
+          fs::path(cwd_relative).lexically_normal());
     sqlite3* h = nullptr;
     REQUIRE(sqlite3_open(db.c_str(), &h) == SQLITE_OK);
     sqlite3_stmt* q = nullptr;

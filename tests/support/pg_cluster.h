@@ -84,9 +84,8 @@ class PgCluster {
 
   ~PgCluster() {
     std::string out;
-    if (running_) run(server_cmd({bin_dir() + "/pg_ctl", "-D", data(), "-m", "immediate", "-w",
-                                  "stop"}),
-                      out);
+    if (running_)
+      run(server_cmd({bin_dir() + "/pg_ctl", "-D", data(), "-m", "immediate", "-w", "stop"}), out);
     remove_dir();
     if (watchdog_write_ >= 0) ::close(watchdog_write_);  // the watchdog finds nothing left
     if (watchdog_pid_ > 0) ::waitpid(watchdog_pid_, nullptr, 0);
@@ -160,10 +159,10 @@ class PgCluster {
   /// could not run or died of a signal).
   static int run(const std::vector<std::string>& argv, std::string& out) {
     static std::atomic<int> counter{0};
-    const std::string capture = (std::filesystem::temp_directory_path() /
-                                 ("llsf_pg_out_" + std::to_string(::getpid()) + "_" +
-                                  std::to_string(counter++)))
-                                    .string();
+    const std::string capture =
+        (std::filesystem::temp_directory_path() /
+         ("llsf_pg_out_" + std::to_string(::getpid()) + "_" + std::to_string(counter++)))
+            .string();
     std::vector<char*> args;
     for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
     args.push_back(nullptr);
@@ -237,8 +236,8 @@ class PgCluster {
     if (::pipe2(fds, O_CLOEXEC) != 0) return;
     std::string stop = "'" + bin_dir() + "/pg_ctl' -D '" + data() + "' -m immediate -w stop";
     if (as_root_) stop = "/sbin/runuser -u postgres -- " + stop;
-    const std::string script = "while read -r _; do :; done; " + stop +
-                               " >/dev/null 2>&1; rm -rf '" + dir_ + "'";
+    const std::string script =
+        "while read -r _; do :; done; " + stop + " >/dev/null 2>&1; rm -rf '" + dir_ + "'";
     const char* argv[] = {"/bin/sh", "-c", script.c_str(), nullptr};
     const pid_t pid = ::fork();
     if (pid == 0) {
