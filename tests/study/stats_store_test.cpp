@@ -662,6 +662,15 @@ TEST_CASE("StatsStore (PostgreSQL): bad URLs and unreachable servers are clear e
   CHECK(refused.find("hunter2") == std::string::npos);
   CHECK(refused.find("postgresql://llsf:***@127.0.0.1:" + std::to_string(closed) + "/x") !=
         std::string::npos);
+  // Garbage: a StatsError each, never a crash or another exception.
+  for (const std::string& garbage :
+       std::vector<std::string>{"postgresql://[::1", "postgresql://a@b:99999999/x",
+                                "postgres://%zz@/", "postgresql://h/db?sslmode=nonsense",
+                                "postgresql://:@:/?&=", std::string("postgres://\x01\xff"),
+                                "postgresql://" + std::string(5000, 'a')}) {
+    CAPTURE(garbage);
+    CHECK(error_of(garbage) != "no error");
+  }
   // A database that does not exist, a role that does not exist.
   CHECK(error_of(pg.url("missing")).find("\"missing\" does not exist") != std::string::npos);
   CHECK(error_of("postgresql://nobody@127.0.0.1:" + std::to_string(pg.port()) + "/postgres")
