@@ -3,6 +3,7 @@
 #include "llsf/study/stats_store.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cinttypes>
 #include <cstdio>
 #include <filesystem>
@@ -79,9 +80,23 @@ bool is_database_url(std::string_view db) {
   return db.starts_with("postgresql://") || db.starts_with("postgres://");
 }
 
+namespace {
+// "scheme://..." (RFC 3986 scheme: a letter, then letters, digits, '+', '-', '.').
+bool has_url_scheme(std::string_view s) {
+  const std::size_t colon = s.find("://");
+  if (colon == std::string_view::npos || colon == 0 ||
+      std::isalpha(static_cast<unsigned char>(s[0])) == 0) {
+    return false;
+  }
+  return std::all_of(s.begin(), s.begin() + static_cast<std::ptrdiff_t>(colon), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '+' || c == '-' || c == '.';
+  });
+}
+}  // namespace
+
 std::string masked_database_url(std::string_view db) {
   std::string out(db);
-  if (!is_database_url(db)) return out;
+  if (!has_url_scheme(db)) return out;
   // user:password@ in the authority.
   const std::size_t scheme = out.find("://") + 3;
   const std::size_t end = std::min(out.find_first_of("/?", scheme), out.size());
@@ -106,8 +121,21 @@ std::string masked_database_url(std::string_view db) {
 
 // ---- StatsStore --------------------------------------------------------------------------------
 
-StatsStore::StatsStore(const std::string& path)
-    : backend_(is_database_url(path) ? make_postgres_backend(path) : make_sqlite_backend(path)) {}
+namespace {
+// The backend `path` names. Another URL scheme (`mysql://`, `POSTGRESQL://`, `sqlite://`) is an
+// error, not a file whose name starts with "scheme:".
+std::unique_ptr<StatsBackend> open_backend(const std::string& path) {
+  if (is_database_url(path)) return make_postgres_backend(path);
+  if (has_url_scheme(path)) {
+    throw StatsError(masked_database_url(path) +
+                     ": not a statistics store: a file path, or a database URL "
+                     "postgresql://USER@HOST:PORT/DB (postgres://...)");
+  }
+  return make_sqlite_backend(path);
+}
+}  // namespace
+
+StatsStore::StatsStore(const std::string& path) : backend_(open_backend(path)) {}
 StatsStore::~StatsStore() = default;
 StatsStore::StatsStore(StatsStore&&) noexcept = default;
 StatsStore& StatsStore::operator=(StatsStore&&) noexcept = default;

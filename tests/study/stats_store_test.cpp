@@ -628,6 +628,23 @@ TEST_CASE("masked_database_url hides passwords") {
   CHECK(llsf::study::is_database_url("postgres://h/db"));
   CHECK_FALSE(llsf::study::is_database_url("llsfsim.db"));
   CHECK_FALSE(llsf::study::is_database_url("postgresql.db"));
+  // Another scheme is not taken for a file name; the password masked there as well.
+  const TempDir dir;
+  const fs::path cwd = fs::current_path();
+  fs::current_path(dir.path);
+  for (const char* other : {"mysql://ann:s3cret@h/db", "POSTGRESQL://ann:s3cret@h/db"}) {
+    CAPTURE(other);
+    CHECK_THROWS_WITH_AS(StatsStore{other}, doctest::Contains("not a statistics store"),
+                         StatsError);
+    try {
+      StatsStore store{other};
+    } catch (const StatsError& e) {
+      CHECK(std::string(e.what()).find("s3cret") == std::string::npos);
+      CHECK(std::string(e.what()).find("ann:***@h/db") != std::string::npos);
+    }
+  }
+  CHECK(fs::is_empty(dir.path));  // no file or directory made
+  fs::current_path(cwd);
 }
 
 TEST_CASE("StatsStore (PostgreSQL): the cluster of the tests") {

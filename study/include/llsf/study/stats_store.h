@@ -84,8 +84,8 @@ class StatsBackend;
 
 /// True if `db` names a database server (`postgresql://...` or `postgres://...`), not a file.
 bool is_database_url(std::string_view db);
-/// `db` with the password of a URL (`user:PASSWORD@`, `password=PASSWORD`) replaced by `***`;
-/// anything else unchanged. For every message that shows a --db value.
+/// `db` with the password of a URL (`scheme://user:PASSWORD@`, `password=PASSWORD`) replaced by
+/// `***`; a file path unchanged. For every message that shows a --db value.
 std::string masked_database_url(std::string_view db);
 
 /// The statistics database. Not thread-safe: one thread writes (a batch queues its results to
