@@ -654,6 +654,20 @@ TEST_CASE("StatsStore (PostgreSQL): the cluster of the tests") {
   CHECK(pg.psql("postgres", "SELECT 1") == "1");
 }
 
+TEST_CASE("scripts/test-postgres: a server for shell tests, stopped and removed afterwards") {
+  const std::string dir =
+      (fs::temp_directory_path() / ("llsf_pg_script_" + std::to_string(::getpid()))).string();
+  std::string out;
+  // CMD sees the URL; its exit status is the script's; DIR is gone afterwards.
+  const int rc = PgCluster::run(
+      {"/bin/bash", std::string(LLSF_SOURCE_DIR) + "/scripts/test-postgres", "run", dir, "/bin/sh",
+       "-c", PgCluster::bin_dir() + "/psql -X -A -t -c 'SELECT 6 * 7' \"$LLSF_PG_URL\"; exit 3"},
+      out);
+  CHECK(rc == 3);
+  CHECK(out.find("42") != std::string::npos);
+  CHECK_FALSE(fs::exists(dir));
+}
+
 TEST_CASE("StatsStore (PostgreSQL): bad URLs and unreachable servers are clear errors") {
   PgCluster& pg = PgCluster::shared();
   const EnvVar no_password("PGPASSWORD", nullptr);
