@@ -4,10 +4,13 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cctype>
 #include <filesystem>
 #include <functional>
 #include <iosfwd>
 #include <string>
+
+#include "llsf/study/stats_store.h"
 
 namespace llsf::app {
 
@@ -15,8 +18,20 @@ namespace llsf::app {
 using Action = std::function<int(std::ostream& out, std::ostream& err)>;
 
 /// Where recordings go by default: "<name>-recordings" beside the statistics store `db`
-/// (llsfsim.db: llsfsim-recordings/), so that two stores never share one.
+/// (llsfsim.db: llsfsim-recordings/), so that two stores never share one; for a database server
+/// (`postgresql://.../study`) "<database>-recordings" in the working directory (study-recordings/,
+/// llsfsim-recordings/ when the URL names no database).
 inline std::string default_recordings_dir(const std::string& db) {
+  if (study::is_database_url(db)) {
+    const std::size_t authority = db.find("://") + 3;
+    const std::size_t slash = db.find('/', authority);
+    std::string name =
+        slash == std::string::npos ? "" : db.substr(slash + 1, db.find('?', slash) - slash - 1);
+    for (char& c : name) {
+      if (std::isalnum(static_cast<unsigned char>(c)) == 0 && c != '-' && c != '_') c = '_';
+    }
+    return (name.empty() ? std::string("llsfsim") : name) + "-recordings";
+  }
   const std::filesystem::path p(db);
   return (p.parent_path() / (p.stem().string() + "-recordings")).string();
 }

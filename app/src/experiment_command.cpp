@@ -92,7 +92,7 @@ std::optional<int> play(const ExperimentOptions& o, const study::Experiment& e,
       }
       out << fmt::format(
           "batch      {} ({}) #{} in {}: {} runs, {} played, {} stored before{}\n", eb.name,
-          eb.file, b.batch_id, o.db, b.total, b.played, b.skipped,
+          eb.file, b.batch_id, store.path(), b.total, b.played, b.skipped,
           failed > 0 ? fmt::format("; {} of {} failed a test case", failed, runs) : "");
       out.flush();
     }
@@ -132,7 +132,7 @@ int experiment(const ExperimentOptions& o, std::ostream& out, std::ostream& err)
       return kExitBadInput;
     }
   }
-  if (o.report_only && !std::filesystem::exists(o.db)) {
+  if (o.report_only && !study::is_database_url(o.db) && !std::filesystem::exists(o.db)) {
     err << "llsfsim experiment: no statistics store " << o.db
         << " (play the experiment first: llsfsim experiment " << o.file << ")\n";
     return kExitBadInput;
@@ -202,7 +202,9 @@ Action add_experiment_command(CLI::App& app) {
   app.add_option("experiment", o->file, "Experiment file (docs/experiments.md)")
       ->required()
       ->check(CLI::ExistingFile);
-  app.add_option("--db", o->db, "Statistics store (SQLite; docs/statistics.md)")
+  app.add_option("--db", o->db,
+                 "Statistics store: a SQLite file or a postgresql://USER@HOST:PORT/DB URL "
+                 "(docs/statistics.md)")
       ->capture_default_str();
   app.add_option("--runs", o->runs,
                  "Seeds per variant of every batch: the first N of each scenario's list, or "

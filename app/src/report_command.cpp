@@ -46,7 +46,7 @@ int report(const ReportOptions& o, std::ostream& out, std::ostream& err) {
       if (!id && !batches.empty()) id = batches.back().id;
     }
     if (!id) {
-      err << "llsfsim report: " << o.db << " holds no batch (run llsfsim batch first)\n";
+      err << "llsfsim report: " << store.path() << " holds no batch (run llsfsim batch first)\n";
       return kExitBadInput;
     }
     const study::BatchReport r = study::make_report(store, *id);
@@ -88,7 +88,10 @@ int report(const ReportOptions& o, std::ostream& out, std::ostream& err) {
 Action add_report_command(CLI::App& app) {
   auto o = std::make_shared<ReportOptions>();
   app.add_option("batch", o->batch, "Batch id (default: the latest batch; see --list)");
-  app.add_option("--db", o->db, "Statistics store")->capture_default_str();
+  app.add_option("--db", o->db,
+                 "Statistics store: a SQLite file or a postgresql://USER@HOST:PORT/DB URL "
+                 "(docs/statistics.md)")
+      ->capture_default_str();
   app.add_option("--csv", o->csv,
                  "Also write every statistic per variant (n, mean, median, quartiles, min, max, "
                  "pass rate) as CSV");
@@ -101,8 +104,9 @@ Action add_report_command(CLI::App& app) {
       "mean points against the first variant's, with a bootstrap 95 % interval (* = the "
       "interval excludes 0). The HTML page inlines the viewer's bundle from $LLSF_VIEWER_DIR or "
       "viewer/dist of the data directory (`make viewer` builds it).\n"
-      "Exit code: 0 done, 2 bad input (a bad store or batch, a file that cannot be written, a "
-      "missing viewer bundle), 3 internal error (a bug: please report it).");
+      "Exit code: 0 done, 2 bad input (a bad store or batch, a database server that cannot be "
+      "reached, a file that cannot be written, a missing viewer bundle), 3 internal error (a bug: "
+      "please report it).");
   return [o](std::ostream& out, std::ostream& err) { return report(*o, out, err); };
 }
 

@@ -365,7 +365,7 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
     try {
       const std::int64_t batch = store->open_batch(key);
       const std::int64_t run = store->add_run(batch, r, /*replace=*/true);
-      stored_as = fmt::format("{} (batch {}, run {})", o.db, batch, run);
+      stored_as = fmt::format("{} (batch {}, run {})", store->path(), batch, run);
     } catch (const study::StatsError& e) {
       err << "llsfsim run: " << e.what() << "\n";
       return kExitBadInput;
@@ -544,14 +544,16 @@ Action add_run_command(CLI::App& app) {
                "by the work budget), a rule loop cut by the firing limit, a lock held over 300 s, "
                "an unknown skill (as the scenario key strict: true)");
   auto* db = app.add_option("--db", o->db,
-                            "Statistics store (SQLite) the run is written to (docs/statistics.md)")
+                            "Statistics store the run is written to: a SQLite file or a "
+                            "postgresql://USER@HOST:PORT/DB URL (docs/statistics.md)")
                  ->capture_default_str();
   app.add_flag("--no-db", o->no_db, "Do not write the run to a statistics store")->excludes(db);
   auto* record =
       app.add_option("--record", o->record,
                      "Write the recording to FILE (gzip JSON lines, docs/recording.md; default: "
                      "llsfsim-recordings/<scenario>[-<variant>]-seed<N>.jsonl.gz, beside the --db "
-                     "file and named after it)");
+                     "file and named after it; for a URL <database>-recordings/ in the working "
+                     "directory)");
   app.add_flag("--no-record", o->no_record, "Do not record the game")->excludes(record);
   app.add_flag("--no-reload", o->no_reload,
                "Paced runs: do not reload the agent's CLIPS files when they change");

@@ -25,11 +25,13 @@ Action add_serve_command(CLI::App& app) {
   app.add_option("--port", o->port, "Port to listen on (0: any free port)")
       ->capture_default_str()
       ->check(CLI::Range(0, 65535));
-  app.add_option("--db", o->db, "Statistics store whose batches are served (docs/statistics.md)")
+  app.add_option("--db", o->db,
+                 "Statistics store whose batches are served: a SQLite file or a "
+                 "postgresql://USER@HOST:PORT/DB URL (docs/statistics.md)")
       ->capture_default_str();
   app.add_option("--recordings", o->recordings,
                  "Recordings served below /api/recordings/ (default: <db>-recordings beside "
-                 "the --db file)");
+                 "the --db file; <database>-recordings in the working directory for a URL)");
   app.add_option("--viewer", o->viewer,
                  "The built viewer (default: $LLSF_VIEWER_DIR, else viewer/dist of the data "
                  "directory; `make viewer`)");
@@ -52,15 +54,15 @@ Action add_serve_command(CLI::App& app) {
       "Serves the browser viewer, the stored batches, runs and reports as JSON and the "
       "recordings as JSON lines (docs/llsfsim.md). Prints 'llsfsim serve: URL' and runs until "
       "Ctrl-C or SIGTERM.\n"
-      "Exit code: 0 stopped, 2 cannot listen (bad address or port, port in use), 3 internal "
-      "error (a bug: please report it).");
+      "Exit code: 0 stopped, 2 cannot listen (bad address or port, port in use) or cannot open "
+      "a --db URL's database, 3 internal error (a bug: please report it).");
   return [o, request_timeout_s](std::ostream& out, std::ostream& err) {
     o->request_timeout = std::chrono::milliseconds(
         std::max<std::int64_t>(1, std::llround(*request_timeout_s * 1000.0)));
     std::unique_ptr<Server> server;
     try {
       server = std::make_unique<Server>(*o);
-    } catch (const core::UserError& e) {  // cannot listen
+    } catch (const core::UserError& e) {  // cannot listen, cannot open the database
       err << "llsfsim serve: " << e.what() << "\n";
       return kExitBadInput;
     }

@@ -297,7 +297,8 @@ struct ServerImpl {
   Reply handle(const std::vector<std::string>& path);
   Reply handle_api(const std::vector<std::string>& path);
   Reply serve_static(const std::vector<std::string>& path);
-  /// The statistics store, opened on first use if its file exists (nullptr if it does not).
+  /// The statistics store, opened on first use if its file exists (nullptr if it does not); a
+  /// database server's store is opened by the constructor.
   study::StatsStore* stats();
 };
 
@@ -312,7 +313,10 @@ void ServerImpl::log(const std::string& line) const {
 study::StatsStore* ServerImpl::stats() {
   if (store) return &*store;
   std::error_code ec;
-  if (options.db.empty() || !fs::is_regular_file(options.db, ec)) return nullptr;
+  if (options.db.empty() || study::is_database_url(options.db) ||
+      !fs::is_regular_file(options.db, ec)) {
+    return nullptr;
+  }
   store.emplace(options.db);  // StatsError reaches handle(): 500
   return &*store;
 }
@@ -687,6 +691,9 @@ Server::Server(ServerOptions options, LiveFeed* feed) : impl_(std::make_unique<S
   if (options.viewer.empty()) options.viewer = study::viewer_dir();
   m.options = std::move(options);
   m.feed = feed;
+  // A database server's store at once: an unreachable server or a bad URL is an error of the
+  // command (StatsError is a UserError: exit 2), not a 500 of every batch page later.
+  if (study::is_database_url(m.options.db)) m.store.emplace(m.options.db);
   const std::string& bind = m.options.bind;
   if (m.options.port < 0 || m.options.port > 65535) {
     throw core::UserError(fmt::format("bad port {}", m.options.port));

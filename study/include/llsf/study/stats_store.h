@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: MIT
-// StatsStore: the statistics of played games in one SQLite file (default `llsfsim.db`) --
-// batches, runs, every numeric result, orders, test verdicts, points awards and events. Each run
-// is written in one transaction: an interrupted batch never leaves half a run. docs/statistics.md
-// documents the schema.
+// StatsStore: the statistics of played games -- batches, runs, every numeric result, orders, test
+// verdicts, points awards and events -- in one SQLite file (default `llsfsim.db`) or in a
+// PostgreSQL database (`postgresql://USER@HOST:PORT/DB`). Both backends keep the same schema with
+// the same semantics: each run is written in one transaction (an interrupted batch never leaves
+// half a run), a run is identified by (batch, variant, seed), writing a run again is harmless.
+// docs/statistics.md documents the schema.
 #pragma once
 
 #include <cstdint>
@@ -19,8 +21,8 @@
 
 namespace llsf::study {
 
-/// The store could not be opened, read or written (the message names the file and SQLite's
-/// reason).
+/// The store could not be opened, read or written (the message names the file or the URL, its
+/// password masked, and the database's reason).
 class StatsError : public core::UserError {
  public:
   using core::UserError::UserError;
@@ -73,20 +75,33 @@ struct StoredRun {
   double cpu_s = 0.0;
   double real_time_factor = 0.0;
   /// The run's recording ("" if none): a path relative to the working directory (or absolute),
-  /// resolved from what the store keeps -- relative to the database's directory when inside it.
+  /// resolved from what the store keeps -- relative to the database's directory when inside it;
+  /// a database server's store keeps absolute paths.
   std::string recording;
 };
 
+class StatsBackend;
+
+/// True if `db` names a database server (`postgresql://...` or `postgres://...`), not a file.
+bool is_database_url(std::string_view db);
+/// `db` with the password of a URL (`scheme://user:PASSWORD@`, `password=PASSWORD`) replaced by
+/// `***`; a file path unchanged. For every message that shows a --db value.
+std::string masked_database_url(std::string_view db);
+
 /// The statistics database. Not thread-safe: one thread writes (a batch queues its results to
-/// the thread that owns the store). Several processes may share a file (SQLite locks it; a
-/// writer waits up to 10 s).
+/// the thread that owns the store). Many processes may write one store at once: SQLite locks the
+/// file (a writer waits up to 10 s); PostgreSQL takes each run in its own transaction, and a
+/// store that loses its connection reconnects and retries (docs/statistics.md).
 class StatsStore {
  public:
   /// The default file, in the current directory.
   static constexpr std::string_view kDefaultPath = "llsfsim.db";
 
-  /// Opens `path` (created if missing) and creates the schema if the file is new. Throws
-  /// StatsError if the file cannot be opened or holds another schema version.
+  /// Opens the store `path` names: a PostgreSQL database for a `postgresql://` or `postgres://`
+  /// URL (what it leaves out comes from the PG* environment variables, as for psql), else a
+  /// SQLite file (created if missing). Creates the schema in a new store and migrates an older
+  /// one. Throws StatsError if the store cannot be opened or reached, or holds a newer schema
+  /// version or other tables.
   explicit StatsStore(const std::string& path);
   ~StatsStore();
   StatsStore(const StatsStore&) = delete;
@@ -94,17 +109,18 @@ class StatsStore {
   StatsStore(StatsStore&&) noexcept;
   StatsStore& operator=(StatsStore&&) noexcept;
 
-  /// The file's path.
+  /// The file's path; for a database server its URL with the password masked.
   const std::string& path() const;
 
   /// Throws StatsError unless runs can be written: the file opened read-only (its permissions,
-  /// a read-only file system) or its directory not writable (SQLite's journal goes there). For
+  /// a read-only file system) or its directory not writable (SQLite's journal goes there); for
+  /// PostgreSQL a read-only server (a standby) or a role without INSERT on the tables. For
   /// `run` and `batch` before the first game, so that a store that cannot take the result
   /// costs no game.
   void require_writable() const;
 
   /// The id of the batch with `key`'s identity (kind, scenario_hash, runs_per_variant), created
-  /// if there is none.
+  /// if there is none (two writers opening the same new batch at once get the same id).
   std::int64_t open_batch(const BatchKey& key);
   /// Marks a batch complete (sets `finished` to now, once).
   void finish_batch(std::int64_t batch_id);
@@ -114,9 +130,12 @@ class StatsStore {
   std::optional<StoredBatch> batch(std::int64_t batch_id) const;
 
   /// Writes `r` with its statistics, orders, test verdicts, awards and events in one
-  /// transaction; returns the run's id. With `replace`, an earlier run of the same (batch,
-  /// variant, seed) is deleted in the same transaction; without, such a run is an error. On
-  /// any error nothing of the run is written (StatsError).
+  /// transaction; returns the run's id. A run is identified by (batch, variant, seed); if the
+  /// batch holds one already: with the same result hash, nothing is written and its id returned
+  /// (a retried task, a merged shard: never a second copy); with another result, `replace`
+  /// deletes it in the same transaction and writes `r` (the latest game counts: `llsfsim run`),
+  /// else that is an error. With `replace` the run is always written anew (measurements,
+  /// recording; its id may change). On any error nothing of the run is written (StatsError).
   std::int64_t add_run(std::int64_t batch_id, const RunResult& r, bool replace = false);
 
   /// The runs of a batch, by id.
@@ -133,8 +152,7 @@ class StatsStore {
   std::int64_t count_rows(std::string_view table) const;
 
  private:
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
+  std::unique_ptr<StatsBackend> backend_;  ///< SQLite or PostgreSQL (study/src/stats_backend.h)
 };
 
 /// FNV-1a 64 of the file's bytes as 16 hex digits. Throws StatsError if the file cannot be read.
@@ -153,9 +171,11 @@ std::string batch_identity_hash(const std::string& scenario_path, const Scenario
 std::vector<std::pair<std::string, double>> numeric_statistics(const RunResult& r);
 
 /// How the store keeps a recording path: relative to the database file's directory when the
-/// file lies inside it (database and recordings can move together), else absolute.
+/// file lies inside it (database and recordings can move together), else absolute; always
+/// absolute for a database server (`db_path` a URL).
 std::string stored_recording_path(const std::string& db_path, const std::string& recording);
-/// The inverse: a kept path as a path usable from the working directory.
+/// The inverse: a kept path as a path usable from the working directory (for a database server a
+/// relative kept path is taken as relative to the working directory).
 std::string resolved_recording_path(const std::string& db_path, const std::string& stored);
 
 }  // namespace llsf::study
