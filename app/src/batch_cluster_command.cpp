@@ -254,6 +254,8 @@ int batch_submit(const BatchCommandOptions& o, std::ostream& out, std::ostream& 
         job_id);
     std::string follow;
     for (const LoadedBatch& l : loaded) follow += " " + study::shell_quote(l.path);
+    if (o.runs) follow += " --runs " + std::to_string(*o.runs);
+    if (!o.seeds.empty()) follow += " --seeds " + study::shell_quote(o.seeds);
     out << fmt::format("follow     llsfsim batch status{} --db {} --wait\n", follow,
                        study::shell_quote(db));
     if (!study::is_database_url(db)) {
@@ -382,7 +384,8 @@ struct Status {
 
 bool live_state(const std::string& s) {
   return s == "RUNNING" || s == "COMPLETING" || s == "CONFIGURING" || s == "REQUEUED" ||
-         s == "RESIZING" || s == "SIGNALING" || s == "STAGE_OUT";
+         s == "RESIZING" || s == "SIGNALING" || s == "STAGE_OUT" || s == "REQUEUE_HOLD" ||
+         s == "REQUEUE_FED" || s == "SUSPENDED";
 }
 bool failed_state(const std::string& s) {
   return s == "FAILED" || s == "CANCELLED" || s == "TIMEOUT" || s == "NODE_FAIL" ||
@@ -402,21 +405,25 @@ Status collect(const std::vector<LoadedBatch>& loaded, const std::string& db) {
     games_per_task[j.job_id] = j.games_per_task;
     ids += (ids.empty() ? "" : ",") + j.job_id;
   }
+  // squeue -t all: the live tasks and those that ended within slurmctld's MinJobAge (all jobs,
+  // filtered here: a job id slurmctld has forgotten would fail `squeue -j`); sacct (with Slurm
+  // accounting) for older ones.
   std::vector<study::SlurmTask> live;
   std::vector<study::SlurmTask> ended;
   if (!ids.empty()) {
-    const ProcessOutput q = run_process({"squeue", "-h", "-j", ids, "-o", "%i|%T|%r"});
+    const ProcessOutput q = run_process({"squeue", "-h", "-t", "all", "-o", "%i|%T|%r"});
     if (q.code == 0) {
-      live = study::parse_slurm_tasks(q.output);
+      for (study::SlurmTask& t : study::parse_slurm_tasks(q.output)) {
+        if (!games_per_task.contains(t.job_id)) continue;
+        (failed_state(t.state) ? ended : live).push_back(std::move(t));
+      }
     } else {
       st.note = "squeue failed: " + q.output.substr(0, q.output.find('\n'));
     }
     const ProcessOutput a =
         run_process({"sacct", "-n", "-P", "-X", "-j", ids, "-o", "JobID,State,ExitCode"});
     if (a.code == 0) {
-      ended = study::parse_slurm_tasks(a.output);
-    } else if (st.note.empty()) {
-      st.note = "sacct unavailable (no Slurm accounting): ended tasks are not listed";
+      for (study::SlurmTask& t : study::parse_slurm_tasks(a.output)) ended.push_back(std::move(t));
     }
   }
   // Global pair index -> running (1) / queued (2).
@@ -433,19 +440,22 @@ Status collect(const std::vector<LoadedBatch>& loaded, const std::string& db) {
     }
   };
   for (const study::SlurmTask& t : live) {
+    if (!live_state(t.state) && t.state != "PENDING") continue;  // COMPLETED and the like
     if (t.task >= 0) {
       mark(t.job_id, t.task, live_state(t.state) ? 1 : 2);
     } else {
       for (const int p : t.pending) mark(t.job_id, p, 2);
     }
   }
-  std::map<std::int64_t, std::string> why_failed;  // first pair index of a failed task
+  // A failed task's pairs [first, first + games per task) and what happened to it.
+  std::map<std::int64_t, std::pair<std::int64_t, std::string>> why_failed;
   for (const study::SlurmTask& t : ended) {
     if (t.task < 0 || !failed_state(t.state) || live_tasks.contains({t.job_id, t.task})) continue;
     const auto g = games_per_task.find(t.job_id);
     if (g == games_per_task.end()) continue;
-    why_failed[static_cast<std::int64_t>(t.task) * g->second] = fmt::format(
-        "task {} (job {}_{}): {}, exit {}", t.task, t.job_id, t.task, t.state, t.detail);
+    why_failed[static_cast<std::int64_t>(t.task) * g->second] = {
+        g->second, fmt::format("task {} (job {}_{}): {}{}", t.task, t.job_id, t.task, t.state,
+                               t.detail.empty() ? "" : " (" + t.detail + ")")};
   }
 
   std::int64_t offset = 0;
@@ -469,9 +479,10 @@ Status collect(const std::vector<LoadedBatch>& loaded, const std::string& db) {
         continue;
       }
       // Missing: name a failed task that held it.
-      for (const auto& [first, text] : why_failed) {
-        const auto gpt = games_per_task.begin()->second;
-        if (g >= first && g < first + gpt && told.insert(text).second) st.failed.push_back(text);
+      for (const auto& [first, what] : why_failed) {
+        if (g >= first && g < first + what.first && told.insert(what.second).second) {
+          st.failed.push_back(what.second);
+        }
       }
     }
     for (const study::Scenario& s : l.file.variants) {
