@@ -455,7 +455,7 @@ Status collect(const std::vector<LoadedBatch>& loaded, const std::string& db) {
     if (g == games_per_task.end()) continue;
     why_failed[static_cast<std::int64_t>(t.task) * g->second] = {
         g->second, fmt::format("task {} (job {}_{}): {}{}", t.task, t.job_id, t.task, t.state,
-                               t.detail.empty() ? "" : " (" + t.detail + ")")};
+                               t.detail.empty() || t.detail == "None" ? "" : " (" + t.detail + ")")};
   }
 
   std::int64_t offset = 0;
