@@ -184,8 +184,8 @@ int batch_submit(const BatchCommandOptions& o, std::ostream& out, std::ostream& 
   script.command = {self, "batch"};
   for (const LoadedBatch& l : loaded) script.command.push_back(l.path);
   script.command.insert(script.command.end(),
-                        {"--db", db, "--games-per-task", std::to_string(o.games_per_task),
-                         "--jobs", std::to_string(script.cpus_per_task)});
+                        {"--db", db, "--games-per-task", std::to_string(o.games_per_task), "--jobs",
+                         std::to_string(script.cpus_per_task)});
   if (o.runs) script.command.insert(script.command.end(), {"--runs", std::to_string(*o.runs)});
   if (!o.seeds.empty()) script.command.insert(script.command.end(), {"--seeds", o.seeds});
   if (o.no_record) {
@@ -454,8 +454,9 @@ Status collect(const std::vector<LoadedBatch>& loaded, const std::string& db) {
     const auto g = games_per_task.find(t.job_id);
     if (g == games_per_task.end()) continue;
     why_failed[static_cast<std::int64_t>(t.task) * g->second] = {
-        g->second, fmt::format("task {} (job {}_{}): {}{}", t.task, t.job_id, t.task, t.state,
-                               t.detail.empty() || t.detail == "None" ? "" : " (" + t.detail + ")")};
+        g->second,
+        fmt::format("task {} (job {}_{}): {}{}", t.task, t.job_id, t.task, t.state,
+                    t.detail.empty() || t.detail == "None" ? "" : " (" + t.detail + ")")};
   }
 
   std::int64_t offset = 0;
@@ -510,8 +511,8 @@ Status collect(const std::vector<LoadedBatch>& loaded, const std::string& db) {
 }
 
 void print_status(const Status& st, const std::string& db, std::ostream& out) {
-  out << fmt::format("{:<32} {:>6} {:>6} {:>7} {:>6} {:>7}\n", "variant", "runs", "done",
-                     "running", "queued", "missing");
+  out << fmt::format("{:<32} {:>6} {:>6} {:>7} {:>6} {:>7}\n", "variant", "runs", "done", "running",
+                     "queued", "missing");
   for (const VariantCount& c : st.variants) {
     out << fmt::format("{:<32} {:>6} {:>6} {:>7} {:>6} {:>7}\n",
                        c.variant.empty() ? "-" : c.variant, c.total, c.done, c.running, c.queued,
@@ -523,9 +524,10 @@ void print_status(const Status& st, const std::string& db, std::ostream& out) {
     const double eta = (st.total - st.done) / *st.per_minute * 60.0;
     rate = fmt::format("games/min   {:.1f}, ETA {}", *st.per_minute, duration_text(eta));
   }
-  out << fmt::format("total       {} of {} runs stored in {} and its shards; {} running, {} "
-                     "queued, {} missing\n{}\n",
-                     st.done, st.total, db, st.running, st.queued, missing, rate);
+  out << fmt::format(
+      "total       {} of {} runs stored in {} and its shards; {} running, {} "
+      "queued, {} missing\n{}\n",
+      st.done, st.total, db, st.running, st.queued, missing, rate);
   for (const std::string& f : st.failed) out << "failed      " << f << "\n";
   if (!st.note.empty()) out << "note        " << st.note << "\n";
   if (missing > 0 && st.running + st.queued == 0) {
@@ -643,8 +645,8 @@ int batch_merge(const MergeOptions& o, std::ostream& out, std::ostream& err) {
       sum.runs_present += c.runs_present;
       sum.batches_finished += c.batches_finished;
       if (!o.quiet) {
-        out << fmt::format("{}: {} runs added, {} already in {}\n", s, c.runs_added,
-                           c.runs_present, o.db);
+        out << fmt::format("{}: {} runs added, {} already in {}\n", s, c.runs_added, c.runs_present,
+                           o.db);
       }
     } catch (const study::StatsError& e) {
       err << who << ": " << e.what() << "\n";
@@ -652,10 +654,11 @@ int batch_merge(const MergeOptions& o, std::ostream& out, std::ostream& err) {
     }
   }
   if (!o.quiet) {
-    out << fmt::format("merged     {} shards into {}: {} runs added, {} already there, {} new "
-                       "batches, {} batches complete\n",
-                       shards.size(), o.db, sum.runs_added, sum.runs_present, sum.batches_added,
-                       sum.batches_finished);
+    out << fmt::format(
+        "merged     {} shards into {}: {} runs added, {} already there, {} new "
+        "batches, {} batches complete\n",
+        shards.size(), o.db, sum.runs_added, sum.runs_present, sum.batches_added,
+        sum.batches_finished);
   }
   return kExitOk;
 }

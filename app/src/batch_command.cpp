@@ -114,7 +114,8 @@ study::SeedChoice seed_choice(const BatchCommandOptions& o) {
   study::SeedChoice c;
   c.runs = o.runs;
   if (!o.seeds.empty()) c.seeds = study::parse_seed_list(o.seeds);
-  if (c.runs && !c.seeds.empty()) throw core::ConfigError("give either --runs or --seeds, not both");
+  if (c.runs && !c.seeds.empty())
+    throw core::ConfigError("give either --runs or --seeds, not both");
   return c;
 }
 
@@ -141,13 +142,13 @@ Action add_batch_command(CLI::App& app) {
   const Action merge_action = add_batch_merge_command(*merge);
 
   app.add_option("scenarios", o->scenarios, "Scenario files (docs/scenarios.md)");
-  auto* runs = app.add_option(
-                      "--runs", o->runs,
-                      "Seeds per variant: the first N of the scenario's list; beyond the list, the "
-                      "seeds after its largest, counting up (a single seed s: s..s+N-1). Default: "
-                      "the scenario's seeds; at most 100000, and at most 100000 games in all "
-                      "(variants x seeds)")
-                   ->check(CLI::PositiveNumber);
+  auto* runs =
+      app.add_option("--runs", o->runs,
+                     "Seeds per variant: the first N of the scenario's list; beyond the list, the "
+                     "seeds after its largest, counting up (a single seed s: s..s+N-1). Default: "
+                     "the scenario's seeds; at most 100000, and at most 100000 games in all "
+                     "(variants x seeds)")
+          ->check(CLI::PositiveNumber);
   app.add_option("--seeds", o->seeds,
                  "Exactly these seeds for every variant instead of the scenario's: a list of "
                  "seeds and ranges, e.g. 1-100 or 1,5,9-12 (at most 100000)")
@@ -179,8 +180,7 @@ Action add_batch_command(CLI::App& app) {
                                 "playing it here; only the missing runs are submitted")
                        ->group(slurm);
   app.add_option("--partition", o->partition, "sbatch --partition")->needs(on_slurm)->group(slurm);
-  app.add_option("--time-limit", o->time_limit,
-                 "sbatch --time per array task, e.g. 30 or 1:00:00")
+  app.add_option("--time-limit", o->time_limit, "sbatch --time per array task, e.g. 30 or 1:00:00")
       ->needs(on_slurm)
       ->group(slurm);
   app.add_option("--array-throttle", o->array_throttle,
@@ -203,7 +203,10 @@ Action add_batch_command(CLI::App& app) {
       ->needs(on_slurm)
       ->group(slurm);
   // What an array task runs (written into the job script, not for users).
-  app.add_option("--task", o->task, "")->check(CLI::NonNegativeNumber)->excludes(on_slurm)->group("");
+  app.add_option("--task", o->task, "")
+      ->check(CLI::NonNegativeNumber)
+      ->excludes(on_slurm)
+      ->group("");
   (void)gpt;
   app.footer(
       "Plays every matrix variant x N seeds of each scenario on worker threads and stores every "

@@ -159,10 +159,10 @@ std::int64_t batch_games(const ScenarioFile& file, const SeedChoice& choice) {
     games += static_cast<std::int64_t>(batch_seeds(s, choice).size());
   }
   if (games > ScenarioLimits::kMaxGames) {
-    const std::string per =
-        !choice.seeds.empty() ? " x --seeds (" + std::to_string(choice.seeds.size()) + " seeds)"
-        : choice.runs         ? " x --runs " + std::to_string(*choice.runs)
-                              : " x their seeds";
+    const std::string per = !choice.seeds.empty()
+                                ? " x --seeds (" + std::to_string(choice.seeds.size()) + " seeds)"
+                            : choice.runs ? " x --runs " + std::to_string(*choice.runs)
+                                          : " x their seeds";
     throw core::ConfigError(file.file + ": " + std::to_string(file.variants.size()) + " variants" +
                             per + " = " + std::to_string(games) + " games: at most " +
                             std::to_string(ScenarioLimits::kMaxGames) +
@@ -206,9 +206,9 @@ BatchKey batch_key(const ScenarioFile& file, const std::string& scenario_hash,
   if (!choice.seeds.empty()) {
     // --seeds that equal `--runs N`'s seeds for every variant are that batch.
     const SeedChoice as_runs{static_cast<int>(choice.seeds.size()), {}};
-    const bool default_seeds = std::all_of(
-        file.variants.begin(), file.variants.end(),
-        [&](const Scenario& s) { return batch_seeds(s, as_runs) == choice.seeds; });
+    const bool default_seeds =
+        std::all_of(file.variants.begin(), file.variants.end(),
+                    [&](const Scenario& s) { return batch_seeds(s, as_runs) == choice.seeds; });
     if (!default_seeds) {
       std::uint64_t h = 0xcbf29ce484222325ULL;  // FNV-1a 64 over the seeds' 8 bytes each (LE)
       for (std::uint64_t seed : choice.seeds) {
@@ -291,7 +291,8 @@ BatchResult run_batch(const ScenarioFile& file, const std::string& scenario_hash
     const BatchPair& p = pairs[static_cast<std::size_t>(k)];
     ++result.total;
     const Scenario& s = file.variants[static_cast<std::size_t>(p.variant)];
-    if (stored.contains({s.variant, p.seed}) || options.stored_elsewhere.contains({s.variant, p.seed})) {
+    if (stored.contains({s.variant, p.seed}) ||
+        options.stored_elsewhere.contains({s.variant, p.seed})) {
       ++result.skipped;
     } else {
       jobs.push_back({&s, p.seed});

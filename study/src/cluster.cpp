@@ -43,7 +43,8 @@ std::vector<std::string> split(std::string_view s, char sep) {
   std::size_t pos = 0;
   for (;;) {
     const std::size_t at = s.find(sep, pos);
-    out.emplace_back(s.substr(pos, at == std::string_view::npos ? std::string_view::npos : at - pos));
+    out.emplace_back(
+        s.substr(pos, at == std::string_view::npos ? std::string_view::npos : at - pos));
     if (at == std::string_view::npos) return out;
     pos = at + 1;
   }
@@ -180,8 +181,10 @@ std::string slurm_script(const SlurmScript& s) {
     << "#SBATCH --ntasks=1\n"
     << "#SBATCH --cpus-per-task=" << s.cpus_per_task << "\n"
     << "#SBATCH --requeue\n";
-  if (!s.partition.empty()) o << "#SBATCH --partition=" << one_line(s.partition, "--partition") << "\n";
-  if (!s.time_limit.empty()) o << "#SBATCH --time=" << one_line(s.time_limit, "--time-limit") << "\n";
+  if (!s.partition.empty())
+    o << "#SBATCH --partition=" << one_line(s.partition, "--partition") << "\n";
+  if (!s.time_limit.empty())
+    o << "#SBATCH --time=" << one_line(s.time_limit, "--time-limit") << "\n";
   if (!s.log_dir.empty()) {
     o << "#SBATCH --output=" << one_line(s.log_dir, "the log directory") << "/slurm-%A_%a.out\n";
   }
@@ -213,8 +216,8 @@ std::vector<SlurmTask> parse_slurm_tasks(std::string_view text) {
     t.detail = w.size() > 2 ? w[2] : "";
     if (index.starts_with("[")) {
       // A pending rest: "[4-9%2]" or "[4,6-7]".
-      index = index.substr(1, index.find(']') == std::string::npos ? std::string::npos
-                                                                    : index.find(']') - 1);
+      index = index.substr(
+          1, index.find(']') == std::string::npos ? std::string::npos : index.find(']') - 1);
       index = index.substr(0, index.find('%'));
       for (const std::string& part : split(index, ',')) {
         const std::size_t dash = part.find('-');
@@ -281,7 +284,8 @@ class Db {
   std::vector<std::string> columns(const std::string& schema, const std::string& table) {
     auto s = prepare("PRAGMA " + schema + ".table_info(" + table + ")");
     std::vector<std::string> out;
-    while (step(s.get())) out.emplace_back(reinterpret_cast<const char*>(sqlite3_column_text(s.get(), 1)));
+    while (step(s.get()))
+      out.emplace_back(reinterpret_cast<const char*>(sqlite3_column_text(s.get(), 1)));
     return out;
   }
 
@@ -366,8 +370,8 @@ MergeCounts merge_shard(const std::string& shard, const std::string& into) {
       add_child.emplace_back(name, db.prepare(copy_sql(cols, name, "run_id", "", "run_id = ?2")));
     }
     std::set<std::int64_t> touched;
-    auto batches = db.prepare(
-        "SELECT id, kind, scenario_hash, runs_per_variant FROM s.batches ORDER BY id");
+    auto batches =
+        db.prepare("SELECT id, kind, scenario_hash, runs_per_variant FROM s.batches ORDER BY id");
     while (db.step(batches.get())) {
       const std::int64_t from = sqlite3_column_int64(batches.get(), 0);
       sqlite3_reset(find_batch.get());
@@ -427,8 +431,9 @@ MergeCounts merge_shard(const std::string& shard, const std::string& into) {
           "SELECT b.runs_per_variant * b.variants - (SELECT count(*) FROM main.runs r WHERE "
           "r.batch_id = b.id) FROM main.batches b WHERE b.id = " +
           std::to_string(id) + " AND b.kind = 'batch' AND b.finished IS NULL");
-      const std::int64_t unfinished = db.int_query(
-          "SELECT count(*) FROM main.batches WHERE finished IS NULL AND id = " + std::to_string(id));
+      const std::int64_t unfinished =
+          db.int_query("SELECT count(*) FROM main.batches WHERE finished IS NULL AND id = " +
+                       std::to_string(id));
       if (unfinished == 1 && missing <= 0) {
         db.exec(
             "UPDATE main.batches SET finished = strftime('%Y-%m-%dT%H:%M:%SZ', 'now') WHERE id = " +
@@ -440,7 +445,8 @@ MergeCounts merge_shard(const std::string& shard, const std::string& into) {
   } catch (...) {
     try {
       db.exec("ROLLBACK");
-    } catch (const StatsError&) {  // NOLINT(bugprone-empty-catch): the first error is the one to tell
+    } catch (
+        const StatsError&) {  // NOLINT(bugprone-empty-catch): the first error is the one to tell
     }
     throw;
   }

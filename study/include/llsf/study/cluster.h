@@ -29,12 +29,12 @@ std::string slurm_dir(const std::string& db);
 
 /// One submission, as kept in the job file (tab-separated, one line).
 struct SlurmJob {
-  std::string job_id;            ///< sbatch's job id of the array
-  std::string submitted;         ///< UTC, ISO 8601 (wall clock; progress only)
-  int games_per_task = 0;        ///< the slice length
-  std::string array;             ///< the --array spec, e.g. "0-3,7%2"
-  std::int64_t stored_at_submit = 0;  ///< runs stored when submitted (for games per minute)
-  std::int64_t total = 0;        ///< runs of the batch
+  std::string job_id;                  ///< sbatch's job id of the array
+  std::string submitted;               ///< UTC, ISO 8601 (wall clock; progress only)
+  int games_per_task = 0;              ///< the slice length
+  std::string array;                   ///< the --array spec, e.g. "0-3,7%2"
+  std::int64_t stored_at_submit = 0;   ///< runs stored when submitted (for games per minute)
+  std::int64_t total = 0;              ///< runs of the batch
   std::vector<std::string> scenarios;  ///< absolute paths
 };
 /// Appends `job` to the job file of `db`. Throws core::ConfigError if it cannot be written.
@@ -46,14 +46,14 @@ std::vector<SlurmJob> read_jobs(const std::string& db);
 /// What a Slurm job script does.
 struct SlurmScript {
   std::string job_name = "llsfsim";
-  std::string partition;             ///< "" = the cluster's default
-  std::string time_limit;            ///< per task, sbatch --time ("" = the partition's)
-  int array_throttle = 0;            ///< %K: at most K tasks at once; 0 = no limit
-  int cpus_per_task = 1;             ///< = the task's --jobs
-  std::vector<int> tasks;            ///< the array's task ids
+  std::string partition;                 ///< "" = the cluster's default
+  std::string time_limit;                ///< per task, sbatch --time ("" = the partition's)
+  int array_throttle = 0;                ///< %K: at most K tasks at once; 0 = no limit
+  int cpus_per_task = 1;                 ///< = the task's --jobs
+  std::vector<int> tasks;                ///< the array's task ids
   std::vector<std::string> sbatch_args;  ///< extra `#SBATCH` lines, verbatim
-  std::string log_dir;               ///< slurm-%A_%a.out goes there
-  std::vector<std::string> command;  ///< the task's command; SLURM_ARRAY_TASK_ID is appended
+  std::string log_dir;                   ///< slurm-%A_%a.out goes there
+  std::vector<std::string> command;      ///< the task's command; SLURM_ARRAY_TASK_ID is appended
 };
 /// "0-3,7,9-10" (ranges of consecutive ids) followed by "%K" when throttled.
 std::string array_spec(const std::vector<int>& tasks, int throttle);
@@ -66,8 +66,8 @@ std::string shell_quote(std::string_view s);
 
 /// One array task as squeue or sacct reports it.
 struct SlurmTask {
-  std::string job_id;  ///< the array's job id ("123")
-  int task = -1;       ///< the array index; -1 for the pending rest of an array ("[4-9%2]")
+  std::string job_id;        ///< the array's job id ("123")
+  int task = -1;             ///< the array index; -1 for the pending rest of an array ("[4-9%2]")
   std::vector<int> pending;  ///< the indices of a pending rest
   std::string state;   ///< RUNNING, PENDING, COMPLETED, FAILED, CANCELLED, TIMEOUT, NODE_FAIL, ...
   std::string detail;  ///< reason (squeue) or exit code (sacct)
@@ -79,9 +79,9 @@ std::vector<SlurmTask> parse_slurm_tasks(std::string_view text);
 
 /// What merge_shard() did.
 struct MergeCounts {
-  int batches_added = 0;  ///< batches the target did not have
-  int runs_added = 0;     ///< runs copied
-  int runs_present = 0;   ///< runs the target held already (not copied again)
+  int batches_added = 0;     ///< batches the target did not have
+  int runs_added = 0;        ///< runs copied
+  int runs_present = 0;      ///< runs the target held already (not copied again)
   int batches_finished = 0;  ///< batches that became complete by the merge
 };
 /// Copies every run of the SQLite store `shard` that the SQLite store `into` lacks, with its
