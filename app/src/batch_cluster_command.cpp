@@ -121,13 +121,6 @@ const std::string& variant_name(const LoadedBatch& l, const study::BatchPair& p)
   return l.file.variants[static_cast<std::size_t>(p.variant)].variant;
 }
 
-// Loads the scenarios by absolute path (an array task on another node sees the same files).
-std::vector<LoadedBatch> load_absolute(const BatchCommandOptions& o) {
-  std::vector<std::string> paths;
-  for (const std::string& p : o.scenarios) paths.push_back(absolute(p));
-  return load_batches(paths, seed_choice(o));
-}
-
 }  // namespace
 
 // ---- batch --slurm ----------------------------------------------------------------------------
@@ -138,7 +131,7 @@ int batch_submit(const BatchCommandOptions& o, std::ostream& out, std::ostream& 
   std::vector<std::set<Pair>> stored;
   const std::string db = study::is_database_url(o.db) ? o.db : absolute(o.db);
   try {
-    loaded = load_absolute(o);
+    loaded = load_batches(o.scenarios, seed_choice(o));
     stored = stored_pairs(db, loaded);
   } catch (const core::UserError& e) {
     err << who << ": " << e.what() << "\n";
@@ -177,7 +170,10 @@ int batch_submit(const BatchCommandOptions& o, std::ostream& out, std::ostream& 
   script.cpus_per_task = o.jobs.value_or(1);
   script.tasks.assign(tasks.begin(), tasks.end());
   script.sbatch_args = o.sbatch_args;
-  script.log_dir = study::is_database_url(db) ? absolute("llsfsim-slurm") : study::slurm_dir(db);
+  script.log_dir = study::slurm_dir(db);
+  // The tasks start in this directory: scenario paths as given name the same files (and the
+  // same batch identity, which names the agent files as the scenario reaches them).
+  script.workdir = fs::current_path().string();
   std::error_code ec;
   std::string self = fs::read_symlink("/proc/self/exe", ec).string();
   if (ec) self = "llsfsim";
@@ -245,7 +241,7 @@ int batch_submit(const BatchCommandOptions& o, std::ostream& out, std::ostream& 
   job.stored_at_submit = done;
   job.total = total;
   for (const LoadedBatch& l : loaded) job.scenarios.push_back(l.path);
-  if (!study::is_database_url(db)) study::append_job(db, job);
+  study::append_job(db, job);
   if (!o.quiet) {
     out << fmt::format(
         "submitted  job {} (array {}): {} of {} runs missing, {} games per task\n"
@@ -395,8 +391,7 @@ bool failed_state(const std::string& s) {
 Status collect(const std::vector<LoadedBatch>& loaded, const std::string& db) {
   Status st;
   const std::vector<std::set<Pair>> stored = stored_pairs(db, loaded);
-  const std::vector<study::SlurmJob> jobs =
-      study::is_database_url(db) ? std::vector<study::SlurmJob>{} : study::read_jobs(db);
+  const std::vector<study::SlurmJob> jobs = study::read_jobs(db);
 
   // What Slurm says about the recorded arrays: the live tasks (squeue) and the ended ones (sacct).
   std::map<std::string, int> games_per_task;
@@ -545,7 +540,7 @@ int batch_status(const StatusOptions& o, std::ostream& out, std::ostream& err) {
   std::vector<LoadedBatch> loaded;
   Status st;
   try {
-    loaded = load_absolute(bo);
+    loaded = load_batches(bo.scenarios, seed_choice(bo));
     st = collect(loaded, db);
   } catch (const core::UserError& e) {
     err << who << ": " << e.what() << "\n";

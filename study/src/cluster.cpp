@@ -75,9 +75,34 @@ std::vector<std::string> existing_shards(const std::string& db) {
   return out;
 }
 
-std::string job_file_path(const std::string& db) { return db + ".slurm-jobs"; }
+namespace {
 
-std::string slurm_dir(const std::string& db) { return store_stem(db).string() + "-slurm"; }
+// A database URL as a file name: host, port and database, no user or password.
+std::string url_file_name(std::string_view url) {
+  std::string_view rest = url.substr(url.find("://") + 3);
+  if (const std::size_t at = rest.rfind('@'); at != std::string_view::npos)
+    rest = rest.substr(at + 1);
+  rest = rest.substr(0, rest.find('?'));
+  std::string out;
+  for (const char c : rest) {
+    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                    c == '-' || c == '.' || c == '_';
+    out += ok ? c : '_';
+  }
+  return out.empty() ? "database" : out;
+}
+
+}  // namespace
+
+std::string job_file_path(const std::string& db) {
+  if (is_database_url(db)) return slurm_dir(db) + "/" + url_file_name(db) + ".slurm-jobs";
+  return db + ".slurm-jobs";
+}
+
+std::string slurm_dir(const std::string& db) {
+  if (is_database_url(db)) return (fs::current_path() / "llsfsim-slurm").string();
+  return store_stem(db).string() + "-slurm";
+}
 
 // ---- the job file -----------------------------------------------------------------------------
 
@@ -185,6 +210,7 @@ std::string slurm_script(const SlurmScript& s) {
     o << "#SBATCH --partition=" << one_line(s.partition, "--partition") << "\n";
   if (!s.time_limit.empty())
     o << "#SBATCH --time=" << one_line(s.time_limit, "--time-limit") << "\n";
+  if (!s.workdir.empty()) o << "#SBATCH --chdir=" << one_line(s.workdir, "the directory") << "\n";
   if (!s.log_dir.empty()) {
     o << "#SBATCH --output=" << one_line(s.log_dir, "the log directory") << "/slurm-%A_%a.out\n";
   }

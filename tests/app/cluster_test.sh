@@ -11,8 +11,8 @@
 #  (e) --runs / --seeds beyond the scenario's seed list.
 # Usage: cluster_test.sh LLSFSIM SOURCE_DIR
 set -euo pipefail
-L=$1
-SRC=$2
+L=$(realpath "$1")
+SRC=$(realpath "$2")
 T=$(mktemp -d /tmp/llsf-cluster-test.XXXXXX)
 cleanup() {
   "$SRC/scripts/test-slurm-cluster" stop "$T/slurm" || true
@@ -45,7 +45,9 @@ matrix:
 tests:
   - no_agent_errors: true
 YAML
-S=$T/tiny.yaml
+# The scenario by a relative path: the tasks start in this directory (#SBATCH --chdir).
+cd "$T"
+S=tiny.yaml
 hashes() { sqlite3 "$1" "SELECT variant, seed, result_hash FROM runs ORDER BY variant, seed"; }
 wait_batch() {  # db, runs args...: follow until nothing is left running or queued
   local db=$1; shift
@@ -61,6 +63,8 @@ has "$out" "#SBATCH --time=0:10:00"
 has "$out" "#SBATCH --mem=1G"
 has "$out" "#SBATCH --cpus-per-task=2"
 has "$out" "#SBATCH --requeue"
+has "$out" "#SBATCH --chdir=$T"
+has "$out" "batch tiny.yaml --db $T/dry.db"
 has "$out" "--games-per-task 7 --jobs 2 --runs 20"
 has "$out" '--task "$SLURM_ARRAY_TASK_ID"'
 [ ! -e "$T/dry.db" ] || fail "--dry-run wrote the store"

@@ -100,6 +100,7 @@ TEST_CASE("Slurm: array specs, the job script, squeue and sacct lines") {
   s.cpus_per_task = 2;
   s.sbatch_args = {"--mem=1G", "--qos=low"};
   s.log_dir = "/shared/x-slurm";
+  s.workdir = "/shared";
   s.command = {"/opt/llsfsim", "batch", "/shared/a b.yaml", "--db", "/shared/x.db"};
   const std::string text = llsf::study::slurm_script(s);
   CHECK(text.starts_with("#!/bin/bash\n"));
@@ -109,7 +110,8 @@ TEST_CASE("Slurm: array specs, the job script, squeue and sacct lines") {
   CHECK(text.find("#SBATCH --cpus-per-task=2\n") != std::string::npos);
   CHECK(text.find("#SBATCH --requeue\n") != std::string::npos);
   CHECK(text.find("#SBATCH --mem=1G\n#SBATCH --qos=low\n") != std::string::npos);
-  CHECK(text.find("#SBATCH --output=/shared/x-slurm/slurm-%A_%a.out\n") != std::string::npos);
+  CHECK(text.find("#SBATCH --chdir=/shared\n#SBATCH --output=/shared/x-slurm/slurm-%A_%a.out\n") !=
+        std::string::npos);
   CHECK(text.find("exec /opt/llsfsim batch '/shared/a b.yaml' --db /shared/x.db --task "
                   "\"$SLURM_ARRAY_TASK_ID\"\n") != std::string::npos);
   s.sbatch_args = {"--mem=1G\nrm -rf /"};
@@ -163,6 +165,8 @@ TEST_CASE("Slurm: shard names, the job file") {
   CHECK_THROWS_WITH_AS(llsf::study::read_jobs(db),
                        doctest::Contains("slurm-jobs:3: not a job line"), ConfigError);
   CHECK(llsf::study::is_database_url("postgresql://u@h:5432/db"));
+  CHECK(llsf::study::job_file_path("postgresql://u:pw@h:5432/db?sslmode=require")
+            .ends_with("/llsfsim-slurm/h_5432_db.slurm-jobs"));
   CHECK(!llsf::study::is_database_url("study.db"));
 }
 

@@ -22,9 +22,11 @@ std::string shard_path(const std::string& db, int task);
 /// The shards of `db` that exist, by name.
 std::vector<std::string> existing_shards(const std::string& db);
 
-/// The job file beside the store, "<db>.slurm-jobs": one line per submission (SlurmJob).
+/// The job file beside the store, "<db>.slurm-jobs": one line per submission (SlurmJob); for a
+/// database server "llsfsim-slurm/<host and database>.slurm-jobs" in the current directory.
 std::string job_file_path(const std::string& db);
-/// The directory beside the store for job scripts and the tasks' logs, "<dir>/<stem>-slurm".
+/// The directory beside the store for job scripts and the tasks' logs, "<dir>/<stem>-slurm";
+/// for a database server "llsfsim-slurm" in the current directory (absolute).
 std::string slurm_dir(const std::string& db);
 
 /// One submission, as kept in the job file (tab-separated, one line).
@@ -53,6 +55,7 @@ struct SlurmScript {
   std::vector<int> tasks;                ///< the array's task ids
   std::vector<std::string> sbatch_args;  ///< extra `#SBATCH` lines, verbatim
   std::string log_dir;                   ///< slurm-%A_%a.out goes there
+  std::string workdir;                   ///< sbatch --chdir: where the tasks start ("" = sbatch's)
   std::vector<std::string> command;      ///< the task's command; SLURM_ARRAY_TASK_ID is appended
 };
 /// "0-3,7,9-10" (ranges of consecutive ids) followed by "%K" when throttled.
