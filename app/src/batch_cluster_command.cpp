@@ -639,6 +639,7 @@ int batch_merge(const MergeOptions& o, std::ostream& out, std::ostream& err) {
       sum.runs_added += c.runs_added;
       sum.runs_present += c.runs_present;
       sum.batches_finished += c.batches_finished;
+      sum.runs_differing += c.runs_differing;
       if (!o.quiet) {
         out << fmt::format("{}: {} runs added, {} already in {}\n", s, c.runs_added, c.runs_present,
                            o.db);
@@ -647,6 +648,11 @@ int batch_merge(const MergeOptions& o, std::ostream& out, std::ostream& err) {
       err << who << ": " << e.what() << "\n";
       return kExitBadInput;
     }
+  }
+  if (sum.runs_differing > 0) {
+    err << who << ": " << sum.runs_differing
+        << " runs of the shards have another result hash than the same (variant, seed) in " << o.db
+        << " (kept: the store's); were they played by different llsfsim versions?\n";
   }
   if (!o.quiet) {
     out << fmt::format(

@@ -387,8 +387,8 @@ MergeCounts merge_shard(const std::string& shard, const std::string& into) {
         "SELECT id FROM main.batches WHERE kind = ?1 AND scenario_hash = ?2 AND "
         "runs_per_variant = ?3");
     auto add_batch = db.prepare(copy_sql(batch_cols, "batches", "finished", "id", "id = ?2"));
-    auto find_run =
-        db.prepare("SELECT 1 FROM main.runs WHERE batch_id = ?1 AND variant = ?2 AND seed = ?3");
+    auto find_run = db.prepare(
+        "SELECT result_hash FROM main.runs WHERE batch_id = ?1 AND variant = ?2 AND seed = ?3");
     auto add_run = db.prepare(copy_sql(run_cols, "runs", "batch_id", "id", "id = ?2"));
     auto set_recording = db.prepare("UPDATE main.runs SET recording = ?1 WHERE id = ?2");
     std::vector<std::pair<std::string, std::unique_ptr<sqlite3_stmt, StmtFinalizer>>> add_child;
@@ -416,7 +416,9 @@ MergeCounts merge_shard(const std::string& shard, const std::string& into) {
         ++counts.batches_added;
       }
       auto runs = db.prepare(
-          "SELECT id, variant, seed, recording FROM s.runs WHERE batch_id = ?1 ORDER BY id");
+          "SELECT id, variant, seed, recording, result_hash FROM s.runs WHERE batch_id = ?1 ORDER "
+          "BY "
+          "id");
       sqlite3_bind_int64(runs.get(), 1, from);
       while (db.step(runs.get())) {
         sqlite3_reset(find_run.get());
@@ -425,6 +427,9 @@ MergeCounts merge_shard(const std::string& shard, const std::string& into) {
         sqlite3_bind_int64(find_run.get(), 3, sqlite3_column_int64(runs.get(), 2));
         if (db.step(find_run.get())) {
           ++counts.runs_present;
+          // The same (variant, seed) of one batch is the same game: a different result means
+          // different programs (llsfsim versions, data directories) played the two copies.
+          if (text(find_run.get(), 0) != text(runs.get(), 4)) ++counts.runs_differing;
           continue;
         }
         const std::int64_t run_from = sqlite3_column_int64(runs.get(), 0);

@@ -98,6 +98,13 @@ before=$(sqlite3 "$T/cluster.db" .dump | md5sum)
 out=$("$L" batch merge --db "$T/cluster.db")
 has "$out" "0 runs added, 40 already there"
 [ "$(sqlite3 "$T/cluster.db" .dump | md5sum)" = "$before" ] || fail "the second merge changed the store"
+# A shard whose copy of a stored run differs (another program played it): said, the store's kept.
+cp "$T/cluster.db" "$T/c2.db"
+cp "$T/cluster.shard-00000.db" "$T/c2-shard.db"
+sqlite3 "$T/c2-shard.db" "UPDATE runs SET result_hash = '0000000000000000' WHERE id = 1"
+out=$("$L" batch merge "$T/c2-shard.db" --db "$T/c2.db" 2>&1)
+has "$out" "1 runs of the shards have another result hash"
+[ "$(hashes "$T/c2.db")" = "$(hashes "$T/local.db")" ] || fail "a differing shard changed the store"
 
 # (b) one array task cancelled mid-slice; status names it; resubmission plays only what is missing.
 out=$("$L" batch "$S" --runs 20 --db "$T/cancel.db" --slurm --games-per-task 8 --array-throttle 1)

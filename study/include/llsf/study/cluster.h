@@ -85,6 +85,7 @@ struct MergeCounts {
   int batches_added = 0;     ///< batches the target did not have
   int runs_added = 0;        ///< runs copied
   int runs_present = 0;      ///< runs the target held already (not copied again)
+  int runs_differing = 0;    ///< of those, runs whose result hash differs from the shard's copy
   int batches_finished = 0;  ///< batches that became complete by the merge
 };
 /// Copies every run of the SQLite store `shard` that the SQLite store `into` lacks, with its
