@@ -556,14 +556,11 @@ int batch_status(const StatusOptions& o, std::ostream& out, std::ostream& err) {
   int last_done = -1;
   for (;;) {
     if (st.done != last_done || bar) {
-      constexpr int kWidth = 30;
-      const int filled = st.total > 0 ? kWidth * st.done / st.total : kWidth;
       const std::string eta =
           st.per_minute ? duration_text((st.total - st.done) / *st.per_minute * 60.0) : "-";
-      err << fmt::format("{}[{}{}] {}/{} runs, {} running, {} queued, {:.1f} games/min, ETA {}{}",
-                         bar ? "\r" : "", std::string(static_cast<std::size_t>(filled), '#'),
-                         std::string(static_cast<std::size_t>(kWidth - filled), '.'), st.done,
-                         st.total, st.running, st.queued, st.per_minute.value_or(0.0), eta,
+      err << fmt::format("{}{} {}/{} runs, {} running, {} queued, {:.1f} games/min, ETA {}{}",
+                         bar ? "\r" : "", progress_bar(st.done, st.total), st.done, st.total,
+                         st.running, st.queued, st.per_minute.value_or(0.0), eta,
                          bar ? "   " : "\n");
       err.flush();
       last_done = st.done;
