@@ -351,12 +351,12 @@ namespace {
 
 struct StatusOptions {
   std::vector<std::string> scenarios;
-  std::string runs_text;
   std::optional<int> runs;
   std::string seeds;
   std::string db{study::StatsStore::kDefaultPath};
   bool wait = false;
   double interval_s = 5.0;
+  int resubmit = 0;  ///< --wait: resubmissions of the missing tasks at most
 };
 
 struct VariantCount {
@@ -376,6 +376,9 @@ struct Status {
   std::optional<double> per_minute;
   std::vector<std::string> failed;  ///< "task 3 (job 123_3): CANCELLED ..." with missing runs
   std::string note;                 ///< e.g. sacct unavailable
+  /// The tasks (of the last submission's games per task) holding a run that is neither stored
+  /// nor in a live task.
+  std::set<int> missing_tasks;
 };
 
 bool live_state(const std::string& s) {
@@ -474,7 +477,8 @@ Status collect(const std::vector<LoadedBatch>& loaded, const std::string& db) {
         (a->second == 1 ? c.running : c.queued) += 1;
         continue;
       }
-      // Missing: name a failed task that held it.
+      // Missing: its task in the last submission's cut, and a failed task that held it.
+      if (!jobs.empty()) st.missing_tasks.insert(static_cast<int>(g / jobs.back().games_per_task));
       for (const auto& [first, what] : why_failed) {
         if (g >= first && g < first + what.first && told.insert(what.second).second) {
           st.failed.push_back(what.second);
@@ -530,6 +534,49 @@ void print_status(const Status& st, const std::string& db, std::ostream& out) {
   }
 }
 
+// Submits the tasks of `st.missing_tasks` again with the last submission's job script (sbatch's
+// --array overrides the script's); records the job. Returns false (and says why) if it cannot.
+bool resubmit(const Status& st, const std::string& db, std::ostream& err) {
+  const std::vector<study::SlurmJob> jobs = study::read_jobs(db);
+  if (jobs.empty() || st.missing_tasks.empty()) return false;
+  // The last job script: study-slurm/job-N.sh with the largest N.
+  std::string script;
+  int largest = 0;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(study::slurm_dir(db), ec)) {
+    const std::string name = e.path().filename().string();
+    if (!name.starts_with("job-") || !name.ends_with(".sh")) continue;
+    const int n = std::atoi(name.c_str() + 4);
+    if (n > largest) {
+      largest = n;
+      script = e.path().string();
+    }
+  }
+  if (script.empty()) {
+    err << "llsfsim batch status: no job script in " << study::slurm_dir(db) << " to resubmit\n";
+    return false;
+  }
+  const std::vector<int> tasks(st.missing_tasks.begin(), st.missing_tasks.end());
+  const std::string array = study::array_spec(tasks, 0);
+  const ProcessOutput sb = run_process({"sbatch", "--parsable", "--array=" + array, script});
+  const std::string job_id = sb.output.substr(0, sb.output.find_first_of(";\n"));
+  if (sb.code != 0 || job_id.empty()) {
+    err << "llsfsim batch status: sbatch " << script << " failed:\n" << sb.output;
+    return false;
+  }
+  study::SlurmJob job = jobs.back();
+  job.job_id = job_id;
+  job.submitted = utc_now();
+  job.array = array;
+  job.stored_at_submit = st.done;
+  study::append_job(db, job);
+  err << fmt::format(
+      "llsfsim batch status: resubmitted the tasks holding the {} missing runs: job {} "
+      "(array {})\n",
+      st.total - st.done - st.running - st.queued, job_id, array);
+  return true;
+}
+
 int batch_status(const StatusOptions& o, std::ostream& out, std::ostream& err) {
   const std::string who = "llsfsim batch status";
   BatchCommandOptions bo;
@@ -554,6 +601,7 @@ int batch_status(const StatusOptions& o, std::ostream& out, std::ostream& err) {
   const SigintGuard sigint;
   const bool bar = &err == &std::cerr && isatty(STDERR_FILENO) != 0;
   int last_done = -1;
+  int resubmits_left = o.resubmit;
   for (;;) {
     if (st.done != last_done || bar) {
       const std::string eta =
@@ -566,7 +614,14 @@ int batch_status(const StatusOptions& o, std::ostream& out, std::ostream& err) {
       last_done = st.done;
     }
     if (st.done == st.total || SigintGuard::interrupted()) break;
-    if (st.running + st.queued == 0) break;  // nothing left that could store the rest
+    if (st.running + st.queued == 0) {  // nothing left that could store the rest
+      if (resubmits_left == 0) break;
+      if (bar) err << "\n";
+      for (const std::string& f : st.failed) err << "failed      " << f << "\n";
+      if (!resubmit(st, db, err)) break;
+      --resubmits_left;
+      last_done = -1;
+    }
     std::this_thread::sleep_for(std::chrono::duration<double>(o.interval_s));
     try {
       st = collect(loaded, db);
@@ -589,9 +644,16 @@ Action add_batch_status_command(CLI::App& sub) {
   auto* runs = sub.add_option("--runs", o->runs, "As given to `batch`")->check(CLI::PositiveNumber);
   sub.add_option("--seeds", o->seeds, "As given to `batch`")->excludes(runs);
   sub.add_option("--db", o->db, "The statistics store given to `batch`")->capture_default_str();
-  sub.add_flag("--wait", o->wait,
-               "Follow the batch with a progress bar until every run is stored (exit 0), or "
-               "until no task is left running or queued with runs missing (exit 1)");
+  auto* wait =
+      sub.add_flag("--wait", o->wait,
+                   "Follow the batch with a progress bar until every run is stored (exit 0), or "
+                   "until no task is left running or queued with runs missing (exit 1)");
+  sub.add_option("--resubmit", o->resubmit,
+                 "With --wait: when runs are missing and no task is left (a task failed, was "
+                 "cancelled or timed out), submit the tasks holding them again with the last job "
+                 "script, at most N times")
+      ->check(CLI::Range(0, 1000))
+      ->needs(wait);
   sub.add_option("--interval", o->interval_s, "Seconds between two looks with --wait")
       ->check(CLI::Range(0.1, 3600.0))
       ->capture_default_str();

@@ -136,6 +136,21 @@ wait_batch "$T/cancel.db" --runs 20
   fail "a half-written run"
 [ "$(hashes "$T/local.db")" = "$(hashes "$T/cancel.db")" ] || fail "hashes differ after the resubmission"
 
+# (b') the same, retried by `batch status --wait --resubmit 1`: 12 games, tasks of 6, one at a time.
+out=$("$L" batch "$S" --seeds 100-105 --db "$T/retry.db" --slurm --games-per-task 6 --array-throttle 1)
+job=$(sed -n 's/^submitted  job \([0-9]*\) .*/\1/p' <<<"$out")
+for _ in $(seq 600); do
+  n=$(sqlite3 "$T/retry.shard-00000.db" "SELECT count(*) FROM runs" 2>/dev/null || echo 0)
+  [ "$n" -ge 1 ] && break
+  sleep 0.05
+done
+scancel "${job}_0"
+"$L" batch status "$S" --seeds 100-105 --db "$T/retry.db" --wait --resubmit 1 --interval 0.5 \
+  > "$T/retry.out" 2> "$T/retry.err" || fail "--resubmit did not complete: $(cat "$T/retry.out" "$T/retry.err")"
+has "$(cat "$T/retry.err")" "resubmitted the tasks holding the"
+has "$(cat "$T/retry.err")" "(array 0)"
+has "$(cat "$T/retry.out")" "12 of 12 runs stored"
+
 # (e) --runs and --seeds beyond the file's list [3, 4]: seeds after the largest, counting up.
 [ "$(sqlite3 "$T/local.db" "SELECT group_concat(seed) FROM (SELECT DISTINCT seed FROM runs ORDER BY seed)")" = \
   "3,4,5,6,7,8,9,10,11,12,13,14,15,16,17,18,19,20,21,22" ] || fail "--runs 20 seeds"
