@@ -19,6 +19,7 @@ cleanup() {
   rm -rf "$T"
 }
 trap cleanup EXIT
+trap 'exit 143' TERM INT
 fail() { echo "cluster_test: FAIL: $*" >&2; exit 1; }
 has() { grep -qF -- "$2" <<<"$1" || fail "expected '$2' in: $1"; }
 
