@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "batch_cluster.h"
 #include "batch_progress.h"
 #include "commands.h"
 #include "llsf/app/cli.h"
@@ -22,24 +23,7 @@ namespace llsf::app {
 
 namespace {
 
-struct BatchCommandOptions {
-  std::vector<std::string> scenarios;
-  std::optional<int> runs;
-  std::optional<int> jobs;
-  std::string db{study::StatsStore::kDefaultPath};
-  std::string recordings;  ///< "" = default_recordings_dir(db)
-  bool no_record = false;
-  bool record_agents = false;
-  bool quiet = false;
-};
-
-struct Loaded {
-  std::string path;
-  study::ScenarioFile file;
-  std::string hash;
-};
-
-void print_summary(const Loaded& l, const study::BatchResult& b, const std::string& db,
+void print_summary(const LoadedBatch& l, const study::BatchResult& b, const std::string& db,
                    const std::string& recordings, std::ostream& out) {
   out << fmt::format("batch      {} ({}) #{} in {}: {} runs, {} played, {} stored before\n",
                      l.file.variants.front().name, l.path, b.batch_id, db, b.total, b.played,
@@ -71,15 +55,16 @@ void print_summary(const Loaded& l, const study::BatchResult& b, const std::stri
 }
 
 int batch(const BatchCommandOptions& o, std::ostream& out, std::ostream& err) {
+  if (o.scenarios.empty()) {
+    err << "llsfsim batch: give one or more scenario files (or: batch status, batch merge)\n";
+    return kExitBadInput;
+  }
+  if (o.slurm) return batch_submit(o, out, err);
+  if (o.task) return batch_task(o, out, err);
   // Load and check everything before the first game: bad input costs no time.
-  std::vector<Loaded> loaded;
+  std::vector<LoadedBatch> loaded;
   try {
-    for (const std::string& path : o.scenarios) {
-      Loaded l{path, study::load_scenario(path), ""};
-      l.hash = study::batch_identity_hash(path, l.file);
-      (void)study::batch_games(l.file, o.runs);  // each variant's seeds, within the budget
-      loaded.push_back(std::move(l));
-    }
+    loaded = load_batches(o.scenarios, seed_choice(o));
   } catch (const core::UserError& e) {
     err << "llsfsim batch: " << e.what() << "\n";
     return kExitBadInput;
@@ -97,9 +82,9 @@ int batch(const BatchCommandOptions& o, std::ostream& out, std::ostream& err) {
   // A bar on a terminal; otherwise (logs, tests) one line per stored run.
   BatchProgressPrinter progress("llsfsim batch", err, o.quiet);
   bool all_passed = true;
-  for (const Loaded& l : loaded) {
+  for (const LoadedBatch& l : loaded) {
     study::BatchOptions options;
-    options.runs = o.runs;
+    options.choice = l.choice;
     options.jobs = o.jobs.value_or(0);
     options.record_agents = o.record_agents;
     if (!o.no_record)
@@ -125,17 +110,55 @@ int batch(const BatchCommandOptions& o, std::ostream& out, std::ostream& err) {
 
 }  // namespace
 
+study::SeedChoice seed_choice(const BatchCommandOptions& o) {
+  study::SeedChoice c;
+  c.runs = o.runs;
+  if (!o.seeds.empty()) c.seeds = study::parse_seed_list(o.seeds);
+  if (c.runs && !c.seeds.empty())
+    throw core::ConfigError("give either --runs or --seeds, not both");
+  return c;
+}
+
+std::vector<LoadedBatch> load_batches(const std::vector<std::string>& paths,
+                                      const study::SeedChoice& choice) {
+  std::vector<LoadedBatch> out;
+  for (const std::string& path : paths) {
+    LoadedBatch l{path, study::load_scenario(path), "", choice, {}, {}};
+    l.hash = study::batch_identity_hash(path, l.file);
+    l.pairs = study::batch_pairs(l.file, choice);  // each variant's seeds, within the budget
+    l.key = study::batch_key(l.file, l.hash, choice);
+    out.push_back(std::move(l));
+  }
+  return out;
+}
+
 Action add_batch_command(CLI::App& app) {
   auto o = std::make_shared<BatchCommandOptions>();
-  app.add_option("scenarios", o->scenarios, "Scenario files (docs/scenarios.md)")->required();
-  app.add_option("--runs", o->runs,
-                 "Seeds per variant: the first N of the scenario's list, or s..s+N-1 for a "
-                 "single seed s (default: the scenario's seeds); at most 100000, and at most "
-                 "100000 games in all (variants x seeds)")
+  CLI::App* status = app.add_subcommand(
+      "status", "Progress of a batch from the store (and squeue): done, running, missing, ETA");
+  const Action status_action = add_batch_status_command(*status);
+  CLI::App* merge = app.add_subcommand(
+      "merge", "Fold the SQLite shards of Slurm array tasks into one store (idempotent)");
+  const Action merge_action = add_batch_merge_command(*merge);
+
+  app.add_option("scenarios", o->scenarios, "Scenario files (docs/scenarios.md)");
+  auto* runs =
+      app.add_option("--runs", o->runs,
+                     "Seeds per variant: the first N of the scenario's list; beyond the list, the "
+                     "seeds after its largest, counting up (a single seed s: s..s+N-1). Default: "
+                     "the scenario's seeds; at most 100000, and at most 100000 games in all "
+                     "(variants x seeds)")
+          ->check(CLI::PositiveNumber);
+  app.add_option("--seeds", o->seeds,
+                 "Exactly these seeds for every variant instead of the scenario's: a list of "
+                 "seeds and ranges, e.g. 1-100 or 1,5,9-12 (at most 100000)")
+      ->excludes(runs);
+  app.add_option("--jobs,-j", o->jobs,
+                 "Games played at once (default: the number of cores; with --slurm: 1 per array "
+                 "task, its --cpus-per-task)")
       ->check(CLI::PositiveNumber);
-  app.add_option("--jobs,-j", o->jobs, "Games played at once (default: the number of cores)")
-      ->check(CLI::PositiveNumber);
-  app.add_option("--db", o->db, "Statistics store (SQLite; docs/statistics.md)")
+  app.add_option("--db", o->db,
+                 "Statistics store (SQLite; docs/statistics.md); with --slurm on shared storage")
       ->capture_default_str();
   auto* rec = app.add_option(
       "--recordings", o->recordings,
@@ -149,15 +172,57 @@ Action add_batch_command(CLI::App& app) {
                "docs/benchmarks.md)")
       ->excludes(no_rec);
   app.add_flag("-q,--quiet", o->quiet, "No progress and no summary, only the exit code");
+
+  // Slurm (docs/cluster.md).
+  const std::string slurm = "Slurm (docs/cluster.md)";
+  auto* on_slurm = app.add_flag("--slurm", o->slurm,
+                                "Submit the batch as a Slurm job array (sbatch) instead of "
+                                "playing it here; only the missing runs are submitted")
+                       ->group(slurm);
+  app.add_option("--partition", o->partition, "sbatch --partition")->needs(on_slurm)->group(slurm);
+  app.add_option("--time-limit", o->time_limit, "sbatch --time per array task, e.g. 30 or 1:00:00")
+      ->needs(on_slurm)
+      ->group(slurm);
+  app.add_option("--array-throttle", o->array_throttle,
+                 "At most K array tasks at once (sbatch --array=...%K)")
+      ->check(CLI::PositiveNumber)
+      ->needs(on_slurm)
+      ->group(slurm);
+  auto* gpt = app.add_option("--games-per-task", o->games_per_task,
+                             "Games per array task (a slice of the batch's (variant, seed) "
+                             "pairs); keep it when resubmitting")
+                  ->check(CLI::Range(1, 100000))
+                  ->capture_default_str()
+                  ->group(slurm);
+  app.add_option("--sbatch-arg", o->sbatch_args,
+                 "An extra sbatch argument, as an #SBATCH line (repeatable), e.g. "
+                 "--sbatch-arg=--mem=2G")
+      ->needs(on_slurm)
+      ->group(slurm);
+  app.add_flag("--dry-run", o->dry_run, "Print the job script; submit nothing, write nothing")
+      ->needs(on_slurm)
+      ->group(slurm);
+  // What an array task runs (written into the job script, not for users).
+  app.add_option("--task", o->task, "")
+      ->check(CLI::NonNegativeNumber)
+      ->excludes(on_slurm)
+      ->group("");
+  (void)gpt;
   app.footer(
       "Plays every matrix variant x N seeds of each scenario on worker threads and stores every "
       "run in the statistics store, with a recording of every game (docs/recording.md). "
       "Resumable: runs the store already holds for the same "
-      "scenario file content and --runs are not played again; Ctrl-C stores the running games "
-      "and stops.\n"
-      "Exit code: 0 every run passed its test cases, 1 one failed, 2 bad input, 3 internal "
-      "error (a bug: please report it), 130 interrupted.");
-  return [o](std::ostream& out, std::ostream& err) { return batch(*o, out, err); };
+      "scenario file content and seeds are not played again; Ctrl-C stores the running games "
+      "and stops. With --slurm the batch becomes a Slurm job array whose tasks write SQLite "
+      "shards beside --db (`batch merge` folds them in) and `batch status` follows it "
+      "(docs/cluster.md).\n"
+      "Exit code: 0 every run passed its test cases (--slurm: submitted), 1 one failed, 2 bad "
+      "input, 3 internal error (a bug: please report it), 130 interrupted.");
+  return [o, status, status_action, merge, merge_action](std::ostream& out, std::ostream& err) {
+    if (status->parsed()) return status_action(out, err);
+    if (merge->parsed()) return merge_action(out, err);
+    return batch(*o, out, err);
+  };
 }
 
 }  // namespace llsf::app

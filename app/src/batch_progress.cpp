@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <iostream>
 #include <ostream>
 #include <utility>
@@ -41,6 +42,14 @@ std::string duration_text(double s) {
   return fmt::format("{}m{:02}s", t / 60, t % 60);
 }
 
+std::string progress_bar(std::int64_t done, std::int64_t total) {
+  constexpr std::int64_t kWidth = 30;
+  const std::int64_t filled =
+      total > 0 ? std::clamp<std::int64_t>(kWidth * done / total, 0, kWidth) : kWidth;
+  return "[" + std::string(static_cast<std::size_t>(filled), '#') +
+         std::string(static_cast<std::size_t>(kWidth - filled), '.') + "]";
+}
+
 BatchProgressPrinter::BatchProgressPrinter(std::string command, std::ostream& err, bool quiet)
     : command_(std::move(command)),
       err_(err),
@@ -58,12 +67,9 @@ void BatchProgressPrinter::stored(const study::RunResult& r, const study::BatchP
   if (quiet_) return;
   const double eta = p.done > 0 ? p.elapsed_s / p.done * (p.to_play - p.done) : 0.0;
   if (bar_) {
-    constexpr int kWidth = 30;
-    const int filled = p.to_play > 0 ? kWidth * p.done / p.to_play : kWidth;
-    err_ << fmt::format("\r[{}{}] {}/{} runs, {} failed, {} elapsed, ETA {}   ",
-                        std::string(static_cast<std::size_t>(filled), '#'),
-                        std::string(static_cast<std::size_t>(kWidth - filled), '.'), p.done,
-                        p.to_play, p.failed, duration_text(p.elapsed_s), duration_text(eta));
+    err_ << fmt::format("\r{} {}/{} runs, {} failed, {} elapsed, ETA {}   ",
+                        progress_bar(p.done, p.to_play), p.done, p.to_play, p.failed,
+                        duration_text(p.elapsed_s), duration_text(eta));
     if (p.done == p.to_play) err_ << "\n";
   } else {
     err_ << fmt::format("[{}/{}] {}{}seed {}: {} points, {}, result {:016x}, ETA {}\n", p.done,

@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <csignal>
+#include <cstdint>
 #include <iosfwd>
 #include <string>
 
@@ -35,6 +36,9 @@ class SigintGuard {
 
 /// "1m05s", "2h03m": a wall-clock duration for progress lines.
 std::string duration_text(double s);
+
+/// "[#########.....................]": `done` of `total` as a bar of 30 characters.
+std::string progress_bar(std::int64_t done, std::int64_t total);
 
 /// Prints the progress of run_batch on `err` for the command `command` ("llsfsim batch"): a bar
 /// when `err` is std::cerr on a terminal, else one line per stored run; says once that Ctrl-C

@@ -194,9 +194,9 @@ TEST_CASE("llsfsim batch: a failed test case exits 1, bad input exits 2") {
   CHECK(!fs::exists(dir.file("b.db")));  // nothing written before the input is checked
 
   const std::string tiny = write_tiny(dir);
-  r = llsfsim({"batch", tiny, "--runs", "3", "--db", dir.file("b.db")});
+  r = llsfsim({"batch", tiny, "--seeds", "3,3", "--db", dir.file("b.db")});
   CHECK(r.code == llsf::app::kExitBadInput);
-  CHECK(has(r.err, "lists 2 seeds"));
+  CHECK(has(r.err, "seed 3 is given twice"));
   r = llsfsim({"batch", tiny, "--jobs", "0"});
   CHECK(r.code == llsf::app::kExitBadInput);
   r = llsfsim({"batch", dir.file("missing.yaml")});

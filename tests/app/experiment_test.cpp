@@ -173,13 +173,13 @@ TEST_CASE("llsfsim experiment: bad input exits 2 before anything is played") {
   CHECK(slurp(dir.file("plain.md")) == "no markers\n");
   CHECK(!fs::exists(db));
 
-  // --report-only without a store; --runs beyond the seed list; options that exclude each other.
+  // --report-only without a store; --runs over the budget; options that exclude each other.
   r = llsfsim({"experiment", exp, "--db", db, "--report-only"});
   CHECK(r.code == llsf::app::kExitBadInput);
   CHECK(has(r.err, "no statistics store"));
-  r = llsfsim({"experiment", exp, "--db", db, "--runs", "5"});
+  r = llsfsim({"experiment", exp, "--db", db, "--runs", "100001"});
   CHECK(r.code == llsf::app::kExitBadInput);
-  CHECK(has(r.err, "lists 3 seeds"));
+  CHECK(has(r.err, "at most 100000 seeds per variant"));
   CHECK(llsfsim({"experiment", exp, "--report-only", "--jobs", "2"}).code ==
         llsf::app::kExitBadInput);
   CHECK(llsfsim({"experiment", dir.file("missing.yaml")}).code == llsf::app::kExitBadInput);

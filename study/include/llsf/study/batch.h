@@ -8,7 +8,10 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <set>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include "llsf/study/runner.h"
@@ -17,28 +20,78 @@
 
 namespace llsf::study {
 
+/// Which seeds every variant of a batch plays: `--runs N`, `--seeds LIST` or the scenario's own.
+struct SeedChoice {
+  /// Runs per variant: the first N seeds of the scenario's list; beyond the list, the seeds
+  /// after the list's largest, counting up (a single seed s: s, s+1, ..., s+N-1). Unset: the
+  /// scenario's seed list.
+  std::optional<int> runs;
+  /// If not empty: exactly these seeds for every variant, in this order (`--seeds`,
+  /// parse_seed_list()); `runs` must then be unset.
+  std::vector<std::uint64_t> seeds;
+};
+
+/// A (variant, seed) pair of a batch: the index of the variant in ScenarioFile::variants.
+struct BatchPair {
+  int variant = 0;
+  std::uint64_t seed = 0;
+};
+
 /// How a batch is played.
 struct BatchOptions {
-  /// Runs per variant: the first N seeds of the scenario's list; for a single seed s the seeds
-  /// s, s+1, ..., s+N-1. Unset: the scenario's seed list.
+  /// The seeds (SeedChoice); `runs` is kept as a shorthand for `choice.runs`.
   std::optional<int> runs;
+  SeedChoice choice;
   /// Worker threads (>= 1); 0: std::thread::hardware_concurrency().
   int jobs = 0;
   /// If set, every game is recorded to <recordings_dir>/batch<ID>/recording_file_name(...)
   /// (the directory is created) and the store keeps the path with the run.
   std::string recordings_dir;
+  /// The ID of the recordings' subdirectory batch<ID>; 0: the batch's id in the store. A Slurm
+  /// task writing a shard names the main store's id, so that recordings are named as in a local
+  /// batch.
+  std::int64_t recordings_batch_id = 0;
   /// Recordings also keep the agents' facts and rule firings (RunHooks::record_agents).
   bool record_agents = false;
+  /// Only the pairs [slice_begin, slice_end) of batch_pairs() (a Slurm array task's slice);
+  /// slice_end < 0: to the end. A sliced batch is never marked finished in the store.
+  std::int64_t slice_begin = 0;
+  std::int64_t slice_end = -1;
+  /// (variant, seed) pairs stored elsewhere (the main store, for a task writing a shard): not
+  /// played, counted as skipped.
+  std::set<std::pair<std::string, std::uint64_t>> stored_elsewhere;
 };
 
-/// The seeds a batch plays for `s`. Throws core::ConfigError if `runs` < 1 or exceeds a seed
-/// list of more than one seed.
+/// The seed list of `--seeds`: comma-separated seeds and inclusive ranges A-B ("1,5,9-12"),
+/// each seed in [0, 2^63-1], no seed twice, at most ScenarioLimits::kMaxSeeds seeds. Throws
+/// core::ConfigError naming the bad item.
+std::vector<std::uint64_t> parse_seed_list(std::string_view text);
+
+/// The seeds a batch plays for `s`. Throws core::ConfigError if `runs` < 1 or is more than
+/// ScenarioLimits::kMaxSeeds, or if both runs and seeds are given.
+std::vector<std::uint64_t> batch_seeds(const Scenario& s, const SeedChoice& choice);
+/// batch_seeds() with `runs` only.
 std::vector<std::uint64_t> batch_seeds(const Scenario& s, std::optional<int> runs);
 
-/// The games a batch of `file` plays with `runs` (every variant's batch_seeds). Throws
-/// core::ConfigError as batch_seeds() does, and if they are more than ScenarioLimits::kMaxGames
-/// (docs/security.md, "Scenario budgets").
+/// The games a batch of `file` plays (every variant's batch_seeds). Throws core::ConfigError as
+/// batch_seeds() does, and if they are more than ScenarioLimits::kMaxGames (docs/security.md,
+/// "Scenario budgets").
+std::int64_t batch_games(const ScenarioFile& file, const SeedChoice& choice);
+/// batch_games() with `runs` only.
 std::int64_t batch_games(const ScenarioFile& file, std::optional<int> runs);
+
+/// Every (variant, seed) pair of the batch in the order it is played: seed-major (the first seed
+/// of every variant, then the second, ...), so that an interrupted batch has every variant on
+/// its first seeds. Slices of this list are a Slurm array's tasks (docs/cluster.md).
+std::vector<BatchPair> batch_pairs(const ScenarioFile& file, const SeedChoice& choice);
+
+/// The batch's identity in the store: scenario_hash (batch_identity_hash()) and the number of
+/// seeds per variant. With `--seeds` that are not the default seeds of their count (the first N
+/// of batch_seeds()), the seed list joins the identity: scenario_hash becomes
+/// "<hash>+seeds-<FNV-1a 64 of the seeds>", so that two different seed lists of one length are
+/// two batches. The same (variant, seed) plays the same game in every batch.
+BatchKey batch_key(const ScenarioFile& file, const std::string& scenario_hash,
+                   const SeedChoice& choice);
 
 /// Progress after a stored run.
 struct BatchProgress {
