@@ -252,8 +252,9 @@ int batch_submit(const BatchCommandOptions& o, std::ostream& out, std::ostream& 
     for (const LoadedBatch& l : loaded) follow += " " + study::shell_quote(l.path);
     if (o.runs) follow += " --runs " + std::to_string(*o.runs);
     if (!o.seeds.empty()) follow += " --seeds " + study::shell_quote(o.seeds);
-    out << fmt::format("follow     llsfsim batch status{} --db {} --wait\n", follow,
-                       study::shell_quote(db));
+    out << fmt::format(
+        "follow     llsfsim batch status{} --db {} --wait\n", follow,
+        study::shell_quote(study::is_database_url(db) ? study::masked_database_url(db) : db));
     if (!study::is_database_url(db)) {
       out << fmt::format("then       llsfsim batch merge --db {}\n", study::shell_quote(db));
     }

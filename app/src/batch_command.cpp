@@ -101,7 +101,7 @@ int batch(const BatchCommandOptions& o, std::ostream& out, std::ostream& err) {
       return kExitBadInput;
     }
     if (progress.bar() && b.interrupted) err << "\n";
-    if (!o.quiet) print_summary(l, b, o.db, options.recordings_dir, out);
+    if (!o.quiet) print_summary(l, b, store->path(), options.recordings_dir, out);  // (password masked)
     if (b.interrupted) return kExitInterrupted;
     all_passed = all_passed && b.all_passed();
   }
@@ -158,7 +158,8 @@ Action add_batch_command(CLI::App& app) {
                  "task, its --cpus-per-task)")
       ->check(CLI::PositiveNumber);
   app.add_option("--db", o->db,
-                 "Statistics store (SQLite; docs/statistics.md); with --slurm on shared storage")
+                 "Statistics store: a SQLite file or a postgresql://USER@HOST:PORT/DB URL "
+                 "(docs/statistics.md); with --slurm a file on shared storage or the URL")
       ->capture_default_str();
   auto* rec = app.add_option(
       "--recordings", o->recordings,
