@@ -19,10 +19,6 @@ namespace llsf::study {
 
 namespace fs = std::filesystem;
 
-bool is_database_url(std::string_view db) {
-  return db.starts_with("postgresql://") || db.starts_with("postgres://");
-}
-
 namespace {
 
 // "<dir>/<stem>" of a store path: study.db -> study; a name without extension stays.

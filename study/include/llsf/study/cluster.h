@@ -13,8 +13,7 @@
 
 namespace llsf::study {
 
-/// True if `db` names a database server (postgresql:// or postgres://), not a SQLite file.
-bool is_database_url(std::string_view db);
+// (is_database_url(): llsf/study/stats_store.h)
 
 /// The SQLite shard that array task `task` writes for the store `db`: "<dir>/<stem>.shard-<task,
 /// 5 digits>.db" beside it (study.db -> study.shard-00003.db).
