@@ -56,8 +56,8 @@
 ; Ask again after a second (the decision rules may drop the task instead: see task-abandon).
 (defrule task-lock-retry
   (declare (salience ?*PRIORITY-TASK*))
-  (time $?)
   ?t <- (task (state LOCK_WAIT) (lock ?r) (since ?s))
+  (time $?)                     ; after the task: a new (time) fact meets only waiting tasks
   (test (> (- (now) ?s) 1.0))   ; a test CE: evaluated again with every new (time) fact
   =>
   (assert (resource-request (resource ?r)))
@@ -93,8 +93,8 @@
 
 (defrule task-wait-over
   (declare (salience ?*PRIORITY-TASK*))
-  (time $?)
   ?t <- (task (state RUNNING) (kind WAIT) (since ?s))
+  (time $?)
   (test (> (- (now) ?s) 3.0))
   =>
   (modify ?t (state DONE))

@@ -51,8 +51,8 @@
 
 (defrule locks-on-answer
   (declare (salience ?*PRIORITY-TASK*))
-  (time $?)
   ?p <- (resource-pending (resource ?res))
+  (time $?)
   =>
   (bind ?st (lock-state ?res))
   (if (eq ?st ACCEPTED) then

@@ -41,12 +41,12 @@
 
 (defrule explore-decide
   (declare (salience ?*PRIORITY-DECIDE*))
-  (time $?)
   (game (phase EXPLORATION) (state RUNNING))
   (signal)
   (explore-pos (machine ?pos))
   (not (task))
   (not (explore-idle))
+  (time $?)
   =>
   (bind ?m (explore-next ?pos))
   (if (neq ?m NONE)
@@ -56,8 +56,8 @@
 
 (defrule explore-idle-over
   (declare (salience ?*PRIORITY-DECIDE*))
-  (time $?)
   ?f <- (explore-idle (until ?u))
+  (time $?)
   (test (>= (now) ?u))
   =>
   (retract ?f)
@@ -129,10 +129,10 @@
 
 (defrule explore-report-periodic
   (declare (salience ?*PRIORITY-DECIDE*))
-  (time $?now)
   (game (phase EXPLORATION))
-  ?t <- (timer (name explore-report) (time $?last&:(timeout ?now ?last 2.0)) (seq ?s))
+  ?t <- (timer (name explore-report) (time $?last) (seq ?s))
   (explored-by-me)
+  (time $?now&:(timeout ?now ?last 2.0))
   =>
   (modify ?t (time ?now) (seq (+ ?s 1)))
   (explore-send-report)

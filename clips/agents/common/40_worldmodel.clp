@@ -12,9 +12,9 @@
 
 (defrule wm-broadcast
   (declare (salience ?*PRIORITY-WM*))
-  (time $?now)
   (game (phase EXPLORATION|PRODUCTION))
-  ?t <- (timer (name worldmodel) (time $?last&:(timeout ?now ?last 1.0)) (seq ?seq))
+  ?t <- (timer (name worldmodel) (time $?last) (seq ?seq))
+  (time $?now&:(timeout ?now ?last 1.0))
   =>
   (modify ?t (time ?now) (seq (+ ?seq 1)))
   (bind ?wm (pb-create "llsf_agent_msgs.Worldmodel"))

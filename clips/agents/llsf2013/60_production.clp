@@ -209,11 +209,11 @@
 
 (defrule prod-decide
   (declare (salience ?*PRIORITY-DECIDE*))
-  (time $?)
   (game (phase PRODUCTION) (state RUNNING))
   (role (name ?role) (target ?target))
   (holding (puck ?h))
   (not (task))
+  (time $?)
   =>
   (bind ?step (prod-next-step ?role ?target ?h))
   (assert (task (kind (nth$ 1 ?step)) (place (nth$ 2 ?step)) (lock (nth$ 3 ?step))))
@@ -336,9 +336,9 @@
 ; After a refused delivery the product is held a while before the next attempt.
 (defrule prod-cooldown
   (declare (salience (+ ?*PRIORITY-DECIDE* 1)))
-  (time $?)
   ?c <- (task-cooldown (until ?until))
   (not (task))
+  (time $?)
   =>
   (if (> ?until (now))
    then (assert (task (kind WAIT)))
