@@ -7,6 +7,8 @@
 // asserts on timing.
 #include <doctest/doctest.h>
 #include <llsf_agent_msgs/LockMessage.pb.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <boost/asio/io_context.hpp>
@@ -14,6 +16,7 @@
 #include <boost/asio/write.hpp>
 #include <chrono>
 #include <cstdint>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <random>
@@ -479,4 +482,72 @@ TEST_CASE("TCP: a server destroyed with connections open and frames under way") 
   }
   CHECK(gone);
   CHECK_FALSE(client.connected());
+}
+
+namespace {
+
+/// Fills the process's descriptor table (the soft limit lowered to what is open + 8, then dup()
+/// until EMFILE) but for `spare` descriptors; release() or the destructor undoes it.
+class DescriptorsExhausted {
+ public:
+  explicit DescriptorsExhausted(int spare) {
+    REQUIRE(::getrlimit(RLIMIT_NOFILE, &old_) == 0);
+    int highest = 2;
+    for (const auto& e : std::filesystem::directory_iterator("/proc/self/fd")) {
+      highest = std::max(highest, std::stoi(e.path().filename().string()));
+    }
+    rlimit low = old_;
+    low.rlim_cur = static_cast<rlim_t>(highest + 8);
+    REQUIRE(::setrlimit(RLIMIT_NOFILE, &low) == 0);
+    for (;;) {
+      const int fd = ::dup(0);
+      if (fd < 0) break;
+      fds_.push_back(fd);
+    }
+    for (int i = 0; i < spare && !fds_.empty(); ++i) {
+      ::close(fds_.back());
+      fds_.pop_back();
+    }
+  }
+  DescriptorsExhausted(const DescriptorsExhausted&) = delete;
+  DescriptorsExhausted& operator=(const DescriptorsExhausted&) = delete;
+  ~DescriptorsExhausted() { release(); }
+  void release() {
+    for (const int fd : fds_) ::close(fd);
+    fds_.clear();
+    ::setrlimit(RLIMIT_NOFILE, &old_);
+  }
+
+ private:
+  rlimit old_{};
+  std::vector<int> fds_;
+};
+
+}  // namespace
+
+TEST_CASE("TCP: out of file descriptors, the server retries accepting (logged once), recovers") {
+  const MessageRegistry reg = registry();
+  std::vector<std::string> log;
+  StreamServerOptions options{"127.0.0.1", 0};
+  options.log = [&](std::string_view line) { log.emplace_back(line); };
+  StreamServer server(reg, options);
+  Pump pump(server);
+  asio::io_context io;
+  tcp::socket raw(io);
+  raw.open(tcp::v4());  // the controller's descriptor (and its event loop's) taken before
+  {
+    DescriptorsExhausted full(0);
+    // The connection waits in the listen backlog and every accept fails with EMFILE.
+    raw.connect(tcp::endpoint(kLoopback, static_cast<unsigned short>(server.port())));
+    for (int i = 0; i < 30; ++i) pump.once(milliseconds(10));
+    CHECK(pump.count(StreamEvent::Kind::kConnected) == 0);
+    full.release();
+  }
+  REQUIRE(log.size() == 1);
+  CHECK(log[0] ==
+        "stream server: cannot accept a connection: Too many open files; retrying every 100 ms "
+        "until it works");
+  pump.until([&] { return pump.count(StreamEvent::Kind::kConnected) == 1; });
+  CHECK(pump.count(StreamEvent::Kind::kConnected) == 1);
+  CHECK(log.size() == 1);
 }
