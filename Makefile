@@ -3,7 +3,7 @@
 JOBS ?= $(shell nproc)
 PREFIX ?= /usr/local
 
-.PHONY: all deps viewer run demo test test-tsan lint lint-changed install build-release build-ci bench \
+.PHONY: all deps viewer run demo test test-tsan test-asan lint lint-changed install build-release build-ci bench \
         format check-format clean help
 
 all: build-release
@@ -13,9 +13,12 @@ help:
 	@echo "make demo         the kinematic world demo (three robots, no refbox)"
 	@echo "make test         install deps, check formatting, build with -Werror, run the whole test"
 	@echo "                  suite, clang-tidy on the files changed since main, the batch tests"
-	@echo "                  under ThreadSanitizer (docs/testing.md)"
+	@echo "                  under ThreadSanitizer, the comm tests under AddressSanitizer"
+	@echo "                  (docs/testing.md)"
 	@echo "make lint         clang-tidy (.clang-tidy) over every project source and test"
 	@echo "make test-tsan    build the batch tests with ThreadSanitizer (build/tsan) and run them"
+	@echo "make test-asan    build the comm tests with AddressSanitizer + UBSan (build/asan) and run"
+	@echo "                  them (the stream server's stress test)"
 	@echo "make install      build Release, install into PREFIX (default /usr/local; docs/install.md)"
 	@echo "make bench        build Release and run every benchmark (bench/run)"
 	@echo "make viewer       build the browser front end (viewer/dist/report.js; scripts/build-viewer)"
@@ -45,11 +48,13 @@ demo: build-release
 	./build/release/kinematic/llsf-world-demo $(ARGS)
 
 # The whole suite: formatting first (fails in seconds), the -Werror build and every test,
-# clang-tidy on the files changed since main (`make lint`: all), the batch tests under TSan.
+# clang-tidy on the files changed since main (`make lint`: all), the batch tests under TSan, the
+# comm tests under ASan.
 test: check-format build-ci
 	ctest --preset ci -j $(JOBS)
 	@scripts/lint --changed
 	$(tsan_batch_tests)
+	$(asan_comm_tests)
 
 # The batch tests (worker threads) under ThreadSanitizer: only the libraries and the one test
 # binary they need are built (build/tsan).
@@ -61,6 +66,18 @@ endef
 
 test-tsan: deps
 	$(tsan_batch_tests)
+
+# The comm tests (frame decoders, hub, UDP and TCP on loopback, the stream server's stress test)
+# under AddressSanitizer + UBSan: only the comm library and its one test binary are built
+# (build/asan).
+define asan_comm_tests
+@cmake --preset asan >/dev/null
+@cmake --build --preset asan-comm -j $(JOBS)
+ctest --preset asan-comm -j $(JOBS)
+endef
+
+test-asan: deps
+	$(asan_comm_tests)
 
 lint: build-ci
 	@scripts/lint

@@ -154,6 +154,14 @@ LossModel parse_loss_model(const ConfigNode& n) {
   n.fail("unknown loss model '" + s + "' (expected none, global, per_link or burst)");
 }
 
+LockNumbering parse_lock_numbering(const ConfigNode& n) {
+  const std::string s = n.as_string();
+  if (s == lock_numbering_name(LockNumbering::kLlsfsim)) return LockNumbering::kLlsfsim;
+  if (s == lock_numbering_name(LockNumbering::k2013)) return LockNumbering::k2013;
+  n.fail("unknown lock message numbering '" + s +
+         "' (expected llsfsim: component 2100, or 2013: component 2000, types 1337 and 1338)");
+}
+
 }  // namespace
 
 HubConfig load_hub_config(const ConfigNode& node, HubConfig base) {
@@ -176,6 +184,9 @@ HubConfig load_hub_config(const ConfigNode& node, HubConfig base) {
   }
   node.read("max_frame_bytes", c.max_frame_bytes, kFrameBytes);
   node.read("forward_unregistered", c.forward_unregistered);
+  if (node["lock_messages"].defined()) {
+    c.lock_messages = parse_lock_numbering(node["lock_messages"]);
+  }
 
   if (const ConfigNode links = node["links"]; links.defined()) {
     c.links.clear();

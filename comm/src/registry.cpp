@@ -155,9 +155,22 @@ FrameError MessageRegistry::validate(const FrameView& frame, int* index) const {
   return FrameError::kNone;
 }
 
-void add_agent_messages(MessageRegistry& registry) {
-  registry.add<llsf_agent_msgs::LockMessage>();
-  registry.add<llsf_agent_msgs::LockMasterAnnounce>();
+const char* lock_numbering_name(LockNumbering n) {
+  return n == LockNumbering::k2013 ? "2013" : "llsfsim";
+}
+
+void add_agent_messages(MessageRegistry& registry, LockNumbering locks) {
+  if (locks == LockNumbering::k2013) {
+    // The 2013 agent's own .proto declared these in package llsf_msgs with the same fields; the
+    // package is not on the wire, the pair and the field numbers are.
+    registry.add(MessageKey{kRefboxComponentId, k2013LockMessageType},
+                 llsf_agent_msgs::LockMessage::default_instance());
+    registry.add(MessageKey{kRefboxComponentId, k2013LockMasterAnnounceType},
+                 llsf_agent_msgs::LockMasterAnnounce::default_instance());
+  } else {
+    registry.add<llsf_agent_msgs::LockMessage>();
+    registry.add<llsf_agent_msgs::LockMasterAnnounce>();
+  }
   registry.add<llsf_agent_msgs::LockStatus>();
   registry.add<llsf_agent_msgs::Worldmodel>();
   registry.add<llsf_agent_msgs::WorldmodelChange>();
@@ -166,6 +179,11 @@ void add_agent_messages(MessageRegistry& registry) {
   registry.add<llsf_agent_msgs::AuctionAward>();
   registry.add<llsf_agent_msgs::AuctionAck>();
   registry.add<llsf_agent_msgs::AuctionStatus>();
+}
+
+bool is_agent_message(const MessageRegistry& registry, int index) {
+  const google::protobuf::Message* p = registry.prototype(registry.key_at(index));
+  return p != nullptr && p->GetDescriptor()->file()->package() == "llsf_agent_msgs";
 }
 
 }  // namespace llsf::comm

@@ -119,27 +119,36 @@ bool StreamConnection::send(const google::protobuf::Message& message) {
   counters_->bytes_out += size;
   queued_bytes_ += size;
   write_queue_.push_back(std::move(frame));
-  if (!writing_) write_next();
+  write_next();
   return true;
 }
 
 void StreamConnection::write_next() {
-  if (!open_ || write_queue_.empty()) {
-    writing_ = false;
+  if (!open_ || writing_ || write_queue_.empty()) return;
+  // The frame under way leaves the queue now and is owned by in_flight_ until its completion
+  // runs: close() drops only frames not yet started, never the buffer Asio writes from, and the
+  // completion never touches the queue it did not take its frame from.
+  writing_ = true;
+  in_flight_ = std::move(write_queue_.front());
+  write_queue_.pop_front();
+  asio::async_write(socket_, asio::buffer(in_flight_),
+                    [self = shared_from_this()](const boost::system::error_code& ec, std::size_t) {
+                      self->on_written(ec);
+                    });
+}
+
+void StreamConnection::on_written(const boost::system::error_code& ec) {
+  writing_ = false;
+  const auto written = static_cast<std::int64_t>(in_flight_.size());
+  in_flight_.clear();
+  // Closed meanwhile (by us, the peer or a limit): the queue was dropped; nothing to account.
+  if (!open_) return;
+  if (ec) {
+    close();
     return;
   }
-  writing_ = true;
-  asio::async_write(socket_, asio::buffer(write_queue_.front()),
-                    [self = shared_from_this()](const boost::system::error_code& ec, std::size_t) {
-                      if (ec || !self->open_) {
-                        self->close();
-                        return;
-                      }
-                      self->queued_bytes_ -=
-                          static_cast<std::int64_t>(self->write_queue_.front().size());
-                      self->write_queue_.pop_front();
-                      self->write_next();
-                    });
+  queued_bytes_ -= written;
+  write_next();
 }
 
 void StreamConnection::close_for(const char* reason, const std::string& detail) {
@@ -155,7 +164,8 @@ void StreamConnection::close() {
   boost::system::error_code ec;
   partial_timer_.cancel();
   socket_.shutdown(asio::ip::tcp::socket::shutdown_both, ec);
-  socket_.close(ec);
+  socket_.close(ec);  // pending reads, writes and waits complete with operation_aborted
+  // Frames not yet started go; the one under way (in_flight_) stays until its completion.
   write_queue_.clear();
   queued_bytes_ = 0;
   StreamEvent e;

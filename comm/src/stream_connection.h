@@ -44,7 +44,10 @@ class StreamConnection : public std::enable_shared_from_this<StreamConnection> {
  private:
   void read();
   void on_bytes(std::size_t n);
+  /// Starts writing the next queued frame unless a write is under way.
   void write_next();
+  /// The completion of the write of in_flight_.
+  void on_written(const boost::system::error_code& ec);
   /// Arms the partial-frame timer when a frame is incomplete (again when a new frame started
   /// after `frame_done`), disarms it when none is.
   void watch_partial_frame(bool frame_done);
@@ -61,11 +64,14 @@ class StreamConnection : public std::enable_shared_from_this<StreamConnection> {
   Sink sink_;
   std::string peer_;  ///< "address:port" for log lines
   std::array<std::uint8_t, 4096> read_buffer_{};
-  std::deque<std::vector<std::uint8_t>> write_queue_;
-  std::int64_t queued_bytes_ = 0;
+  std::deque<std::vector<std::uint8_t>> write_queue_;  ///< frames not yet started
+  /// The frame async_write is writing (empty when none): Asio reads it until the completion
+  /// runs, even after close(), so only on_written() releases it.
+  std::vector<std::uint8_t> in_flight_;
+  std::int64_t queued_bytes_ = 0;        ///< in write_queue_ and in_flight_
   std::int64_t partial_generation_ = 0;  ///< bumped whenever the partial-frame watch changes
   bool partial_watched_ = false;
-  bool writing_ = false;
+  bool writing_ = false;  ///< an async_write of in_flight_ is under way
   bool open_ = true;
 };
 

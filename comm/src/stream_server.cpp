@@ -2,6 +2,7 @@
 // StreamServer: accepts controller connections on loopback and speaks the 2013 stream framing.
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/steady_timer.hpp>
 #include <deque>
 #include <map>
 #include <stdexcept>
@@ -15,9 +16,14 @@ namespace asio = boost::asio;
 using asio::ip::tcp;
 using detail::StreamConnection;
 
+/// Pause before accepting again after a failed accept (out of file descriptors: EMFILE).
+constexpr std::chrono::milliseconds kAcceptRetry{100};
+
 struct StreamServer::Impl {
   asio::io_context io;  // first: destroyed last
   tcp::acceptor acceptor{io};
+  asio::steady_timer accept_retry{io};
+  bool accept_failing = false;  ///< an accept failed and none worked since (logged once)
   const MessageRegistry* registry;
   StreamServerOptions options;
   std::int64_t refused = 0;
@@ -48,10 +54,15 @@ struct StreamServer::Impl {
 
   void accept() {
     acceptor.async_accept([this](const boost::system::error_code& ec, tcp::socket socket) {
-      if (ec == asio::error::operation_aborted) return;
-      if (!ec && static_cast<int>(open.size()) >= options.max_connections) {
+      if (ec == asio::error::operation_aborted || !acceptor.is_open()) return;
+      if (ec) {
+        on_accept_error(ec);
+        return;
+      }
+      accept_failing = false;
+      if (static_cast<int>(open.size()) >= options.max_connections) {
         refuse(std::move(socket));
-      } else if (!ec) {
+      } else {
         const int id = static_cast<int>(counters.size());
         counters.emplace_back();
         auto conn = std::make_shared<StreamConnection>(
@@ -69,6 +80,22 @@ struct StreamServer::Impl {
         events.push_back(std::move(e));
         conn->start();
       }
+      accept();
+    });
+  }
+
+  /// Out of file descriptors (EMFILE, ENFILE) or memory, the connection stays in the listen
+  /// backlog and accepting again fails at once: retry after a pause instead of spinning.
+  void on_accept_error(const boost::system::error_code& ec) {
+    if (!accept_failing && options.log) {
+      options.log("stream server: cannot accept a connection: " + ec.message() +
+                  "; retrying every " + std::to_string(kAcceptRetry.count()) +
+                  " ms until it works");
+    }
+    accept_failing = true;
+    accept_retry.expires_after(kAcceptRetry);
+    accept_retry.async_wait([this](const boost::system::error_code& e) {
+      if (e || !acceptor.is_open()) return;
       accept();
     });
   }
@@ -97,6 +124,7 @@ StreamServer::StreamServer(const MessageRegistry& registry, StreamServerOptions 
 StreamServer::~StreamServer() {
   boost::system::error_code ec;
   impl_->acceptor.close(ec);
+  impl_->accept_retry.cancel();
   // Closing emits events into impl_; take a copy of the list first.
   const auto open = impl_->open;
   for (const auto& [id, conn] : open) conn->close();

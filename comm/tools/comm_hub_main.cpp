@@ -73,7 +73,7 @@ int main(int argc, char** argv) {
     }
 
     llsf::comm::MessageRegistry registry;
-    llsf::comm::add_agent_messages(registry);
+    llsf::comm::add_agent_messages(registry, hub_cfg.lock_messages);
     llsf::comm::UdpHub hub(hub_cfg, registry, llsf::core::Rng(seed),
                            llsf::comm::UdpHubOptions{sock_cfg.address});
     for (const auto& p : sock_cfg.udp_peers) {

@@ -132,7 +132,7 @@ Game::Game(GameConfig config)
 
   // The radio: the refbox hears and is heard by every channel, the robots share "team".
   add_refbox_messages(registry_);
-  comm::add_agent_messages(registry_);
+  comm::add_agent_messages(registry_, config_.hub.lock_messages);
   std::vector<std::string> names;
   names.emplace_back(kRefboxPeer);
   for (const auto& r : config_.world.robots) names.push_back(r.name);
@@ -425,7 +425,8 @@ void Game::step() {
   for (const comm::Delivery& d : hub_->received(refbox_peer_)) {
     // Only the refbox's own protocol goes to it; the agents' messages are not its business.
     if (d.type_index < 0 ||
-        registry_.key_at(d.type_index).component_id != comm::kRefboxComponentId) {
+        registry_.key_at(d.type_index).component_id != comm::kRefboxComponentId ||
+        comm::is_agent_message(registry_, d.type_index)) {
       continue;
     }
     const int from = robot_of(d.from);

@@ -395,7 +395,15 @@ class LockAgent : public sim::RobotBrain {
 }  // namespace
 
 TEST_CASE("agents talk over the radio; the refbox ignores their messages") {
-  Game g(test::small_game(2));
+  // Also under the 2013 numbering (radio `lock_messages: 2013`), where the lock messages share
+  // the refbox's component 2000 on the wire.
+  GameConfig config = test::small_game(2);
+  SUBCASE("llsfsim numbering") { config.hub.lock_messages = comm::LockNumbering::kLlsfsim; }
+  SUBCASE("2013 numbering") { config.hub.lock_messages = comm::LockNumbering::k2013; }
+  Game g(config);
+  CHECK(g.registry().key_of(llsf_agent_msgs::LockMessage::default_instance())->component_id ==
+        (config.hub.lock_messages == comm::LockNumbering::k2013 ? comm::kRefboxComponentId
+                                                                : comm::kAgentComponentId));
   LockAgent a;
   LockAgent b;
   g.set_brain(0, &a);

@@ -177,3 +177,33 @@ TEST_CASE("run_game: a short production game, verdicts judged at their deadline,
   CHECK(json["scenario"] == "short");
   CHECK(json["passed"] == false);
 }
+
+TEST_CASE("radio lock_messages: 2013 changes the numbers on the wire, not the game") {
+  // Locks on: the agents' LockMessage and LockMasterAnnounce go through the hub as (2000, 1337)
+  // and (2000, 1338); the refbox, which hears component 2000, must ignore them as it ignores
+  // (2100, 1|2), so the game (world, refbox, messages sent) is the same.
+  const std::string body =
+      "seed: 3\nstart: production\nduration_s: 90\nrobots:\n  count: 2\n"
+      "  locks: true\n" +
+      kAgent + "  config: {roles: [P3, P3]}\n";
+  const ScenarioFile ours = load_scenario(scenario_file("locks-llsfsim.yaml", "name: l\n" + body));
+  const ScenarioFile old = load_scenario(
+      scenario_file("locks-2013.yaml", "name: l\nradio: {lock_messages: 2013}\n" + body));
+  CHECK(ours.variants[0].game.hub.lock_messages == comm::LockNumbering::kLlsfsim);
+  REQUIRE(old.variants[0].game.hub.lock_messages == comm::LockNumbering::k2013);
+  const RunResult a = run_game(ours.variants[0], 3);
+  const RunResult b = run_game(old.variants[0], 3);
+  CHECK(a.lock_grants > 0);
+  CHECK(b.lock_grants == a.lock_grants);
+  CHECK(b.lock_refusals == a.lock_refusals);
+  CHECK(b.points == a.points);
+  CHECK(b.messages_sent == a.messages_sent);
+  CHECK(b.result_hash == a.result_hash);
+
+  // The key is checked where it stands.
+  const std::string p =
+      scenario_file("locks-bad.yaml", "name: l\nradio:\n  lock_messages: 2014\n" + body);
+  CHECK(error_of(p) == p + ":3:18: radio.lock_messages: unknown lock message numbering '2014' "
+                           "(expected llsfsim: component 2100, or 2013: component 2000, types "
+                           "1337 and 1338)");
+}

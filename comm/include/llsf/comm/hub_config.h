@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "llsf/comm/registry.h"
 #include "llsf/core/config.h"
 #include "llsf/core/sim_time.h"
 
@@ -71,6 +72,10 @@ struct HubConfig {
   /// `unknown_type` (false), or forwarded unparsed and counted as type "(unregistered)" (true;
   /// a hub that relays bytes, for tools whose messages this build does not know).
   bool forward_unregistered = false;
+  /// The (component id, message type) of the agents' lock messages: llsfsim's (2100, 1|2) or the
+  /// 2013 Carologistics agent's (2000, 1337|1338), for tools that decode those. Read by whoever
+  /// builds the registry (add_agent_messages); the hub itself only sees the registry.
+  LockNumbering lock_messages = LockNumbering::kLlsfsim;
 
   /// Throws core::ConfigError naming the first bad field ("links[2].loss_probability: ...").
   void validate() const;

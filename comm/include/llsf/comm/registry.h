@@ -102,9 +102,28 @@ class MessageRegistry {
   std::map<const google::protobuf::Descriptor*, int> by_descriptor_;
 };
 
+/// Message types of the 2013 Carologistics agent's LockMessage and LockMasterAnnounce, which it
+/// sent inside the refbox's component 2000 (package llsf_msgs).
+inline constexpr int k2013LockMessageType = 1337;
+inline constexpr int k2013LockMasterAnnounceType = 1338;
+
+/// Where the lock messages go on the wire (docs/comm.md, "Message types and component ids").
+enum class LockNumbering {
+  kLlsfsim,  ///< LockMessage (2100, 1), LockMasterAnnounce (2100, 2): the default
+  k2013,     ///< LockMessage (2000, 1337), LockMasterAnnounce (2000, 1338): the 2013 agent's
+};
+/// "llsfsim", "2013" (the values of the radio's `lock_messages` key).
+const char* lock_numbering_name(LockNumbering n);
+
 /// Registers the agents' own messages (llsf_agent_msgs: LockMessage, LockMasterAnnounce,
 /// LockStatus, Worldmodel, WorldmodelChange, AuctionCall, AuctionBid, AuctionAward, AuctionAck,
-/// AuctionStatus).
-void add_agent_messages(MessageRegistry& registry);
+/// AuctionStatus), the two lock messages under `locks`' numbering, the others at (2100, type).
+/// The registration order (the dense indices) is the same for both numberings.
+void add_agent_messages(MessageRegistry& registry, LockNumbering locks = LockNumbering::kLlsfsim);
+
+/// True if the type with dense index `index` is one of the agents' messages (package
+/// llsf_agent_msgs), whatever its component id: with LockNumbering::k2013 two of them share the
+/// refbox's component 2000, but they are not the refbox's business.
+bool is_agent_message(const MessageRegistry& registry, int index);
 
 }  // namespace llsf::comm
