@@ -795,8 +795,7 @@ void fact_by_slot(void* env, DATA_OBJECT* rv) {
   auto* self = static_cast<Environment*>(GetEnvironmentContext(env));
   auto* t = static_cast<struct deftemplate*>(EnvFindDeftemplate(env, DOToString(tmpl)));
   if (t == nullptr || t->implied) {
-    self->error("fact-by-slot", std::string("no deftemplate with slots named ") +
-                                    DOToString(tmpl));
+    self->error("fact-by-slot", std::string("no deftemplate with slots named ") + DOToString(tmpl));
     return;
   }
   long pos = 0;
@@ -805,7 +804,8 @@ void fact_by_slot(void* env, DATA_OBJECT* rv) {
   if (s == nullptr || s->multislot) {
     self->error("fact-by-slot", std::string("deftemplate ") + DOToString(tmpl) +
                                     (s == nullptr ? " has no slot " : " has a multislot ") +
-                                    DOToString(slot) + (s == nullptr ? "" : ": use a single-field slot"));
+                                    DOToString(slot) +
+                                    (s == nullptr ? "" : ": use a single-field slot"));
     return;
   }
   const int type = GetType(value);
@@ -1073,8 +1073,7 @@ Template Environment::find_template(const std::string& name) {
 
 Template Environment::implied_template(const std::string& name) {
   if (EnvFindDeftemplate(env_, name.c_str()) == nullptr) {
-    CreateImpliedDeftemplate(env_, static_cast<SYMBOL_HN*>(EnvAddSymbol(env_, name.c_str())),
-                             TRUE);
+    CreateImpliedDeftemplate(env_, static_cast<SYMBOL_HN*>(EnvAddSymbol(env_, name.c_str())), TRUE);
   }
   Template t = find_template(name);
   if (!t.implied) throw std::logic_error("CLIPS: deftemplate " + name + " is not an ordered one");
