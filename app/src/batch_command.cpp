@@ -101,7 +101,8 @@ int batch(const BatchCommandOptions& o, std::ostream& out, std::ostream& err) {
       return kExitBadInput;
     }
     if (progress.bar() && b.interrupted) err << "\n";
-    if (!o.quiet) print_summary(l, b, store->path(), options.recordings_dir, out);  // (password masked)
+    if (!o.quiet)
+      print_summary(l, b, store->path(), options.recordings_dir, out);  // (password masked)
     if (b.interrupted) return kExitInterrupted;
     all_passed = all_passed && b.all_passed();
   }
