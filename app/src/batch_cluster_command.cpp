@@ -9,8 +9,8 @@
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cerrno>
+#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
@@ -566,8 +566,8 @@ void print_status(const Status& st, const std::string& db, std::ostream& out) {
     rate = fmt::format("games/min   {:.1f}, ETA {}", *st.per_minute, duration_text(eta));
   }
   out << fmt::format(
-      "total       {} of {} runs stored in {}; {} running, {} queued, {} missing\n{}\n",
-      st.done, st.total, store_text(db), st.running, st.queued, missing, rate);
+      "total       {} of {} runs stored in {}; {} running, {} queued, {} missing\n{}\n", st.done,
+      st.total, store_text(db), st.running, st.queued, missing, rate);
   for (const std::string& f : st.failed) out << "failed      " << f << "\n";
   if (!st.note.empty()) out << "note        " << st.note << "\n";
   if (missing > 0 && st.running + st.queued == 0) {

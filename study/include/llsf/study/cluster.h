@@ -31,12 +31,12 @@ std::string slurm_dir(const std::string& db);
 /// One submission, as kept in the job file (tab-separated, one line: job id, submitted, games
 /// per task, array, stored, total, `batch=...`, `script=...`, scenarios).
 struct SlurmJob {
-  std::string job_id;                  ///< sbatch's job id of the array
-  std::string submitted;               ///< UTC, ISO 8601 (wall clock; progress only)
-  int games_per_task = 0;              ///< the slice length
-  std::string array;                   ///< the --array spec, e.g. "0-3,7%2"
-  std::int64_t stored_at_submit = 0;   ///< runs stored when submitted (for games per minute)
-  std::int64_t total = 0;              ///< runs of the batch
+  std::string job_id;                 ///< sbatch's job id of the array
+  std::string submitted;              ///< UTC, ISO 8601 (wall clock; progress only)
+  int games_per_task = 0;             ///< the slice length
+  std::string array;                  ///< the --array spec, e.g. "0-3,7%2"
+  std::int64_t stored_at_submit = 0;  ///< runs stored when submitted (for games per minute)
+  std::int64_t total = 0;             ///< runs of the batch
   /// The batches' identities ("<scenario hash>:<runs per variant>" per file, comma-separated):
   /// tells the submissions of two batches into one store apart ("" in lines of older llsfsim).
   std::string batch;
