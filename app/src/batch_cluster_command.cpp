@@ -379,7 +379,8 @@ int batch_task(const BatchCommandOptions& o, std::ostream& out, std::ostream& er
     }
     if (!o.quiet) {
       out << fmt::format("task {}: {} pairs {}..{} of {}: {} played, {} stored before, into {}\n",
-                         task, l.path, b, e - 1, n, r.played, r.skipped, target);
+                         task, l.path, b, e - 1, n, r.played, r.skipped,
+                         study::masked_database_url(target));
     }
     if (r.interrupted) return kExitInterrupted;
   }

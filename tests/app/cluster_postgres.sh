@@ -95,6 +95,9 @@ out=$("$L" batch "$S" --runs 20 --db "$U" --slurm --games-per-task 8)
 has "$out" "$left of 40 runs missing"
 has "$out" "(array 0)"
 wait_batch "$U" --runs 20
+# The resubmitted task skipped the runs of its slice that the server holds.
+job=$(sed -n 's/^submitted  job \([0-9]*\) .*/\1/p' <<<"$out")
+has "$(cat "$T/llsfsim-slurm/slurm-${job}_0.out")" "$left played, $((8 - left)) stored before, into $U"
 once "$U" 40
 [ "$(pg_rows "$U")" = "$local_rows" ] || fail "after the restart and the resubmission:
 $(diff <(echo "$local_rows") <(pg_rows "$U"))"
