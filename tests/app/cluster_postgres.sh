@@ -1,4 +1,5 @@
 # SPDX-License-Identifier: MIT
+# shellcheck shell=bash
 # Sourced by cluster_test.sh with the Slurm cluster up, in $T, after the local 40-game batch
 # ($T/local.db, `$S --runs 20`): `batch --slurm` into a real PostgreSQL 15 server
 # (scripts/test-postgres in $T/pg, stopped by cluster_test.sh's cleanup):
