@@ -9,8 +9,10 @@
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -111,6 +113,32 @@ std::vector<std::set<Pair>> stored_pairs(const std::string& db,
   return out;
 }
 
+// The batches' identities as kept in the job file: tells two batches' submissions into one store
+// (one job file) apart.
+std::string batch_identity(const std::vector<LoadedBatch>& loaded) {
+  std::string id;
+  for (const LoadedBatch& l : loaded) {
+    id += (id.empty() ? "" : ",") + l.key.scenario_hash + ":" +
+          std::to_string(l.key.runs_per_variant);
+  }
+  return id;
+}
+
+// The submissions of this batch recorded for `db` (lines of older llsfsim, without the
+// identity, count for every batch).
+std::vector<study::SlurmJob> batch_jobs(const std::string& db,
+                                        const std::vector<LoadedBatch>& loaded) {
+  const std::string id = batch_identity(loaded);
+  std::vector<study::SlurmJob> jobs = study::read_jobs(db);
+  std::erase_if(jobs, [&](const study::SlurmJob& j) { return !j.batch.empty() && j.batch != id; });
+  return jobs;
+}
+
+// The store as printed: a URL with its password masked; a SQLite file "and its shards".
+std::string store_text(const std::string& db) {
+  return study::is_database_url(db) ? study::masked_database_url(db) : db + " and its shards";
+}
+
 std::int64_t total_pairs(const std::vector<LoadedBatch>& loaded) {
   std::int64_t n = 0;
   for (const LoadedBatch& l : loaded) n += static_cast<std::int64_t>(l.pairs.size());
@@ -155,8 +183,7 @@ int batch_submit(const BatchCommandOptions& o, std::ostream& out, std::ostream& 
   }
   const std::int64_t total = total_pairs(loaded);
   if (tasks.empty()) {
-    out << fmt::format("all {} runs are stored in {} (and its shards); nothing to submit\n", total,
-                       db);
+    out << fmt::format("all {} runs are stored in {}; nothing to submit\n", total, store_text(db));
     return kExitOk;
   }
 
@@ -218,12 +245,24 @@ int batch_submit(const BatchCommandOptions& o, std::ostream& out, std::ostream& 
     return kExitBadInput;
   }
   const std::string stamp = utc_now();
+  // job-N.sh with the first free N, created exclusively: two submissions at once into one
+  // directory (two batches of one database server) never share a script.
   std::string script_path;
   for (int n = 1;; ++n) {
     script_path = script.log_dir + "/job-" + std::to_string(n) + ".sh";
-    if (!fs::exists(script_path, ec)) break;
+    std::FILE* f = std::fopen(script_path.c_str(), "wx");
+    if (f == nullptr) {
+      if (errno == EEXIST) continue;
+      err << who << ": cannot write " << script_path << ": " << std::strerror(errno) << "\n";
+      return kExitBadInput;
+    }
+    const bool written = std::fwrite(text.data(), 1, text.size(), f) == text.size();
+    if (std::fclose(f) != 0 || !written) {
+      err << who << ": cannot write " << script_path << "\n";
+      return kExitBadInput;
+    }
+    break;
   }
-  std::ofstream(script_path) << text;
   const ProcessOutput sb = run_process({"sbatch", "--parsable", script_path});
   std::string job_id = sb.output.substr(0, sb.output.find_first_of(";\n"));
   if (sb.code != 0 || job_id.empty() ||
@@ -240,6 +279,8 @@ int batch_submit(const BatchCommandOptions& o, std::ostream& out, std::ostream& 
   job.array = study::array_spec(script.tasks, o.array_throttle);
   job.stored_at_submit = done;
   job.total = total;
+  job.batch = batch_identity(loaded);
+  job.script = script_path;
   for (const LoadedBatch& l : loaded) job.scenarios.push_back(l.path);
   study::append_job(db, job);
   if (!o.quiet) {
@@ -338,7 +379,8 @@ int batch_task(const BatchCommandOptions& o, std::ostream& out, std::ostream& er
     }
     if (!o.quiet) {
       out << fmt::format("task {}: {} pairs {}..{} of {}: {} played, {} stored before, into {}\n",
-                         task, l.path, b, e - 1, n, r.played, r.skipped, target);
+                         task, l.path, b, e - 1, n, r.played, r.skipped,
+                         study::masked_database_url(target));
     }
     if (r.interrupted) return kExitInterrupted;
   }
@@ -395,7 +437,7 @@ bool failed_state(const std::string& s) {
 Status collect(const std::vector<LoadedBatch>& loaded, const std::string& db) {
   Status st;
   const std::vector<std::set<Pair>> stored = stored_pairs(db, loaded);
-  const std::vector<study::SlurmJob> jobs = study::read_jobs(db);
+  const std::vector<study::SlurmJob> jobs = batch_jobs(db, loaded);
 
   // What Slurm says about the recorded arrays: the live tasks (squeue) and the ended ones (sacct).
   std::map<std::string, int> games_per_task;
@@ -525,9 +567,8 @@ void print_status(const Status& st, const std::string& db, std::ostream& out) {
     rate = fmt::format("games/min   {:.1f}, ETA {}", *st.per_minute, duration_text(eta));
   }
   out << fmt::format(
-      "total       {} of {} runs stored in {} and its shards; {} running, {} "
-      "queued, {} missing\n{}\n",
-      st.done, st.total, db, st.running, st.queued, missing, rate);
+      "total       {} of {} runs stored in {}; {} running, {} queued, {} missing\n{}\n", st.done,
+      st.total, store_text(db), st.running, st.queued, missing, rate);
   for (const std::string& f : st.failed) out << "failed      " << f << "\n";
   if (!st.note.empty()) out << "note        " << st.note << "\n";
   if (missing > 0 && st.running + st.queued == 0) {
@@ -537,20 +578,24 @@ void print_status(const Status& st, const std::string& db, std::ostream& out) {
 
 // Submits the tasks of `st.missing_tasks` again with the last submission's job script (sbatch's
 // --array overrides the script's); records the job. Returns false (and says why) if it cannot.
-bool resubmit(const Status& st, const std::string& db, std::ostream& err) {
-  const std::vector<study::SlurmJob> jobs = study::read_jobs(db);
+bool resubmit(const Status& st, const std::string& db, const std::vector<LoadedBatch>& loaded,
+              std::ostream& err) {
+  const std::vector<study::SlurmJob> jobs = batch_jobs(db, loaded);
   if (jobs.empty() || st.missing_tasks.empty()) return false;
-  // The last job script: study-slurm/job-N.sh with the largest N.
-  std::string script;
+  // The last job script of this batch (job files of older llsfsim: study-slurm/job-N.sh with the
+  // largest N).
+  std::string script = jobs.back().script;
   int largest = 0;
   std::error_code ec;
-  for (const auto& e : fs::directory_iterator(study::slurm_dir(db), ec)) {
-    const std::string name = e.path().filename().string();
-    if (!name.starts_with("job-") || !name.ends_with(".sh")) continue;
-    const int n = std::atoi(name.c_str() + 4);
-    if (n > largest) {
-      largest = n;
-      script = e.path().string();
+  if (script.empty()) {
+    for (const auto& e : fs::directory_iterator(study::slurm_dir(db), ec)) {
+      const std::string name = e.path().filename().string();
+      if (!name.starts_with("job-") || !name.ends_with(".sh")) continue;
+      const int n = std::atoi(name.c_str() + 4);
+      if (n > largest) {
+        largest = n;
+        script = e.path().string();
+      }
     }
   }
   if (script.empty()) {
@@ -569,6 +614,7 @@ bool resubmit(const Status& st, const std::string& db, std::ostream& err) {
   job.job_id = job_id;
   job.submitted = utc_now();
   job.array = array;
+  job.script = script;
   job.stored_at_submit = st.done;
   study::append_job(db, job);
   err << fmt::format(
@@ -619,7 +665,7 @@ int batch_status(const StatusOptions& o, std::ostream& out, std::ostream& err) {
       if (resubmits_left == 0) break;
       if (bar) err << "\n";
       for (const std::string& f : st.failed) err << "failed      " << f << "\n";
-      if (!resubmit(st, db, err)) break;
+      if (!resubmit(st, db, loaded, err)) break;
       --resubmits_left;
       last_done = -1;
     }

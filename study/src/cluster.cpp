@@ -107,6 +107,8 @@ void append_job(const std::string& db, const SlurmJob& job) {
   std::ofstream f(path, std::ios::app);
   f << job.job_id << '\t' << job.submitted << '\t' << job.games_per_task << '\t' << job.array
     << '\t' << job.stored_at_submit << '\t' << job.total;
+  if (!job.batch.empty()) f << "\tbatch=" << job.batch;
+  if (!job.script.empty()) f << "\tscript=" << job.script;
   for (const std::string& s : job.scenarios) f << '\t' << s;
   f << '\n';
   f.flush();
@@ -127,7 +129,8 @@ std::vector<SlurmJob> read_jobs(const std::string& db) {
     auto bad = [&] {
       return core::ConfigError(path + ":" + std::to_string(n) +
                                ": not a job line (job id, submitted, games per task, array, "
-                               "stored, total, scenarios...; written by llsfsim batch --slurm)");
+                               "stored, total, batch=, script=, scenarios...; written by llsfsim "
+                               "batch --slurm)");
     };
     if (w.size() < 7) throw bad();
     SlurmJob j;
@@ -143,7 +146,18 @@ std::vector<SlurmJob> read_jobs(const std::string& db) {
     } catch (const std::exception&) {
       throw bad();
     }
-    j.scenarios.assign(w.begin() + 6, w.end());
+    auto field = w.begin() + 6;
+    for (; field != w.end(); ++field) {
+      if (field->starts_with("batch=")) {
+        j.batch = field->substr(6);
+      } else if (field->starts_with("script=")) {
+        j.script = field->substr(7);
+      } else {
+        break;
+      }
+    }
+    j.scenarios.assign(field, w.end());
+    if (j.scenarios.empty()) throw bad();
     out.push_back(std::move(j));
   }
   return out;

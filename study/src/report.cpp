@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <numeric>
 #include <sstream>
+#include <tuple>
 
 #include "llsf/core/assert.h"
 #include "llsf/core/data_dir.h"
@@ -100,7 +101,14 @@ BatchReport make_report(const StatsStore& store, std::int64_t batch_id, std::uin
   std::vector<std::string> order;
   std::map<std::string, std::map<std::string, std::vector<double>>> values;
   std::map<std::string, std::pair<int, int>> pass;  // runs, passed
-  for (const StoredRun& run : store.runs(batch_id)) {
+  // Runs by (variant, seed), not in stored order: the order in which workers, array tasks or a
+  // merge stored them must not change the bootstrap's resamples (the same report from a local
+  // batch and from the same batch played on a cluster).
+  std::vector<StoredRun> runs = store.runs(batch_id);
+  std::sort(runs.begin(), runs.end(), [](const StoredRun& a, const StoredRun& b) {
+    return std::tie(a.variant, a.seed) < std::tie(b.variant, b.seed);
+  });
+  for (const StoredRun& run : runs) {
     if (values.find(run.variant) == values.end()) order.push_back(run.variant);
     auto& per = values[run.variant];
     for (const auto& [name, v] : store.statistics(run.id)) per[name].push_back(v);

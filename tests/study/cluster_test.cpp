@@ -13,6 +13,7 @@
 #include "llsf/core/error.h"
 #include "llsf/study/batch.h"
 #include "llsf/study/scenario.h"
+#include "llsf/study/stats_store.h"
 #include "support/temp_dir.h"
 
 namespace {
@@ -161,9 +162,19 @@ TEST_CASE("Slurm: shard names, the job file") {
   CHECK(jobs[1].games_per_task == 6);
   CHECK(jobs[1].total == 40);
   CHECK(jobs[1].scenarios == std::vector<std::string>{"/a.yaml", "/b.yaml"});
+  CHECK(jobs[1].batch.empty());
+  // The batch's identity and the script: optional fields before the scenarios.
+  j.batch = "0123456789abcdef:20";
+  j.script = "/s/job-2.sh";
+  llsf::study::append_job(db, j);
+  const auto three = llsf::study::read_jobs(db);
+  REQUIRE(three.size() == 3);
+  CHECK(three[2].batch == "0123456789abcdef:20");
+  CHECK(three[2].script == "/s/job-2.sh");
+  CHECK(three[2].scenarios == std::vector<std::string>{"/a.yaml", "/b.yaml"});
   std::ofstream(llsf::study::job_file_path(db), std::ios::app) << "43\tx\n";
   CHECK_THROWS_WITH_AS(llsf::study::read_jobs(db),
-                       doctest::Contains("slurm-jobs:3: not a job line"), ConfigError);
+                       doctest::Contains("slurm-jobs:4: not a job line"), ConfigError);
   CHECK(llsf::study::is_database_url("postgresql://u@h:5432/db"));
   CHECK(llsf::study::job_file_path("postgresql://u:pw@h:5432/db?sslmode=require")
             .ends_with("/llsfsim-slurm/h_5432_db.slurm-jobs"));

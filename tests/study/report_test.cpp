@@ -3,8 +3,10 @@
 #include <doctest/doctest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "llsf/study/report.h"
 #include "llsf/study/stats_store.h"
@@ -88,4 +90,44 @@ TEST_CASE("a report summarises each variant and bounds the difference of means")
   CHECK(to_csv(quoted).find("\"config=\"\"P3\"\"\",points,") != std::string::npos);
   CHECK_THROWS_AS(make_report(store, 999), StatsError);
   std::filesystem::remove(path);
+}
+
+TEST_CASE("a report does not depend on the order in which the runs were stored") {
+  // Workers, Slurm array tasks and merges store runs in any order; the bootstrap's intervals
+  // must come out the same (the cluster test compares a local and a cluster batch's reports).
+  const std::filesystem::path dir = std::filesystem::temp_directory_path();
+  std::vector<std::string> texts;
+  for (const bool reversed : {false, true}) {
+    const std::string path =
+        (dir / ("llsf_report_order_" + std::to_string(::getpid()) + (reversed ? "r" : "f") + ".db"))
+            .string();
+    std::filesystem::remove(path);
+    {
+      StatsStore store(path);
+      BatchKey key;
+      key.scenario_file = "x.yaml";
+      key.scenario_name = "x";
+      key.scenario_hash = "h";
+      key.runs_per_variant = 12;
+      key.variants = 2;
+      const std::int64_t b = store.open_batch(key);
+      std::vector<RunResult> runs;
+      for (int seed = 1; seed <= 12; ++seed) {
+        for (const char* v : {"a", "b"}) {
+          RunResult r;
+          r.scenario = "x";
+          r.variant = v;
+          r.seed = static_cast<std::uint64_t>(seed);
+          r.points = (seed * 37) % 23 + (std::string(v) == "b" ? 5 : 0);
+          runs.push_back(r);
+        }
+      }
+      if (reversed) std::reverse(runs.begin(), runs.end());
+      for (const RunResult& r : runs) store.add_run(b, r);
+    }
+    const StatsStore store(path);
+    texts.push_back(to_text(make_report(store, store.batches().front().id)));
+    std::filesystem::remove(path);
+  }
+  CHECK(texts[0] == texts[1]);
 }

@@ -13,7 +13,7 @@
 
 namespace llsf::study {
 
-// (is_database_url(): llsf/study/stats_store.h)
+// is_database_url() (a postgresql:// URL or a SQLite file) is in stats_store.h.
 
 /// The SQLite shard that array task `task` writes for the store `db`: "<dir>/<stem>.shard-<task,
 /// 5 digits>.db" beside it (study.db -> study.shard-00003.db).
@@ -28,15 +28,20 @@ std::string job_file_path(const std::string& db);
 /// for a database server "llsfsim-slurm" in the current directory (absolute).
 std::string slurm_dir(const std::string& db);
 
-/// One submission, as kept in the job file (tab-separated, one line).
+/// One submission, as kept in the job file (tab-separated, one line: job id, submitted, games
+/// per task, array, stored, total, `batch=...`, `script=...`, scenarios).
 struct SlurmJob {
-  std::string job_id;                  ///< sbatch's job id of the array
-  std::string submitted;               ///< UTC, ISO 8601 (wall clock; progress only)
-  int games_per_task = 0;              ///< the slice length
-  std::string array;                   ///< the --array spec, e.g. "0-3,7%2"
-  std::int64_t stored_at_submit = 0;   ///< runs stored when submitted (for games per minute)
-  std::int64_t total = 0;              ///< runs of the batch
-  std::vector<std::string> scenarios;  ///< absolute paths
+  std::string job_id;                 ///< sbatch's job id of the array
+  std::string submitted;              ///< UTC, ISO 8601 (wall clock; progress only)
+  int games_per_task = 0;             ///< the slice length
+  std::string array;                  ///< the --array spec, e.g. "0-3,7%2"
+  std::int64_t stored_at_submit = 0;  ///< runs stored when submitted (for games per minute)
+  std::int64_t total = 0;             ///< runs of the batch
+  /// The batches' identities ("<scenario hash>:<runs per variant>" per file, comma-separated):
+  /// tells the submissions of two batches into one store apart ("" in lines of older llsfsim).
+  std::string batch;
+  std::string script;                  ///< the job script submitted ("" in older lines)
+  std::vector<std::string> scenarios;  ///< as given to `batch --slurm`
 };
 /// Appends `job` to the job file of `db`. Throws core::ConfigError if it cannot be written.
 void append_job(const std::string& db, const SlurmJob& job);
