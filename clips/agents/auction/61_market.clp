@@ -61,8 +61,8 @@
 
 (defrule au-status-send
   (declare (salience ?*PRIORITY-WM*))
-  (time $?now)
-  ?t <- (timer (name au-status) (time $?last&:(timeout ?now ?last 1.0)) (seq ?seq))
+  ?t <- (timer (name au-status) (time $?last) (seq ?seq))
+  (time $?now&:(timeout ?now ?last 1.0))
   =>
   (modify ?t (time ?now) (seq (+ ?seq 1)))
   (au-send-status)
@@ -170,11 +170,11 @@
 ; Looks for a task to announce every announce-period s while no auction of this robot is open.
 (defrule au-announce
   (declare (salience ?*PRIORITY-DECIDE*))
-  (time $?now)
   (game (phase PRODUCTION) (state RUNNING))
   (au-start (at ?s))
   (not (au-auction (state BIDDING)))
-  ?t <- (timer (name au-announce) (time $?last&:(timeout ?now ?last ?*AU-ANNOUNCE-PERIOD*)))
+  ?t <- (timer (name au-announce) (time $?last))
+  (time $?now&:(timeout ?now ?last ?*AU-ANNOUNCE-PERIOD*))
   (test (> (now) (+ ?s (au-start-grace))))
   (test (au-i-am-auctioneer))
   =>
@@ -217,8 +217,8 @@
 ; The bid window is over: the lowest bid wins (ties: the lower robot name).
 (defrule au-close
   (declare (salience ?*PRIORITY-DECIDE*))
-  (time $?)
   ?a <- (au-auction (id ?id) (key ?key) (state BIDDING) (deadline ?d))
+  (time $?)
   (test (> (now) ?d))
   =>
   (bind ?best NONE) (bind ?bc 0.0)
@@ -246,8 +246,8 @@
 ; No acknowledgement yet: send the award again; after award-timeout, auction the task again.
 (defrule au-award-resend
   (declare (salience ?*PRIORITY-DECIDE*))
-  (time $?)
   ?a <- (au-auction (id ?id) (key ?key) (state AWARDED) (since ?since) (sent ?s) (sends ?n))
+  (time $?)
   (test (> (now) (+ ?s (au-award-resend))))
   =>
   (if (> (now) (+ ?since (au-award-timeout)))
@@ -320,8 +320,8 @@
 
 (defrule au-silent-winner
   (declare (salience ?*PRIORITY-DECIDE*))
-  (time $?)
   ?a <- (au-auction (id ?id) (key ?key) (state RUNNING) (winner ?w) (seen ?s))
+  (time $?)
   (test (> (now) (+ ?s (au-silence-timeout))))
   =>
   (log-warn "auction " ?id ": " ?w " is silent, auctioning " ?key " again")
@@ -331,8 +331,8 @@
 
 (defrule au-cooldown-expired
   (declare (salience ?*PRIORITY-LOW*))
-  (time $?)
   ?c <- (au-cooldown (until ?u))
+  (time $?)
   (test (> (now) ?u))
   =>
   (retract ?c)

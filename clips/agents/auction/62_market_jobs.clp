@@ -106,11 +106,11 @@
 
 (defrule au-job-step
   (declare (salience ?*PRIORITY-DECIDE*))
-  (time $?)
   (game (phase PRODUCTION) (state RUNNING))
   ?j <- (au-job (state RUNNING) (kind ?k) (machine ?m) (input ?i) (steps ?n))
   (holding (puck ?h))
   (not (task))
+  (time $?)
   (test (not (au-cooling-down)))
   =>
   (bind ?step (au-step ?k ?m ?i ?h ?n))
@@ -132,11 +132,11 @@
 ; Without a task: what the robot holds decides (see the header).
 (defrule au-idle-holding
   (declare (salience ?*PRIORITY-DECIDE*))
-  (time $?)
   (game (phase PRODUCTION) (state RUNNING))
   (not (au-job))
   (not (task))
   (holding (puck ?h&~NONE&~S0&~S1))
+  (time $?)
   (test (not (au-cooling-down)))
   =>
   (bind ?step (au-step LOCAL NONE NONE ?h 1))
@@ -146,11 +146,11 @@
 
 (defrule au-idle-s1
   (declare (salience ?*PRIORITY-DECIDE*))
-  (time $?)
   (game (phase PRODUCTION) (state RUNNING))
   (not (au-job))
   (not (task))
   (holding (puck S1))
+  (time $?)
   =>
   (bind ?hs (find-fact ((?x au-hold)) TRUE))
   (if (= (length$ ?hs) 0)
@@ -173,8 +173,8 @@
 ; ...) is stopped: the skill fails, the step and the task fail, the task is auctioned again.
 (defrule au-step-watchdog
   (declare (salience ?*PRIORITY-DECIDE*))
-  (time $?)
   (task (state RUNNING) (kind ?k&~WAIT&~EXPLORE) (since ?s))
+  (time $?)
   (test (> (now) (+ ?s ?*AU-STEP-TIMEOUT*)))
   (skill (status RUNNING|IDLE))
   =>
