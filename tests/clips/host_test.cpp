@@ -394,3 +394,43 @@ TEST_CASE("fixture helpers: bad facts and queries") {
   CHECK(f.find("machine", {{"mtype", Value::symbol("T3")}}).empty());
   CHECK(f.agent().runtime_errors() == 0);
 }
+
+TEST_CASE("fact-by-slot finds the fact a do-for-fact query would, or FALSE") {
+  AgentFixture f;
+  f.load(
+      "(deftemplate m (slot name) (slot n) (multislot l))\n"
+      "(deffacts ms (m (name M1) (n 1)) (m (name M2) (n 2.0)) (m (name M2) (n 3)))\n");
+  f.step();
+  auto index = [&](const std::string& expr) { return f.agent().eval(expr); };
+  // The first of two M2 facts, as find-fact (the query functions' order) gives it.
+  const Value by_slot = index("(fact-index (fact-by-slot m name M2))");
+  const Value by_query = index("(fact-index (nth$ 1 (find-fact ((?x m)) (eq ?x:name M2))))");
+  CHECK(by_slot.type == Value::Type::kInteger);
+  CHECK(by_slot == by_query);
+  CHECK(index("(fact-slot-value (fact-by-slot m name M1) n)") == Value::integer_value(1));
+  // eq semantics: 2 is not 2.0; unknown values give FALSE.
+  CHECK(index("(fact-by-slot m n 2)") == Value::boolean(false));
+  CHECK(index("(fact-slot-value (fact-by-slot m n 2.0) name)") == Value::symbol("M2"));
+  CHECK(index("(fact-by-slot m name M9)") == Value::boolean(false));
+  // Modified in a rule: the look-up sees the new fact.
+  f.load(
+      "(defrule rename (go) =>\n"
+      "  (bind ?m (fact-by-slot m name M1))\n"
+      "  (if ?m then (modify ?m (name M7))))\n");
+  f.assert_fact("(go)");
+  CHECK(f.step().runtime_errors == 0);
+  CHECK(index("(fact-by-slot m name M1)") == Value::boolean(false));
+  CHECK(index("(fact-slot-value (fact-by-slot m name M7) n)") == Value::integer_value(1));
+  // Wrong templates and slots are runtime errors that name them.
+  f.load(
+      "(defrule bad-template (bad1) => (fact-by-slot nosuch name M1))\n"
+      "(defrule bad-slot (bad2) => (fact-by-slot m nosuch M1))\n"
+      "(defrule bad-multislot (bad3) => (fact-by-slot m l M1))\n");
+  f.assert_fact("(bad1)");
+  f.assert_fact("(bad2)");
+  f.assert_fact("(bad3)");
+  CHECK(f.step().runtime_errors == 3);
+  CHECK(f.logged("fact-by-slot: no deftemplate with slots named nosuch"));
+  CHECK(f.logged("fact-by-slot: deftemplate m has no slot nosuch"));
+  CHECK(f.logged("fact-by-slot: deftemplate m has a multislot l: use a single-field slot"));
+}
