@@ -29,8 +29,9 @@
 (deffunction explore-next (?from)
   (bind ?m ?from)
   (loop-for-count 10
-    (if (and (any-factp ((?x machine)) (and (eq ?x:name ?m) (eq ?x:explored FALSE)))
-             (not (any-factp ((?e explored-by-me)) (eq ?e:machine ?m)))
+    (bind ?f (fact-by-slot machine name ?m))
+    (if (and ?f (eq (fact-slot-value ?f explored) FALSE)
+             (not (fact-by-slot explored-by-me machine ?m))
              (not (any-factp ((?s explore-skip)) (and (eq ?s:machine ?m) (> ?s:until (now))))))
      then (return ?m))
     (bind ?m (ring-after ?m)))
