@@ -18,7 +18,9 @@ namespace {
 /// Receive buffer per UDP peer: larger than any legal frame, so that an oversized datagram is
 /// seen whole and counted as oversized (as UdpHub does).
 constexpr std::size_t kReceiveBuffer = 65536;
-/// Datagrams kept between two receive() calls; more are dropped unread (a flood between ticks).
+/// Datagrams read between two receive() calls. When that many are waiting the sockets are not
+/// read again until the next receive(): a flood stays in (and overflows) the kernel's buffer
+/// instead of keeping the game's thread in io_context::poll().
 constexpr std::size_t kMaxArrived = 4096;
 
 /// A copy of `m` with its times in wire time.
@@ -38,6 +40,7 @@ struct RefboxSockets::Peer {
   udp::endpoint destination;  ///< where the radio's frames for this peer go
   bool destination_known = false;
   bool learn_destination = false;
+  bool reading = false;  ///< a receive is pending (none while kMaxArrived datagrams wait)
   int bound_port = 0;
   std::vector<std::uint8_t> buffer = std::vector<std::uint8_t>(kReceiveBuffer);
 };
@@ -117,11 +120,13 @@ void RefboxSockets::attach(sim::Game& game) {
 
 void RefboxSockets::start_receive(int peer) {
   Peer& p = *peers_[static_cast<std::size_t>(peer)];
+  p.reading = true;
   p.socket.async_receive_from(
       asio::buffer(p.buffer), p.source,
       [this, peer](const boost::system::error_code& ec, std::size_t n) {
         if (ec == asio::error::operation_aborted) return;
         Peer& q = *peers_[static_cast<std::size_t>(peer)];
+        q.reading = false;
         if (!ec && arrived_.size() < kMaxArrived) {
           arrived_.push_back(
               {peer,
@@ -129,7 +134,7 @@ void RefboxSockets::start_receive(int peer) {
                                          q.buffer.begin() + static_cast<std::ptrdiff_t>(n)),
                q.source});
         }
-        start_receive(peer);
+        if (arrived_.size() < kMaxArrived) start_receive(peer);
       });
 }
 
@@ -208,6 +213,10 @@ void RefboxSockets::receive() {
   std::vector<Datagram> arrived;
   arrived.swap(arrived_);
   for (const Datagram& d : arrived) take_datagram(d);
+  // Peers whose reading stopped at kMaxArrived read again from the next poll on.
+  for (std::size_t i = 0; i < peers_.size(); ++i) {
+    if (!peers_[i]->reading) start_receive(static_cast<int>(i));
+  }
 }
 
 void RefboxSockets::take_datagram(const Datagram& d) {
