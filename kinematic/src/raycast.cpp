@@ -21,6 +21,8 @@ constexpr double kAngleSlack = 1e-9;
 /// Slack on the segment parameter so that a beam exactly through a corner shared by two visible
 /// faces hits at least one of them despite rounding.
 constexpr double kEdgeSlack = 1e-10;
+/// Slack on a box's bounding circle when a single ray is culled against it (RayCaster::cast).
+constexpr double kCullSlack = 1e-6;
 
 /// Per-scan state shared by the face and circle rasterisers. Geometry is taken relative to the
 /// origin and rotated by -angle0, so that beam i has direction (cos_[i], sin_[i]).
@@ -181,11 +183,11 @@ RayHit RayCaster::cast(const Vec2& origin, double angle_rad, double max_range_m,
   int index = -1;
 
   // Faces seen from their visible side.
-  for (const Segment& s : segments_) {
+  auto check_face = [&](const Segment& s) {
     const double wx = s.ax - origin.x(), wy = s.ay - origin.y();
     const double num = wx * s.ey - wy * s.ex;
     const double denom = dx * s.ey - dy * s.ex;
-    if (!(num < 0.0) || !(denom < 0.0)) continue;
+    if (!(num < 0.0) || !(denom < 0.0)) return;
     const double t = num / denom;
     const double u = (wx * dy - wy * dx) / denom;
     if (u >= -kEdgeSlack && u <= 1.0 + kEdgeSlack && t < best) {
@@ -193,6 +195,20 @@ RayHit RayCaster::cast(const Vec2& origin, double angle_rad, double max_range_m,
       kind = s.kind;
       index = s.index;
     }
+  };
+  for (int k = 0; k < wall_count_; ++k) check_face(segments_[k]);
+  // A box's faces only when the ray, up to max_range_m, passes within its bounding circle
+  // (widened by kCullSlack, far more than the faces' kEdgeSlack can reach past a corner): the
+  // faces of a box the ray cannot reach would give no hit, or one beyond max_range_m, which the
+  // result ignores (segments are in groups_ order, so the hits compared are the same).
+  for (const DeviceGroup& g : groups_) {
+    const double gx = g.cx - origin.x(), gy = g.cy - origin.y();
+    const double r = g.radius + kCullSlack;
+    const double along = gx * dx + gy * dy;  // the circle's centre projected on the ray
+    const double across = gx * dy - gy * dx;
+    if (across * across > r * r) continue;                // the line misses the circle
+    if (along < -r || along > max_range_m + r) continue;  // behind the origin, or out of range
+    for (int k = g.first; k < g.first + g.count; ++k) check_face(segments_[k]);
   }
 
   // Circles not containing the origin.

@@ -210,6 +210,42 @@ TEST_CASE("raycast: scan agrees with cast beam by beam") {
   }
 }
 
+TEST_CASE("raycast: cast matches the brute-force reference, also with short ranges") {
+  // cast() looks at a box's faces only when the ray passes its bounding circle within range:
+  // random rays near devices and short ranges test that the culling never loses a hit.
+  const WorldConfig config = field_2013();
+  const RayCaster caster(config);
+  llsf::core::RandomStream rng(20131126);
+  const std::vector<Circle> circles = {{{1.2, 1.0}, 0.185, 0}, {{2.2, 2.5}, 0.0375, 1}};
+  const double w = config.field.width_m, h = config.field.height_m;
+  int hits = 0, mismatches = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    Vec2 origin;
+    do {
+      if (trial % 2 == 0) {
+        origin = Vec2(rng.uniform(0.05, w - 0.05), rng.uniform(0.05, h - 0.05));
+      } else {
+        const DeviceConfig& d = config.devices[static_cast<std::size_t>(
+            rng.uniform_int(0, static_cast<std::int64_t>(config.devices.size()) - 1))];
+        origin = Vec2(d.pose.x + rng.uniform(-0.6, 0.6), d.pose.y + rng.uniform(-0.6, 0.6));
+      }
+    } while (inside_any_footprint(config, origin, 1e-3) || origin.x() <= 0.0 || origin.y() <= 0.0 ||
+             origin.x() >= w || origin.y() >= h);
+    const double angle = rng.uniform(-kPi, kPi);
+    const double max_range = rng.uniform(0.05, 2.0);
+    const double ref = reference_range(config, origin, angle, max_range, circles);
+    const RayHit hit = caster.cast(origin, angle, max_range, circles, {});
+    if (std::isinf(ref)) {
+      if (hit.kind != HitKind::kNone) ++mismatches;
+    } else {
+      ++hits;
+      if (hit.kind == HitKind::kNone || std::abs(hit.distance_m - ref) > 1e-9) ++mismatches;
+    }
+  }
+  CHECK(hits > 5000);
+  CHECK(mismatches == 0);
+}
+
 TEST_CASE("raycast: scan matches the brute-force reference from random poses") {
   const WorldConfig config = field_2013();
   const RayCaster caster(config);
