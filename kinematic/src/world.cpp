@@ -113,7 +113,32 @@ struct World::Impl : public b2ContactListener {
   std::vector<Robot> robots;
   std::vector<Puck> pucks;
   std::vector<PuckId> puck_ids;
-  std::unordered_map<std::int32_t, int> puck_index;
+  /// Puck id -> index in `pucks` (ids are positive; the usual small ones in a flat table, the
+  /// hot look-up of has_puck/puck_position, any other in the map).
+  struct PuckIndex {
+    static constexpr std::int32_t kFlat = 4096;
+    std::vector<int> flat;
+    std::unordered_map<std::int32_t, int> rest;
+    /// The index, or -1.
+    int find(std::int32_t id) const {
+      if (id >= 0 && id < kFlat) {
+        return id < static_cast<std::int32_t>(flat.size()) ? flat[static_cast<std::size_t>(id)]
+                                                           : -1;
+      }
+      auto it = rest.find(id);
+      return it == rest.end() ? -1 : it->second;
+    }
+    void insert(std::int32_t id, int index) {
+      if (id >= 0 && id < kFlat) {
+        if (id >= static_cast<std::int32_t>(flat.size()))
+          flat.resize(static_cast<std::size_t>(id) + 1, -1);
+        flat[static_cast<std::size_t>(id)] = index;
+      } else {
+        rest[id] = index;
+      }
+    }
+  };
+  PuckIndex puck_index;
   std::array<SignalLights, kDeviceCount> lights{};
   std::array<Vec2, kDeviceCount> zone_center{};
   std::array<double, kDeviceCount> zone_radius2{};
@@ -264,7 +289,7 @@ struct World::Impl : public b2ContactListener {
   void add_puck(PuckId id, const Vec2& pos) {
     if (id.value() <= 0)
       throw core::ConfigError("puck id must be > 0 (got " + std::to_string(id.value()) + ")");
-    if (puck_index.count(id.value()))
+    if (puck_index.find(id.value()) >= 0)
       throw core::ConfigError("puck " + std::to_string(id.value()) + " already exists");
     const PuckModelConfig& m = cfg.puck;
     b2BodyDef def;
@@ -297,15 +322,15 @@ struct World::Impl : public b2ContactListener {
     p.zone = -1;
     pucks.push_back(p);
     puck_ids.push_back(id);
-    puck_index[id.value()] = index;
+    puck_index.insert(id.value(), index);
     pending_zone_check.push_back(index);
   }
 
   int puck_at(PuckId id) const {
-    auto it = puck_index.find(id.value());
-    if (it == puck_index.end() || pucks[it->second].removed)
+    const int index = puck_index.find(id.value());
+    if (index < 0 || pucks[static_cast<std::size_t>(index)].removed)
       throw core::ConfigError("unknown puck " + std::to_string(id.value()));
-    return it->second;
+    return index;
   }
   const Robot& robot_at(RobotId id) const {
     LLSF_DEMAND_MSG(id.valid() && id.value() < static_cast<int>(robots.size()), "bad robot id");
@@ -676,8 +701,8 @@ const RobotSensors& World::sensors(RobotId robot) const { return impl_->robot_at
 
 std::span<const PuckId> World::pucks() const { return impl_->puck_ids; }
 bool World::has_puck(PuckId puck) const {
-  auto it = impl_->puck_index.find(puck.value());
-  return it != impl_->puck_index.end() && !impl_->pucks[it->second].removed;
+  const int index = impl_->puck_index.find(puck.value());
+  return index >= 0 && !impl_->pucks[static_cast<std::size_t>(index)].removed;
 }
 Vec2 World::puck_position(PuckId puck) const {
   return from_b2(impl_->pucks[impl_->puck_at(puck)].body->GetPosition());
@@ -701,7 +726,7 @@ void World::add_puck(PuckId puck, const Vec2& position) {
   if (!(position.x() > 0 && position.y() > 0 && position.x() < f.width_m &&
         position.y() < f.height_m))
     throw core::ConfigError("add_puck: position outside the field");
-  if (has_puck(puck) || impl_->puck_index.count(puck.value()))
+  if (has_puck(puck) || impl_->puck_index.find(puck.value()) >= 0)
     throw core::ConfigError("add_puck: puck " + std::to_string(puck.value()) + " already exists");
   impl_->add_puck(puck, position);
 }

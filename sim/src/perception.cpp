@@ -128,9 +128,13 @@ void LightDetection::update(SimTime now, const core::Pose2D& truth,
 int LightDetection::device_in_front(const core::Pose2D& pose, bool vision) const {
   int best = -1;
   double best_d = 0.0;
+  const double range2_margin = c_.range_m * c_.range_m * (1.0 + 1e-9) + 1e-12;
   for (int i = 0; i < static_cast<int>(devices_.size()); ++i) {
     const DeviceView& d = devices_[static_cast<std::size_t>(i)];
     const core::Vec2 v = d.front - pose.position();  // robot -> device front
+    // Far out of range, by a margin no rounding reaches: skip the square root (the exact test
+    // below decides the rest).
+    if (v.squaredNorm() > range2_margin) continue;
     const double dist = v.norm();
     if (dist > c_.range_m) continue;
     if (std::abs(core::angle_diff(std::atan2(v.y(), v.x()), pose.theta)) > c_.half_angle_rad) {
