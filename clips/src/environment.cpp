@@ -214,7 +214,7 @@ struct RouterAccess {
   // All user-defined functions go through this one entry point (context = FunctionEntry*).
   static void dispatch(void* env, DATA_OBJECT* rv) {
     auto* entry = static_cast<Environment::FunctionEntry*>(GetEnvironmentFunctionContext(env));
-    Args args(*entry->self, env, entry->name);
+    Args args(*entry->self, env, entry->name, rv);
     Value result;
     try {
       result = entry->fn(args);
@@ -222,6 +222,7 @@ struct RouterAccess {
       entry->self->error(entry->name, e.what());
       result = Value::boolean(false);
     }
+    if (args.returned() && result.type == Value::Type::kVoid) return;
     if (result.type == Value::Type::kVoid) {
       SetpType(rv, RVOID);
       SetpValue(rv, EnvFalseSymbol(env));
@@ -276,6 +277,98 @@ struct TraceHooks {
 int Args::count() const { return EnvRtnArgCount(clips_env_); }
 
 Value::Type Args::type(int i) const { return value(i).type; }
+
+ArgView Args::view(int i) const {
+  DATA_OBJECT d;
+  EnvRtnUnknown(clips_env_, i + 1, &d);
+  ArgView v;
+  switch (GetType(d)) {
+    case SYMBOL:
+    case INSTANCE_NAME:
+      v.type = Value::Type::kSymbol;
+      v.text = DOToString(d);
+      break;
+    case STRING:
+      v.type = Value::Type::kString;
+      v.text = DOToString(d);
+      break;
+    case INTEGER:
+      v.type = Value::Type::kInteger;
+      v.integer = DOToLong(d);
+      break;
+    case FLOAT:
+      v.type = Value::Type::kFloat;
+      v.real = DOToDouble(d);
+      break;
+    case EXTERNAL_ADDRESS:
+      v.type = Value::Type::kAddress;
+      v.address = DOToPointer(d) == nullptr ? nullptr : ValueToExternalAddress(GetValue(d));
+      break;
+    default:  // multifields and facts: copied
+      v.whole = to_value(clips_env_, d);
+      v.type = v.whole.type;
+  }
+  return v;
+}
+
+Value ArgView::to_value() const {
+  switch (type) {
+    case Value::Type::kSymbol:
+      return Value::symbol(std::string(text));
+    case Value::Type::kString:
+      return Value::string(std::string(text));
+    case Value::Type::kInteger:
+      return Value::integer_value(integer);
+    case Value::Type::kFloat:
+      return Value::float_value(real);
+    case Value::Type::kAddress:
+      return Value::external(address);
+    default:
+      return whole;
+  }
+}
+
+void Args::return_symbol(const char* text) {
+  auto* rv = static_cast<DATA_OBJECT*>(result_);
+  SetpType(rv, SYMBOL);
+  SetpValue(rv, EnvAddSymbol(clips_env_, text));
+  returned_ = true;
+}
+
+void Args::return_string(const char* text) {
+  auto* rv = static_cast<DATA_OBJECT*>(result_);
+  SetpType(rv, STRING);
+  SetpValue(rv, EnvAddSymbol(clips_env_, text));
+  returned_ = true;
+}
+
+void Args::return_integer(std::int64_t i) {
+  auto* rv = static_cast<DATA_OBJECT*>(result_);
+  SetpType(rv, INTEGER);
+  SetpValue(rv, EnvAddLong(clips_env_, i));
+  returned_ = true;
+}
+
+void Args::return_float(double d) {
+  auto* rv = static_cast<DATA_OBJECT*>(result_);
+  SetpType(rv, FLOAT);
+  SetpValue(rv, EnvAddDouble(clips_env_, d));
+  returned_ = true;
+}
+
+void Args::return_external(void* p) {
+  auto* rv = static_cast<DATA_OBJECT*>(result_);
+  SetpType(rv, EXTERNAL_ADDRESS);
+  SetpValue(rv, EnvAddExternalAddress(clips_env_, p, C_POINTER_EXTERNAL_ADDRESS));
+  returned_ = true;
+}
+
+void Args::return_boolean(bool b) {
+  auto* rv = static_cast<DATA_OBJECT*>(result_);
+  SetpType(rv, SYMBOL);
+  SetpValue(rv, b ? EnvTrueSymbol(clips_env_) : EnvFalseSymbol(clips_env_));
+  returned_ = true;
+}
 
 Value Args::value(int i) const {
   DATA_OBJECT d;

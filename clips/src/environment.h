@@ -21,12 +21,32 @@ namespace llsf::clips::detail {
 
 class Environment;
 
+/// One argument read once without copying its text (Args::view; valid during the call only).
+struct ArgView {
+  Value::Type type = Value::Type::kVoid;
+  std::int64_t integer = 0;  ///< kInteger
+  double real = 0.0;         ///< kFloat
+  std::string_view text;     ///< kSymbol, kString (null-terminated: CLIPS' symbol table)
+  void* address = nullptr;   ///< kAddress
+  Value whole;               ///< kMultifield and kFact only: the copied value
+  bool is_number() const { return type == Value::Type::kInteger || type == Value::Type::kFloat; }
+  double number() const {
+    return type == Value::Type::kInteger ? static_cast<double>(integer)
+                                         : (type == Value::Type::kFloat ? real : 0.0);
+  }
+  bool is_symbol(std::string_view s) const { return type == Value::Type::kSymbol && text == s; }
+  /// The argument as a Value (for messages).
+  Value to_value() const;
+};
+
 /// The arguments of a call of a user-defined function (valid during the call only). Indices are
-/// 0-based. The typed accessors read without copying into a Value (cheap in LHS tests).
+/// 0-based. The typed accessors read without copying into a Value (cheap in LHS tests). A
+/// function may also set its result directly (return_*; then what it returns is ignored), which
+/// spares the Value in between.
 class Args {
  public:
-  Args(Environment& env, void* clips_env, std::string_view function)
-      : env_(env), clips_env_(clips_env), function_(function) {}
+  Args(Environment& env, void* clips_env, std::string_view function, void* result = nullptr)
+      : env_(env), clips_env_(clips_env), function_(function), result_(result) {}
   int count() const;
   Value::Type type(int i) const;
   /// The argument as a Value (copies text and multifields).
@@ -41,14 +61,29 @@ class Args {
   bool address(int i, void*& out) const;
   /// A time: a multifield (sec usec) as in (time sec usec) facts, or a number of seconds.
   bool time(int i, double& seconds) const;
+  /// The argument, evaluated once (an argument's expression runs on every read: read it once).
+  ArgView view(int i) const;
   /// The function's name (for error messages).
   std::string_view function() const { return function_; }
   Environment& env() const { return env_; }
+
+  /// Sets the call's result directly (only inside a dispatched call): the text must be
+  /// null-terminated.
+  void return_symbol(const char* text);
+  void return_string(const char* text);
+  void return_integer(std::int64_t i);
+  void return_float(double d);
+  void return_external(void* p);
+  void return_boolean(bool b);
+  /// True once a return_* was called.
+  bool returned() const { return returned_; }
 
  private:
   Environment& env_;
   void* clips_env_;
   std::string_view function_;
+  void* result_;  // the call's DATA_OBJECT*
+  bool returned_ = false;
 };
 
 /// A fact kept alive for later retraction (CLIPS' fact count is incremented while held).

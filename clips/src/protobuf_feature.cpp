@@ -49,7 +49,8 @@ class ProtobufFeature final : public Feature {
         a.env().error(a.function(), f->name() + " is repeated: use pb-field-list");
         return Value::boolean(false);
       }
-      return get(*m, f, -1);
+      return_field(a, *m, f);
+      return Value{};
     });
     env.define_function("pb-field-list", "22*", [this](Args& a) {
       Message* m = nullptr;
@@ -331,6 +332,35 @@ class ProtobufFeature final : public Feature {
     return {};
   }
 
+  // pb-field-value's result, set directly (no Value in between; the same values as get()).
+  void return_field(Args& a, Message& m, const FieldDescriptor* f) {
+    const Reflection* r = m.GetReflection();
+    switch (f->cpp_type()) {
+      case FieldDescriptor::CPPTYPE_INT32:
+        return a.return_integer(r->GetInt32(m, f));
+      case FieldDescriptor::CPPTYPE_INT64:
+        return a.return_integer(r->GetInt64(m, f));
+      case FieldDescriptor::CPPTYPE_UINT32:
+        return a.return_integer(r->GetUInt32(m, f));
+      case FieldDescriptor::CPPTYPE_UINT64:
+        return a.return_integer(static_cast<std::int64_t>(r->GetUInt64(m, f)));
+      case FieldDescriptor::CPPTYPE_DOUBLE:
+        return a.return_float(r->GetDouble(m, f));
+      case FieldDescriptor::CPPTYPE_FLOAT:
+        return a.return_float(r->GetFloat(m, f));
+      case FieldDescriptor::CPPTYPE_BOOL:
+        return a.return_boolean(r->GetBool(m, f));
+      case FieldDescriptor::CPPTYPE_ENUM:
+        return a.return_symbol(r->GetEnum(m, f)->name().c_str());
+      case FieldDescriptor::CPPTYPE_STRING: {
+        std::string scratch;
+        return a.return_string(r->GetStringReference(m, f, &scratch).c_str());
+      }
+      case FieldDescriptor::CPPTYPE_MESSAGE:
+        return a.return_external(get(m, f, -1).address);
+    }
+  }
+
   Value set(Args& a, bool add_to_list) {
     Message* m = nullptr;
     const FieldDescriptor* f = field(a, m);
@@ -345,10 +375,11 @@ class ProtobufFeature final : public Feature {
       return Value{};
     }
     const Reflection* r = m->GetReflection();
-    const Value v = a.value(2);
+    const ArgView v = a.view(2);  // read once: the argument's expression runs on every read
     auto fail = [&](const char* expected) {
+      const std::string got = v.to_value().to_string();
       a.env().error(a.function(), f->full_name() + " expects " + expected + ", got " +
-                                      (v.to_string().empty() ? "nothing" : v.to_string()));
+                                      (got.empty() ? "nothing" : got));
       return Value{};
     };
     switch (f->cpp_type()) {
@@ -404,7 +435,7 @@ class ProtobufFeature final : public Feature {
       case FieldDescriptor::CPPTYPE_ENUM: {
         const google::protobuf::EnumValueDescriptor* ev = nullptr;
         if (v.type == Value::Type::kSymbol || v.type == Value::Type::kString)
-          ev = f->enum_type()->FindValueByName(v.text);
+          ev = f->enum_type()->FindValueByName(std::string(v.text));
         else if (v.type == Value::Type::kInteger)
           ev = f->enum_type()->FindValueByNumber(static_cast<int>(v.integer));
         if (ev == nullptr) return fail(("a value of " + f->enum_type()->full_name()).c_str());
@@ -414,7 +445,8 @@ class ProtobufFeature final : public Feature {
       case FieldDescriptor::CPPTYPE_STRING:
         if (v.type != Value::Type::kString && v.type != Value::Type::kSymbol)
           return fail("a string");
-        add_to_list ? r->AddString(m, f, v.text) : r->SetString(m, f, v.text);
+        add_to_list ? r->AddString(m, f, std::string(v.text))
+                    : r->SetString(m, f, std::string(v.text));
         return Value{};
       case FieldDescriptor::CPPTYPE_MESSAGE: {
         if (v.type != Value::Type::kAddress) return fail("a message");
