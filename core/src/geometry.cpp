@@ -7,6 +7,9 @@
 namespace llsf::core {
 
 double normalize_angle(double rad) {
+  // Already in (-pi, pi]: remainder() would return it unchanged (|rad / 2 pi| <= 1/2, a tie
+  // rounding to the even quotient 0), so skip the libm call (most calls).
+  if (rad > -kPi && rad <= kPi) return rad;
   double a = std::remainder(rad, 2.0 * kPi);  // in [-pi, pi]
   if (a <= -kPi) a += 2.0 * kPi;
   return a;

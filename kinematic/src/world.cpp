@@ -707,6 +707,12 @@ bool World::has_puck(PuckId puck) const {
 Vec2 World::puck_position(PuckId puck) const {
   return from_b2(impl_->pucks[impl_->puck_at(puck)].body->GetPosition());
 }
+bool World::any_puck_within(const Vec2& point, double distance_m) const {
+  for (const auto& p : impl_->pucks) {
+    if (!p.removed && (from_b2(p.body->GetPosition()) - point).norm() < distance_m) return true;
+  }
+  return false;
+}
 Vec2 World::puck_velocity(PuckId puck) const {
   return from_b2(impl_->pucks[impl_->puck_at(puck)].body->GetLinearVelocity());
 }

@@ -561,10 +561,7 @@ bool Game::insertion_slot_occupied() const {
   // Occupied if a new puck at the slot would overlap one already there.
   const core::Vec2 slot = config_.world.field.late_order_slot;
   const double clear = 2.0 * config_.world.puck.radius_m;
-  for (const core::PuckId p : world_->pucks()) {
-    if (world_->has_puck(p) && (world_->puck_position(p) - slot).norm() < clear) return true;
-  }
-  return false;
+  return world_->any_puck_within(slot, clear);
 }
 
 core::Vec2 Game::free_storage_spot() const {

@@ -100,6 +100,9 @@ class World {
   std::span<const PuckId> pucks() const;
   bool has_puck(PuckId puck) const;
   Vec2 puck_position(PuckId puck) const;
+  /// True if the centre of a puck in the world is closer than `distance_m` to `point`
+  /// (|position - point| < distance_m; one pass, no look-ups).
+  bool any_puck_within(const Vec2& point, double distance_m) const;
   Vec2 puck_velocity(PuckId puck) const;
   /// The device whose RFID zone the puck's centre is in, if any.
   std::optional<DeviceId> puck_zone(PuckId puck) const;
