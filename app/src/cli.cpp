@@ -83,6 +83,11 @@ int run(std::span<const std::string> args, std::ostream& out, std::ostream& err)
   }
   {
     CLI::App* sub = app.add_subcommand(
+        "field-map", "Draw the field with coordinates, machines, places and obstacles (SVG)");
+    commands.emplace_back(sub, add_field_map_command(*sub));
+  }
+  {
+    CLI::App* sub = app.add_subcommand(
         "serve", "Serve the browser viewer, stored batches and recordings over HTTP");
     commands.emplace_back(sub, add_serve_command(*sub));
   }

@@ -54,6 +54,8 @@ Action add_exercise_command(CLI::App& app);
 Action add_test_agent_command(CLI::App& app);
 /// `llsfsim new agent`: a minimal working two-robot agent with a scenario and a rule test.
 Action add_new_command(CLI::App& app);
+/// `llsfsim field-map`: the field as an SVG with coordinates (or Markdown tables), from the config.
+Action add_field_map_command(CLI::App& app);
 /// `llsfsim serve`: the browser viewer's HTTP/WebSocket server (server.h) until SIGINT/SIGTERM.
 Action add_serve_command(CLI::App& app);
 
