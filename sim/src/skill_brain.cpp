@@ -61,7 +61,14 @@ void SkillBrain::report_state() {
     ++e;
   const std::string_view skill(str.data() + b, e - b);
   std::string st = skill.empty() ? std::string() : engine_.skill_state(skill);
-  if (skill == state_skill_ && st == state_) return;
+  // A string that ended resets its skills: its end is the state then.
+  const lua::SkillStatus status = engine_.status();
+  if (st.empty() && (status == lua::SkillStatus::kFinal || status == lua::SkillStatus::kFailed))
+    st = lua::to_string(status);
+  if (st == state_ && (skill == state_skill_ || st.empty())) {
+    if (skill != state_skill_) state_skill_ = std::string(skill);  // a new string, no state yet
+    return;
+  }
   SkillStateChange c;
   c.time = game_.time();
   c.robot = std::string(game_.robot(index_).name());
