@@ -98,6 +98,8 @@ export interface DrawOptions {
   grid?: boolean;
   /// A point to mark (the mouse), in field coordinates.
   mouse?: [number, number] | null;
+  /// Goals the navigator refused or gave up on lately: a purple cross there, fading with age (s).
+  navGoals?: {x: number; y: number; age: number; refused: boolean}[];
 }
 
 /// How a puck is drawn: fill, label colour, and the hackathon's marks.
@@ -534,6 +536,27 @@ export function drawField(
     ctx.textAlign = "center";
     ctx.textBaseline = "top";
     ctx.fillText(`radio drop (${state.drops} total)`, X(fw / 2), Y(fh) + 4);
+  }
+
+  // Goals the navigator refused (or failed to reach) in the last seconds: a purple cross.
+  for (const g of options.navGoals ?? []) {
+    ctx.save();
+    ctx.globalAlpha = Math.max(0.15, 1 - g.age / 3);
+    ctx.strokeStyle = "#8e24aa";
+    ctx.lineWidth = 3;
+    const k = 7;
+    ctx.beginPath();
+    ctx.moveTo(X(g.x) - k, Y(g.y) - k);
+    ctx.lineTo(X(g.x) + k, Y(g.y) + k);
+    ctx.moveTo(X(g.x) - k, Y(g.y) + k);
+    ctx.lineTo(X(g.x) + k, Y(g.y) - k);
+    ctx.stroke();
+    ctx.fillStyle = "#8e24aa";
+    ctx.font = `bold ${fontPx - 1}px sans-serif`;
+    ctx.textAlign = "left";
+    ctx.textBaseline = "bottom";
+    ctx.fillText(g.refused ? "refused" : "failed", X(g.x) + k + 2, Y(g.y) - 2);
+    ctx.restore();
   }
 
   // The mouse, with the grid on: a cross hair through the field.

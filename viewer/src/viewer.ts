@@ -347,6 +347,21 @@ class Replay {
     if (this.grid && !this.playing) this.redraw();
   }
 
+  /// The navigator's refused or failed goals of the last 3 s before the shown time.
+  private navGoals(): {x: number; y: number; age: number; refused: boolean}[] {
+    const out: {x: number; y: number; age: number; refused: boolean}[] = [];
+    const log = this.rec.skillLog;
+    for (let i = this.rec.skillLogUpTo(this.time) - 1; i >= 0; i--) {
+      const e = log[i];
+      const age = this.time - e.t;
+      if (age > 3) break;
+      if (e.kind === "nav" && e.goal) {
+        out.push({x: e.goal[0], y: e.goal[1], age, refused: e.level === "refused"});
+      }
+    }
+    return out;
+  }
+
   setGrid(on: boolean): void {
     this.grid = on;
     this.gridBox.checked = on;
@@ -521,6 +536,7 @@ class Replay {
       selected: this.agentOpen ? this.agentPanel.robot : "",
       grid: this.grid,
       mouse: this.mouse,
+      navGoals: this.navGoals(),
     });
     this.maxSightings = Math.max(this.maxSightings, this.lastStats.sightings);
     ++this.framesDrawn;

@@ -12,7 +12,9 @@
 //      another) and `--record`, opened with `llsfsim serve` at #/file/NAME: the printed lines
 //      are markers on the timeline (hovering shows the text, clicking seeks to the line's
 //      time), the skill's state changes and lines are in the panel, the grid and the mouse's
-//      field coordinates show, and at the end the verdict banner says PASS.
+//      field coordinates show, and at the end the verdict banner says PASS;
+//   3. replay: the same skill sent to a goal inside M1: the navigator's refusal is a marker on
+//      the timeline and a line in the panel, and the banner says FAIL and why.
 // Screenshots go to ARTIFACT_DIR. Exit code 0, or 1 with a message.
 import {execFileSync} from "node:child_process";
 import {mkdirSync, mkdtempSync, rmSync, writeFileSync} from "node:fs";
@@ -114,6 +116,7 @@ try {
   check(liveEnd.skills[0].lines.some((l) => /^rescue: \S+ → \S+/.test(l)),
         `no state change in the skill panel: ${JSON.stringify(liveEnd.skills[0].lines)}`);
   await page.screenshot({path: join(artifacts, "exercise-live-end.png")});
+  await page.goto("about:blank");  // the live page polls its server: leave it first
   live.child.kill("SIGTERM");
 
   // 2. Replay of a recording of exercise 01 with a skill that prints.
@@ -174,6 +177,34 @@ try {
   check(/^PASS\b.*m from the target/.test(banner), `the verdict banner says "${banner}"`);
   check(end.skills[0].state === "FINAL", `the skill's state at the end: ${end.skills[0].state}`);
   await page.screenshot({path: join(artifacts, "exercise-replay-end.png")});
+
+  // 3. The same skill sent into M1: the navigator's refusal on the timeline and in the panel,
+  // and a FAIL banner saying why.
+  writeFileSync(join(tmp, "into_m1.lua"),
+                printingSkill.replace("x = self.fsm.vars.x, y = self.fsm.vars.y,", "x = 3.92, y = 1.68,"));
+  let failed = "";
+  try {
+    execFileSync(llsfsim,
+                 ["exercise", "01", "--skill", "into_m1.lua", "--record", join("rec", "nav.jsonl.gz")],
+                 {cwd: tmp, encoding: "utf8", stdio: ["ignore", "pipe", "pipe"], env, timeout: 60_000});
+  } catch (e) {
+    failed = e.stdout ?? "";
+  }
+  check(/result\s+FAIL/.test(failed), `exercise 01 into M1 did not fail:\n${failed}`);
+  await page.goto(`${served.url}#/file/nav.jsonl.gz`);
+  await ready("#/file/nav.jsonl.gz");
+  const nav = await debug();
+  const refusal = nav.markers.find((m) => m.kind === "nav");
+  check(refusal && /refused \(3\.92, 1\.68\): INVALID_GOAL .*inside M1/.test(refusal.label),
+        `no navigator refusal on the timeline: ${JSON.stringify(nav.markers)}`);
+  await page.evaluate((t) => window.llsfViewer.seek(t), refusal.t);
+  const atRefusal = await debug();
+  check(atRefusal.skills[0].lines.some((l) => l.startsWith("navigator refused")),
+        `the panel at the refusal: ${JSON.stringify(atRefusal.skills)}`);
+  await page.screenshot({path: join(artifacts, "exercise-replay-nav.png")});
+  await page.evaluate(() => window.llsfViewer.seek(window.llsfViewer.endTime()));
+  const failBanner = await page.textContent("[data-verdict]");
+  check(/^FAIL\b.*inside M1/.test(failBanner), `the FAIL banner says "${failBanner}"`);
 
   check(errors.length === 0, errors.join("\n"));
   ok = true;
