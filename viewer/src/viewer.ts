@@ -599,7 +599,8 @@ class Replay {
         this.robotName(name, color, r?.role ?? ""),
         el("div", {class: "skill"}, r?.skill ? `${r.skill} ${r.status}` : "–"),
         r?.skillInfo ? el("div", {class: "info"}, r.skillInfo) : "",
-        skill.node,
+        // The skill's section where skills log or report states (or in the hackathon).
+        h.hackathon || this.rec.skillLog.length > 0 ? skill.node : "",
         agentLine
           ? el(
               "div",
