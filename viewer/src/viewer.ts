@@ -8,7 +8,7 @@
 // Test hook: window.llsfViewer (see Replay.hook); #app carries data-page and data-ready.
 import {AgentPanel, fmtTime, type AgentView} from "./agent_panel";
 import {colourCss, drawField, fieldScale, kPuckColors, kRobotColors} from "./field";
-import {Cursor, Recording, type State} from "./recording";
+import {Cursor, kSightingMemory, Recording, type State} from "./recording";
 import {skillSection, verdictBanner, type SkillView} from "./skill_panel";
 import {el, renderReport, table, type Child, type ReportData} from "./report_view";
 
@@ -341,7 +341,25 @@ class Replay {
     if (!p || !h) return;
     const on = p[0] >= 0 && p[1] >= 0 && p[0] <= h.field.width && p[1] <= h.field.height;
     this.mouse = on ? p : null;
-    const text = on ? `x ${p[0].toFixed(2)}  y ${p[1].toFixed(2)} m` : "";
+    let text = on ? `x ${p[0].toFixed(2)}  y ${p[1].toFixed(2)} m` : "";
+    // A camera sighting under the mouse: its colour, robot and age.
+    const st = on ? this.cursor.at(this.time) : null;
+    let best = 0.08;
+    let near = "";
+    for (const [name, r] of Object.entries(st?.robots ?? {})) {
+      for (const f of r.sightings ?? []) {
+        const age = this.time - f.t;
+        if (age < 0 || age > kSightingMemory) continue;
+        for (const [x, y, colour] of f.pucks) {
+          const d = Math.hypot(x - p[0], y - p[1]);
+          if (d < best) {
+            best = d;
+            near = ` · ${colour} seen by ${name} ${age.toFixed(1)} s ago at (${x.toFixed(2)}, ${y.toFixed(2)})`;
+          }
+        }
+      }
+    }
+    text += near;
     this.mouseLabel.textContent = text;
     this.mouseLabel.setAttribute("data-mouse", text);
     if (this.grid && !this.playing) this.redraw();
