@@ -550,7 +550,9 @@ int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err)
   out << "result   " << (passed ? "PASS" : "FAIL") << "\n";
   if (recorder) {  // the verdict is the recording's last line (the viewer's banner)
     const std::string error =
-        failed >= 0 ? brains[static_cast<std::size_t>(failed)]->engine().error() : "";
+        failed >= 0 ? user_paths(brains[static_cast<std::size_t>(failed)]->engine().error(),
+                                 skill_dir.path(), user)
+                    : "";
     recorder->verdict(game.time(), passed ? "PASS" : "FAIL", score,
                       why_not.empty() ? error : why_not);
     recorder->close();
