@@ -20,14 +20,36 @@ export interface SkillView {
   lines: string[];
 }
 
-/// The newest `max` entries of `robot` with t <= time, oldest first.
-export function recentSkillLog(rec: Recording, robot: string, time: number, max: number): SkillLog[] {
+/// Navigator refusals and failures listed apart (the newest), so that log lines do not push
+/// them out.
+export const kNavShown = 5;
+
+/// The newest `max` entries of `robot` with t <= time (of the kinds `kinds`), oldest first.
+export function recentSkillLog(
+  rec: Recording,
+  robot: string,
+  time: number,
+  max: number,
+  kinds: readonly SkillLog["kind"][] = ["log", "state", "nav"],
+): SkillLog[] {
   const out: SkillLog[] = [];
   for (let i = rec.skillLogUpTo(time) - 1; i >= 0 && out.length < max; i--) {
     const e = rec.skillLog[i];
-    if (e.robot === robot) out.push(e);
+    if (e.robot === robot && kinds.includes(e.kind)) out.push(e);
   }
   return out.reverse();
+}
+
+function lineRow(e: SkillLog, seek: (t: number) => void): HTMLElement {
+  const row = el(
+    "div",
+    {class: `sline ${e.kind} ${e.level}`, title: `${fmtTime(e.t)}: click to go there`},
+    el("span", {class: "at"}, fmtTime(e.t)),
+    " ",
+    e.kind === "log" && e.level !== "info" ? `${e.level}: ${e.text}` : e.text,
+  );
+  row.onclick = () => seek(e.t);
+  return row;
 }
 
 /// The section of robot `name` at `time`; `seek` is called with a line's time when it is clicked.
@@ -38,7 +60,8 @@ export function skillSection(
   time: number,
   seek: (t: number) => void,
 ): {node: HTMLElement; view: SkillView} {
-  const lines = recentSkillLog(rec, name, time, kSkillLogShown);
+  const lines = recentSkillLog(rec, name, time, kSkillLogShown, ["log", "state"]);
+  const navs = recentSkillLog(rec, name, time, kNavShown, ["nav"]);
   const state = r?.skillState ?? "";
   const head = el(
     "div",
@@ -47,29 +70,24 @@ export function skillSection(
     el("b", {}, state || "–"),
     state && r && r.skillStateT >= 0 ? ` since ${fmtTime(r.skillStateT)}` : "",
   );
-  const list = el("div", {class: "slog", "data-skill-log": name});
-  for (const e of lines) {
-    const row = el(
-      "div",
-      {class: `sline ${e.kind} ${e.level}`, title: `${fmtTime(e.t)}: click to go there`},
-      el("span", {class: "at"}, fmtTime(e.t)),
-      " ",
-      e.kind === "log" && e.level !== "info" ? `${e.level}: ${e.text}` : e.text,
-    );
-    row.onclick = () => seek(e.t);
-    list.append(row);
-  }
-  const nav = lines.filter((e) => e.kind === "nav").length;
+  const list = el("div", {class: "slog", "data-skill-log": name}, ...lines.map((e) => lineRow(e, seek)));
+  const navList = el("div", {class: "slog", "data-nav-log": name}, ...navs.map((e) => lineRow(e, seek)));
   const node = el(
     "div",
     {class: "skillbox"},
     head,
     lines.length > 0 ? list : el("div", {class: "info"}, "no skill lines yet"),
-    nav > 0 ? el("div", {class: "info"}, `${nav} navigator refusal(s)/failure(s) above`) : "",
+    navs.length > 0 ? el("div", {class: "sstate"}, "navigator refused or failed:") : "",
+    navs.length > 0 ? navList : "",
   );
   return {
     node,
-    view: {robot: name, skill: r?.skillName ?? "", state, lines: lines.map((e) => e.text)},
+    view: {
+      robot: name,
+      skill: r?.skillName ?? "",
+      state,
+      lines: [...lines, ...navs].sort((a, b) => a.t - b.t).map((e) => e.text),
+    },
   };
 }
 
