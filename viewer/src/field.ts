@@ -419,7 +419,9 @@ export function drawField(
   header.robots.forEach((name) => {
     const frames = state.robots[name]?.sightings;
     if (!frames) return;
-    const latest = frames.length > 0 ? frames[frames.length - 1].t : -1;
+    // The camera's latest frame (its last line, with pucks or empty) is drawn solid while it is
+    // new (under 0.15 s, a 10 Hz camera's next frame comes after 0.1 s).
+    const latest = state.robots[name]?.sightingT ?? -1;
     for (const f of frames) {
       const age = time - f.t;
       if (age < 0 || age > kSightingMemory) continue;

@@ -77,9 +77,11 @@ export interface RobotState {
   dropT: number;  // time of the last drop attributed to this robot
   path: [number, number][] | null;
   held: number;
-  /// The colour camera's recent frames with pucks (field frame), oldest first, at most
-  /// kSightingMemory s old at the time of the last line; an empty frame clears them.
+  /// The colour camera's recent frames with pucks (field frame), oldest first, kept for
+  /// kSightingMemory s (an empty frame adds none: the older ones fade on).
   sightings: SightingFrame[];
+  /// The time of the camera's last `sightings` line (with pucks or empty), -1 before one.
+  sightingT: number;
   /// The state of the skill string's first skill (`skill_state` lines), "" when none.
   skillName: string;
   skillState: string;
@@ -172,6 +174,7 @@ function emptyRobot(): RobotState {
     path: null,
     held: 0,
     sightings: [],
+    sightingT: -1,
     skillName: "",
     skillState: "",
     skillStateT: -1,
@@ -345,8 +348,10 @@ function apply(s: State, header: Header, line: Line): void {
         : [];
       // Robots of recordings before sightings existed have no list (snapshots made then).
       const frames = (robot.sightings ??= []);
-      if (pucks.length === 0) frames.length = 0;
-      else frames.push({t: line.t, pucks: pucks.map((p) => [p[0], p[1], String(p[2] ?? "")])});
+      robot.sightingT = line.t;
+      if (pucks.length > 0) {
+        frames.push({t: line.t, pucks: pucks.map((p) => [p[0], p[1], String(p[2] ?? "")])});
+      }
       while (frames.length > 0 && frames[0].t < line.t - kSightingMemory) frames.shift();
       break;
     }
