@@ -376,6 +376,7 @@ int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err)
     sim::SkillBrain& b = *brains[i];
     const std::string name(game.robot(static_cast<int>(i)).name());
     b.engine().set_log_sink([&, name](lua::LogLevel level, std::string_view text) {
+      if (recorder) recorder->log(game.time(), name, level, text);
       if (o.quiet && level < lua::LogLevel::kWarn) return;
       static const char* const names[] = {"debug", "info", "warn", "error"};
       out << stamp(game.time()) << " " << name << " " << names[static_cast<int>(level)] << ": "
@@ -389,6 +390,8 @@ int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err)
       if (!c.result.empty()) out << "  -> " << c.result;
       out << "\n";
     });
+    if (recorder)
+      b.set_state_listener([&](const sim::SkillStateChange& c) { recorder->skill_state(c); });
   }
 
   // Paced mode (the wall clock only paces the loop; it never enters the game).
@@ -470,8 +473,6 @@ int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err)
     }
     return false;
   });
-  if (recorder) recorder->close();
-  feed.finish();
 
   // The verdict.
   bool passed = false;
@@ -547,6 +548,16 @@ int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err)
   out << "score    " << score << "\n";
   if (!why_not.empty()) out << "why      " << why_not << "\n";
   out << "result   " << (passed ? "PASS" : "FAIL") << "\n";
+  if (recorder) {  // the verdict is the recording's last line (the viewer's banner)
+    const std::string error =
+        failed >= 0 ? user_paths(brains[static_cast<std::size_t>(failed)]->engine().error(),
+                                 skill_dir.path(), user)
+                    : "";
+    recorder->verdict(game.time(), passed ? "PASS" : "FAIL", score,
+                      why_not.empty() ? error : why_not);
+    recorder->close();
+  }
+  feed.finish();
   serve_until_stopped(o.live, server, out);
   return passed ? kExitOk : kExitFailed;
 }

@@ -351,6 +351,9 @@ void ColourCamera::update(SimTime now, const core::Pose2D& truth, std::span<cons
   next_frame_ += period;
   if (next_frame_ <= now) next_frame_ = now + period;
   sightings_.clear();
+  frame_time_ = now;
+  frame_pose_ = truth;
+  ++frames_;
   const double half_fov = 0.5 * c_.fov_rad;
   const int colours = static_cast<int>(colour_names_.size());
   for (std::size_t i = 0; i < pucks.size() && i < puck_colours.size(); ++i) {

@@ -85,7 +85,9 @@ kinematic::MotorCommand RobotStack::actuate(SimTime now,
                                             std::span<const planner::DiscObstacle> others) {
   switch (drive_) {
     case Drive::kNavigator: {
+      const bool was_running = nav_.status().outcome == planner::NavOutcome::kRunning;
       const planner::VelocityCommand c = nav_.update(now, localization_.estimate().pose, others);
+      if (was_running) note_nav_end(now);
       if (!arrived_at_ && nav_.status().outcome == planner::NavOutcome::kArrived) {
         // Only the end of a real drive is aligned again (robot profiles): a short push is not.
         const bool drove =
@@ -154,17 +156,50 @@ kinematic::MotorCommand RobotStack::handle(kinematic::MotorCommand c, bool motor
 void RobotStack::goto_place(std::string_view place, bool forward_only) {
   arrived_at_.reset();
   goal_from_ = true_pose_.position();
+  goal_place_.assign(place);
+  goal_known_ = planner_->place(place) != nullptr;
   nav_.go_to_place(place, forward_only);
   drive_ = Drive::kNavigator;
   ++goal_id_;
+  note_nav_end(now_);  // an unknown place is refused at once
 }
 
 void RobotStack::goto_pose(const core::Pose2D& pose, bool forward_only) {
   arrived_at_.reset();
   goal_from_ = true_pose_.position();
+  goal_place_.clear();
+  goal_known_ = true;
   nav_.go_to(pose, forward_only);
   drive_ = Drive::kNavigator;
   ++goal_id_;
+}
+
+void RobotStack::note_nav_end(SimTime now) {
+  const planner::NavStatus& s = nav_.status();
+  switch (s.outcome) {
+    case planner::NavOutcome::kNoPath:
+    case planner::NavOutcome::kInvalidGoal:
+    case planner::NavOutcome::kBlocked:
+    case planner::NavOutcome::kStuck:
+      break;
+    default:
+      return;
+  }
+  NavFailure& f =
+      nav_failure_ring_[static_cast<std::size_t>(nav_failure_count_ % kNavFailureMemory)];
+  f.time = now;
+  f.outcome = s.outcome;
+  f.message = s.message;
+  f.goal = nav_.goal();
+  f.place = goal_place_;
+  f.goal_known = goal_known_;
+  ++nav_failure_count_;
+}
+
+const NavFailure* RobotStack::nav_failure(std::int64_t n) const {
+  if (n < 0 || n >= nav_failure_count_ || n < nav_failure_count_ - kNavFailureMemory)
+    return nullptr;
+  return &nav_failure_ring_[static_cast<std::size_t>(n % kNavFailureMemory)];
 }
 
 lua::NavState RobotStack::navigator() const {

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "llsf/sim/skill_brain.h"
 
+#include <cctype>
 #include <string>
 #include <utility>
 
@@ -39,6 +40,7 @@ lua::ExecResult SkillBrain::exec(std::string_view skill_string) {
   lua::ExecResult r = engine_.exec(skill_string);
   last_string_.clear();  // always report the new string
   report();
+  if (state_listener_) report_state();
   return r;
 }
 
@@ -46,6 +48,36 @@ void SkillBrain::on_skill_cycle(lua::RobotApi& robot) {
   static_cast<void>(robot);
   engine_.cycle();
   report();
+  if (state_listener_) report_state();
+}
+
+void SkillBrain::report_state() {
+  // The first skill of the string: the identifier it starts with.
+  const std::string& str = engine_.skill_string();
+  std::size_t b = 0;
+  while (b < str.size() && std::isspace(static_cast<unsigned char>(str[b])) != 0) ++b;
+  std::size_t e = b;
+  while (e < str.size() && (std::isalnum(static_cast<unsigned char>(str[e])) != 0 || str[e] == '_'))
+    ++e;
+  const std::string_view skill(str.data() + b, e - b);
+  std::string st = skill.empty() ? std::string() : engine_.skill_state(skill);
+  // A string that ended resets its skills: its end is the state then.
+  const lua::SkillStatus status = engine_.status();
+  if (st.empty() && (status == lua::SkillStatus::kFinal || status == lua::SkillStatus::kFailed))
+    st = lua::to_string(status);
+  if (st == state_ && (skill == state_skill_ || st.empty())) {
+    if (skill != state_skill_) state_skill_ = std::string(skill);  // a new string, no state yet
+    return;
+  }
+  SkillStateChange c;
+  c.time = game_.time();
+  c.robot = std::string(game_.robot(index_).name());
+  c.skill = std::string(skill);
+  c.from = skill == state_skill_ ? state_ : std::string();
+  c.to = st;
+  state_skill_ = c.skill;
+  state_ = std::move(st);
+  state_listener_(c);
 }
 
 void SkillBrain::report() {

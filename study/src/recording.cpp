@@ -52,6 +52,22 @@ const char* collision_kind(kinematic::CollisionKind k) {
   return "?";
 }
 
+/// A navigation outcome as skills see it (navigator():status()).
+const char* nav_outcome(planner::NavOutcome o) {
+  switch (o) {
+    case planner::NavOutcome::kNoPath:
+      return "NO_PATH";
+    case planner::NavOutcome::kInvalidGoal:
+      return "INVALID_GOAL";
+    case planner::NavOutcome::kBlocked:
+      return "BLOCKED";
+    case planner::NavOutcome::kStuck:
+      return "STUCK";
+    default:
+      return "?";  // not a failure: never recorded
+  }
+}
+
 /// Appends `s` as a JSON string; text that is not plain ASCII goes through nlohmann (invalid
 /// UTF-8 becomes U+FFFD, as in every other line).
 void append_json_string(std::string& out, std::string_view s) {
@@ -146,7 +162,10 @@ struct Recorder::Impl {
   sim::HackathonScore score;                   // hackathon: as last written
   bool score_known = false;
   LineSink sink;
-  std::vector<AgentFacts> agent_facts;  // per robot index (agent_trace)
+  std::vector<AgentFacts> agent_facts;      // per robot index (agent_trace)
+  std::vector<std::int64_t> camera_frames;  // per robot: the colour camera's frames seen
+  std::vector<bool> sightings_shown;        // per robot: the last sightings line had pucks
+  std::vector<std::int64_t> nav_failures;   // per robot: navigation failures written
 
   void write(const Json& j) {
     if (file == nullptr && !sink) return;
@@ -186,6 +205,9 @@ Recorder::Recorder(const std::string& path, const sim::Game& game, const Recordi
   m.paths.resize(static_cast<std::size_t>(game.robot_count()));
   m.jam_device.assign(static_cast<std::size_t>(game.robot_count()), -1);
   m.robot_dropped.assign(static_cast<std::size_t>(game.robot_count()), 0);
+  m.camera_frames.assign(static_cast<std::size_t>(game.robot_count()), 0);
+  m.sightings_shown.assign(static_cast<std::size_t>(game.robot_count()), false);
+  m.nav_failures.assign(static_cast<std::size_t>(game.robot_count()), 0);
   m.period = core::SimTime::period_of_hz(pose_rate_hz);
   m.next_frame = game.time();
   const kinematic::WorldConfig& w = game.config().world;
@@ -249,7 +271,10 @@ Recorder::Recorder(const std::string& path, const sim::Game& game, const Recordi
                       {"colours", std::move(colours)},
                       {"pucks", std::move(pucks)},
                       {"points_per_puck", hc.points_per_puck},
-                      {"decoy_penalty", hc.decoy_penalty}};
+                      {"decoy_penalty", hc.decoy_penalty},
+                      {"camera",
+                       {{"range_m", fixed(hc.camera.range_m, 3)},
+                        {"fov_deg", fixed(hc.camera.fov_rad * 180.0 / core::kPi, 3)}}}};
   }
   m.write(h);
 }
@@ -277,6 +302,34 @@ void Recorder::skill(const sim::SkillStatusChange& c) {
   j["string"] = c.skill_string;
   if (!c.result.empty()) j["result"] = c.result;
   if (!c.error.empty()) j["error"] = c.error;
+  impl_->write(j);
+}
+
+void Recorder::skill_state(const sim::SkillStateChange& c) {
+  Json j = Impl::event(c.time, "skill_state");
+  j["robot"] = c.robot;
+  j["skill"] = c.skill;
+  j["from"] = c.from;
+  j["to"] = c.to;
+  impl_->write(j);
+}
+
+void Recorder::log(core::SimTime t, const std::string& robot, lua::LogLevel level,
+                   std::string_view text) {
+  static const char* const kLevels[] = {"debug", "info", "warn", "error"};
+  Json j = Impl::event(t, "log");
+  j["robot"] = robot;
+  j["level"] = kLevels[std::min<std::size_t>(static_cast<std::size_t>(level), 3)];
+  j["text"] = std::string(text);
+  impl_->write(j);
+}
+
+void Recorder::verdict(core::SimTime t, const std::string& result, const std::string& score,
+                       const std::string& why) {
+  Json j = Impl::event(t, "verdict");
+  j["result"] = result;
+  j["score"] = score;
+  if (!why.empty()) j["why"] = why;
   impl_->write(j);
 }
 
@@ -496,6 +549,46 @@ void Recorder::frame(const sim::Game& game) {
     j["d"] = kinematic::device_name(core::DeviceId(device));
     j["jammed"] = d >= 0;
     m.write(j);
+  }
+
+  // The colour camera's new frames (hackathon): its sightings in the field frame, written when a
+  // frame saw pucks or the previous written one did. The navigators' refusals and failures.
+  for (int i = 0; i < game.robot_count(); ++i) {
+    const auto r = static_cast<std::size_t>(i);
+    const sim::RobotStack& stack = game.robot(i);
+    if (const sim::ColourCamera* cam = stack.colour_camera();
+        cam != nullptr && cam->frames() != m.camera_frames[r]) {
+      m.camera_frames[r] = cam->frames();
+      const auto seen = cam->sightings();
+      if (!seen.empty() || m.sightings_shown[r]) {
+        m.sightings_shown[r] = !seen.empty();
+        Json pucks = Json::array();
+        for (const lua::ColourPuckSighting& p : seen) {
+          const core::Vec2 at = cam->frame_pose().to_parent(p.position);
+          pucks.push_back(Json::array({fixed(at.x(), 3), fixed(at.y(), 3), p.colour}));
+        }
+        Json j = Impl::event(cam->frame_time(), "sightings");
+        j["robot"] = m.robot_names.at(r);
+        j["pucks"] = std::move(pucks);
+        m.write(j);
+      }
+    }
+    for (; m.nav_failures[r] < stack.nav_failures(); ++m.nav_failures[r]) {
+      const sim::NavFailure* f = stack.nav_failure(m.nav_failures[r]);
+      if (f == nullptr) continue;  // more than kNavFailureMemory in one tick
+      const bool refused = f->outcome == planner::NavOutcome::kInvalidGoal;
+      Json j = Impl::event(f->time, "nav");
+      j["robot"] = m.robot_names.at(r);
+      j["kind"] = refused ? "refused" : "failed";
+      j["outcome"] = nav_outcome(f->outcome);
+      j["message"] = f->message;
+      if (f->goal_known) {
+        j["goal"] =
+            Json::array({fixed(f->goal.x, 3), fixed(f->goal.y, 3), fixed(f->goal.theta, 3)});
+      }
+      if (!f->place.empty()) j["place"] = f->place;
+      m.write(j);
+    }
   }
 
   if (t < m.next_frame) return;

@@ -2,8 +2,10 @@
 // Draws the field to scale on a 2D canvas: walls, the 16 devices with name, type and lamps,
 // pucks coloured by state, robots with heading, name, held puck, skill and status, the believed
 // pose as a ghost, lock holders, radio drops and planned paths. Worlds with extra obstacles get
-// them as dark boxes; the hackathon variant (docs/hackathon.md) its safe area and coloured pucks.
-import type {Header, State} from "./recording";
+// them as dark boxes; the hackathon variant (docs/hackathon.md) its safe area and coloured pucks,
+// each robot's flashlight cone and what its camera reported (fading with age); a finer grid with
+// coordinates on request.
+import {kSightingMemory, type Header, type State} from "./recording";
 
 export const kRobotColors = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#8c564b", "#e377c2"];
 
@@ -80,6 +82,24 @@ export interface DrawStats {
   robots: number;
   pucks: number;
   obstacles: number;
+  /// Flashlight cones drawn (hackathon recordings with the camera in the header).
+  cones: number;
+  /// Camera sightings drawn (every frame still within kSightingMemory s).
+  sightings: number;
+  /// Of them, from each robot's latest frame (age below one camera frame, 0.15 s).
+  freshSightings: number;
+}
+
+/// Options of drawField.
+export interface DrawOptions {
+  /// A robot's name that gets a ring (the agent browser's robot).
+  selected?: string;
+  /// A 0.25 m grid with the metres written along the field's edges (else the 1 m grid alone).
+  grid?: boolean;
+  /// A point to mark (the mouse), in field coordinates.
+  mouse?: [number, number] | null;
+  /// Goals the navigator refused or gave up on lately: a purple cross there, fading with age (s).
+  navGoals?: {x: number; y: number; age: number; refused: boolean}[];
 }
 
 /// How a puck is drawn: fill, label colour, and the hackathon's marks.
@@ -112,8 +132,9 @@ export function drawField(
   state: State,
   poses: number[][],
   time: number,
-  selected = "",
+  options: DrawOptions = {},
 ): DrawStats {
+  const selected = options.selected ?? "";
   const dpr = window.devicePixelRatio || 1;
   const cssW = canvas.clientWidth;
   const cssH = canvas.clientHeight;
@@ -129,7 +150,15 @@ export function drawField(
   const {s, ox, oy} = fieldScale(cssW, cssH, header);
   const X = (x: number) => ox + x * s;
   const Y = (y: number) => oy + (fh - y) * s;
-  const stats: DrawStats = {devices: 0, robots: 0, pucks: 0, obstacles: 0};
+  const stats: DrawStats = {
+    devices: 0,
+    robots: 0,
+    pucks: 0,
+    obstacles: 0,
+    cones: 0,
+    sightings: 0,
+    freshSightings: 0,
+  };
   const hack = header.hackathon;
 
   // The floor, a 1 m grid and the walls.
@@ -147,6 +176,41 @@ export function drawField(
     ctx.lineTo(X(fw), Y(y));
   }
   ctx.stroke();
+  if (options.grid) {
+    // The finer grid (0.25 m) and the metres along the bottom and left edges.
+    ctx.strokeStyle = "#eeeee8";
+    ctx.beginPath();
+    for (let k = 1; k < fw * 4; k++) {
+      if (k % 4 === 0) continue;
+      ctx.moveTo(X(k / 4), Y(0));
+      ctx.lineTo(X(k / 4), Y(fh));
+    }
+    for (let k = 1; k < fh * 4; k++) {
+      if (k % 4 === 0) continue;
+      ctx.moveTo(X(0), Y(k / 4));
+      ctx.lineTo(X(fw), Y(k / 4));
+    }
+    ctx.stroke();
+    ctx.strokeStyle = "#cfcfc6";
+    ctx.beginPath();
+    for (let x = 1; x < fw; x++) {
+      ctx.moveTo(X(x), Y(0));
+      ctx.lineTo(X(x), Y(fh));
+    }
+    for (let y = 1; y < fh; y++) {
+      ctx.moveTo(X(0), Y(y));
+      ctx.lineTo(X(fw), Y(y));
+    }
+    ctx.stroke();
+    ctx.fillStyle = "#777";
+    ctx.font = "10px sans-serif";
+    ctx.textAlign = "center";
+    ctx.textBaseline = "bottom";
+    for (let x = 0; x <= fw + 1e-9; x++) ctx.fillText(String(x), X(x), Y(0) - 2);
+    ctx.textAlign = "left";
+    ctx.textBaseline = "middle";
+    for (let y = 1; y <= fh + 1e-9; y++) ctx.fillText(String(y), X(0) + 3, Y(y));
+  }
 
   // Hackathon: the safe area, tinted and hatched, labelled with its planner place.
   const fontPx = Math.max(9, Math.min(13, s * 0.09));
@@ -326,6 +390,69 @@ export function drawField(
     stats.pucks++;
   }
 
+  // Hackathon: each robot's flashlight cone (from its centre, range and opening of the header's
+  // camera), then what its camera reported: a ring in the reported colour at the reported field
+  // position, fading over kSightingMemory s (the latest frame drawn solid).
+  const cam = hack?.camera;
+  if (cam && cam.range_m > 0 && cam.fov_deg > 0) {
+    const half = (cam.fov_deg * Math.PI) / 360;
+    poses.forEach((p, i) => {
+      const color = robotColor.get(header.robots[i] ?? "") ?? "#000";
+      const [x, y, th] = p;
+      ctx.save();
+      ctx.fillStyle = "rgba(255, 236, 130, 0.28)";
+      ctx.strokeStyle = color;
+      ctx.globalAlpha = 0.9;
+      ctx.lineWidth = 1;
+      ctx.setLineDash([3, 3]);
+      ctx.beginPath();
+      ctx.moveTo(X(x), Y(y));
+      // Canvas angles run clockwise (y down): the field's heading th is -th on screen.
+      ctx.arc(X(x), Y(y), cam.range_m * s, -th - half, -th + half);
+      ctx.closePath();
+      ctx.fill();
+      ctx.stroke();
+      ctx.restore();
+      stats.cones++;
+    });
+  }
+  header.robots.forEach((name) => {
+    const frames = state.robots[name]?.sightings;
+    if (!frames) return;
+    // The camera's latest frame (its last line, with pucks or empty) is drawn solid while it is
+    // new (under 0.15 s, a 10 Hz camera's next frame comes after 0.1 s).
+    const latest = state.robots[name]?.sightingT ?? -1;
+    for (const f of frames) {
+      const age = time - f.t;
+      if (age < 0 || age > kSightingMemory) continue;
+      const fresh = f.t === latest && age < 0.15;
+      ctx.save();
+      ctx.globalAlpha = fresh ? 1 : Math.max(0.08, 0.6 * (1 - age / kSightingMemory));
+      for (const [px, py, colour] of f.pucks) {
+        const r = Math.max(4, header.puck_radius * s) + 3;
+        ctx.beginPath();
+        ctx.arc(X(px), Y(py), r, 0, 2 * Math.PI);
+        ctx.strokeStyle = colourCss(colour);
+        ctx.lineWidth = fresh ? 2.5 : 1.5;
+        ctx.stroke();
+        if (fresh) {
+          // A cross at the reported centre: where the skill believes the puck is.
+          ctx.beginPath();
+          ctx.moveTo(X(px) - 3, Y(py));
+          ctx.lineTo(X(px) + 3, Y(py));
+          ctx.moveTo(X(px), Y(py) - 3);
+          ctx.lineTo(X(px), Y(py) + 3);
+          ctx.strokeStyle = "#111";
+          ctx.lineWidth = 1;
+          ctx.stroke();
+          stats.freshSightings++;
+        }
+        stats.sightings++;
+      }
+      ctx.restore();
+    }
+  });
+
   // Robots: believed pose as a ghost, body, heading, held puck, name, skill and status.
   const rr = header.robot_radius * s;
   poses.forEach((p, i) => {
@@ -398,7 +525,8 @@ export function drawField(
       ctx.textBaseline = "top";
       ctx.fillStyle =
         rs.status === "FAILED" ? "#c0392b" : rs.status === "FINAL" ? "#2e7d32" : "#333";
-      ctx.fillText(`${short} ${rs.status}`, X(x), Y(y) + rr + 2);
+      const st = rs.skillState && rs.status === "RUNNING" ? ` · ${rs.skillState}` : "";
+      ctx.fillText(`${short} ${rs.status}${st}`, X(x), Y(y) + rr + 2);
     }
     stats.robots++;
   });
@@ -410,6 +538,44 @@ export function drawField(
     ctx.textAlign = "center";
     ctx.textBaseline = "top";
     ctx.fillText(`radio drop (${state.drops} total)`, X(fw / 2), Y(fh) + 4);
+  }
+
+  // Goals the navigator refused (or failed to reach) in the last seconds: a purple cross.
+  for (const g of options.navGoals ?? []) {
+    ctx.save();
+    ctx.globalAlpha = Math.max(0.15, 1 - g.age / 3);
+    ctx.strokeStyle = "#8e24aa";
+    ctx.lineWidth = 3;
+    const k = 7;
+    ctx.beginPath();
+    ctx.moveTo(X(g.x) - k, Y(g.y) - k);
+    ctx.lineTo(X(g.x) + k, Y(g.y) + k);
+    ctx.moveTo(X(g.x) - k, Y(g.y) + k);
+    ctx.lineTo(X(g.x) + k, Y(g.y) - k);
+    ctx.stroke();
+    ctx.fillStyle = "#8e24aa";
+    ctx.font = `bold ${fontPx - 1}px sans-serif`;
+    ctx.textAlign = "left";
+    ctx.textBaseline = "bottom";
+    ctx.fillText(g.refused ? "refused" : "failed", X(g.x) + k + 2, Y(g.y) - 2);
+    ctx.restore();
+  }
+
+  // The mouse, with the grid on: a cross hair through the field.
+  if (options.grid && options.mouse) {
+    const [mx, my] = options.mouse;
+    if (mx >= 0 && my >= 0 && mx <= fw && my <= fh) {
+      ctx.save();
+      ctx.strokeStyle = "rgba(43, 93, 154, 0.45)";
+      ctx.lineWidth = 1;
+      ctx.beginPath();
+      ctx.moveTo(X(mx), Y(0));
+      ctx.lineTo(X(mx), Y(fh));
+      ctx.moveTo(X(0), Y(my));
+      ctx.lineTo(X(fw), Y(my));
+      ctx.stroke();
+      ctx.restore();
+    }
   }
   return stats;
 }

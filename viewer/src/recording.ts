@@ -30,6 +30,8 @@ export interface HackathonInfo {
   pucks: Record<string, string>;  // puck id -> colour name
   points_per_puck: number;
   decoy_penalty: number;
+  /// The flashlight camera's cone (recordings before it was added have none: no cone is drawn).
+  camera?: {range_m: number; fov_deg: number};
 }
 
 export interface Header {
@@ -75,6 +77,44 @@ export interface RobotState {
   dropT: number;  // time of the last drop attributed to this robot
   path: [number, number][] | null;
   held: number;
+  /// The colour camera's recent frames with pucks (field frame), oldest first, kept for
+  /// kSightingMemory s (an empty frame adds none: the older ones fade on).
+  sightings: SightingFrame[];
+  /// The time of the camera's last `sightings` line (with pucks or empty), -1 before one.
+  sightingT: number;
+  /// The state of the skill string's first skill (`skill_state` lines), "" when none.
+  skillName: string;
+  skillState: string;
+  skillStateT: number;
+}
+
+/// One frame of a robot's colour camera: when, and each puck seen: [x, y, colour].
+export interface SightingFrame {
+  t: number;
+  pucks: [number, number, string][];
+}
+
+/// How long sightings stay drawn (fading) after the frame that reported them, in simulated s.
+export const kSightingMemory = 2;
+
+/// Lines of a robot's skill on the timeline: its log lines, state changes, the navigator's
+/// refusals and failures (kept apart from the State: they are listed up to the shown time).
+export interface SkillLog {
+  t: number;
+  robot: string;
+  kind: "log" | "state" | "nav";
+  level: string;  // log: debug, info, warn, error; state: ""; nav: refused, failed
+  text: string;
+  /// nav: the goal [x, y, theta], when known.
+  goal?: [number, number, number];
+}
+
+/// An exercise's judged outcome (the `verdict` line).
+export interface Verdict {
+  t: number;
+  result: string;
+  score: string;
+  why: string;
 }
 
 export interface OrderState {
@@ -115,7 +155,7 @@ export interface RescueState {
 
 export interface Marker {
   t: number;
-  kind: "award" | "failure" | "collision" | "rescue";
+  kind: "award" | "failure" | "collision" | "rescue" | "log" | "nav";
   label: string;
 }
 
@@ -133,6 +173,11 @@ function emptyRobot(): RobotState {
     dropT: -1e9,
     path: null,
     held: 0,
+    sightings: [],
+    sightingT: -1,
+    skillName: "",
+    skillState: "",
+    skillStateT: -1,
   };
 }
 
@@ -292,6 +337,32 @@ function apply(s: State, header: Header, line: Line): void {
         pucks: Array.isArray(line.pucks) ? (line.pucks as number[]) : [],
       };
       break;
+    case "sightings": {
+      const robot = robotOf(s, line.robot);
+      if (!robot) break;
+      const pucks = Array.isArray(line.pucks)
+        ? (line.pucks as unknown[]).filter(
+            (p): p is [number, number, string] =>
+              Array.isArray(p) && typeof p[0] === "number" && typeof p[1] === "number",
+          )
+        : [];
+      // Robots of recordings before sightings existed have no list (snapshots made then).
+      const frames = (robot.sightings ??= []);
+      robot.sightingT = line.t;
+      if (pucks.length > 0) {
+        frames.push({t: line.t, pucks: pucks.map((p) => [p[0], p[1], String(p[2] ?? "")])});
+      }
+      while (frames.length > 0 && frames[0].t < line.t - kSightingMemory) frames.shift();
+      break;
+    }
+    case "skill_state": {
+      const robot = robotOf(s, line.robot);
+      if (!robot) break;
+      robot.skillName = String(line.skill ?? "");
+      robot.skillState = String(line.to ?? "");
+      robot.skillStateT = line.t;
+      break;
+    }
     case "path": {
       const robot = robotOf(s, line.robot);
       if (!robot) break;
@@ -332,6 +403,11 @@ export class Recording {
   readonly rescueSteps: {t: number; points: number}[] = [];
   /// The agents' facts, rule firings and output lines, per robot.
   readonly trace = new AgentTrace();
+  /// The skills' log lines, state changes and navigation failures, in time order.
+  readonly skillLog: SkillLog[] = [];
+  readonly skillLogT: number[] = [];
+  /// The exercise's verdict (the last `verdict` line), null before it.
+  verdict: Verdict | null = null;
   /// Incremented whenever lines were appended (the views redraw what depends on them).
   version = 0;
   private builder: State | null = null;
@@ -426,12 +502,59 @@ export class Recording {
         label: `${d >= 0 ? "+" : ""}${d} rescue: ${points} points, ${line.rescued ?? 0} rescued, ` +
           `${line.decoys ?? 0} decoys`,
       });
+    } else if (line.e === "log" || line.e === "skill_state" || line.e === "nav") {
+      this.addSkillLog(line);
+    } else if (line.e === "verdict") {
+      this.verdict = {
+        t: line.t,
+        result: String(line.result ?? ""),
+        score: String(line.score ?? ""),
+        why: String(line.why ?? ""),
+      };
     } else if (line.e === "game" && line.phase && line.phase !== this.lastPhase) {
       this.lastPhase = line.phase;
       this.phaseStarts.push({t: line.t, phase: line.phase});
     }
     apply(builder, header, line);
     this.version++;
+  }
+
+  private addSkillLog(line: Line): void {
+    const robot = String(line.robot ?? "");
+    let entry: SkillLog;
+    if (line.e === "log") {
+      entry = {t: line.t, robot, kind: "log", level: String(line.level ?? "info"), text: String(line.text ?? "")};
+      this.markers.push({t: line.t, kind: "log", label: `${robot} ${entry.level}: ${entry.text}`});
+    } else if (line.e === "skill_state") {
+      const from = String(line.from ?? "") || "–";
+      const to = String(line.to ?? "") || "–";
+      entry = {t: line.t, robot, kind: "state", level: "", text: `${String(line.skill ?? "")}: ${from} → ${to}`};
+    } else {
+      const where = line.place
+        ? String(line.place)
+        : Array.isArray(line.goal)
+          ? `(${Number(line.goal[0]).toFixed(2)}, ${Number(line.goal[1]).toFixed(2)})`
+          : "?";
+      const kind = line.kind === "refused" ? "refused" : "failed";
+      entry = {
+        t: line.t,
+        robot,
+        kind: "nav",
+        level: kind,
+        text: `navigator ${kind} ${where}: ${String(line.outcome ?? "")} ${String(line.message ?? "")}`.trim(),
+      };
+      if (Array.isArray(line.goal) && line.goal.length >= 2) {
+        entry.goal = [Number(line.goal[0]), Number(line.goal[1]), Number(line.goal[2] ?? 0)];
+      }
+      this.markers.push({t: line.t, kind: "nav", label: `${robot} ${entry.text}`});
+    }
+    this.skillLog.push(entry);
+    this.skillLogT.push(line.t);
+  }
+
+  /// The skill log entries with t <= time (their count: a prefix of skillLog).
+  skillLogUpTo(time: number): number {
+    return upperBound(this.skillLogT, time);
   }
 
   /// The number of lines with t <= time.

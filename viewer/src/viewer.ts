@@ -8,7 +8,8 @@
 // Test hook: window.llsfViewer (see Replay.hook); #app carries data-page and data-ready.
 import {AgentPanel, fmtTime, type AgentView} from "./agent_panel";
 import {colourCss, drawField, fieldScale, kPuckColors, kRobotColors} from "./field";
-import {Cursor, Recording, type State} from "./recording";
+import {Cursor, kSightingMemory, Recording, type State} from "./recording";
+import {skillSection, verdictBanner, type SkillView} from "./skill_panel";
 import {el, renderReport, table, type Child, type ReportData} from "./report_view";
 
 interface BatchInfo {
@@ -55,6 +56,25 @@ interface ViewerHook {
   /// The agent browser's robot and facts at the shown time (all, and those the filters show);
   /// null while it is closed.
   agent(): AgentView | null;
+  /// The debugger's view at the shown time: cones and camera sightings drawn (all, and of the
+  /// latest frames), each robot's skill section, the verdict banner, the timeline's markers
+  /// (x in CSS pixels of the timeline canvas), the grid and the mouse readout.
+  debug(): DebugView;
+  /// Shows or hides the finer grid with coordinates.
+  setGrid(on: boolean): void;
+}
+
+interface DebugView {
+  cones: number;
+  sightings: number;
+  freshSightings: number;
+  /// The most sightings drawn in one render so far (a live game moves on between polls).
+  maxSightings: number;
+  skills: SkillView[];
+  verdict: {result: string; score: string; shown: boolean} | null;
+  markers: {t: number; kind: string; label: string; x: number}[];
+  grid: boolean;
+  mouse: string;
 }
 
 declare global {
@@ -169,7 +189,22 @@ class Replay {
   private lastWall = 0;
   private lastPanel = -1;
   private panelVersion = -1;
-  private lastStats = {devices: 0, robots: 0, pucks: 0, obstacles: 0};
+  private lastStats = {
+    devices: 0,
+    robots: 0,
+    pucks: 0,
+    obstacles: 0,
+    cones: 0,
+    sightings: 0,
+    freshSightings: 0,
+  };
+  private maxSightings = 0;
+  private skillViews: SkillView[] = [];
+  private grid = false;
+  private mouse: [number, number] | null = null;
+  private readonly mouseLabel = el("span", {class: "mouse", "data-mouse": ""}, "");
+  private readonly gridBox = el("input", {type: "checkbox", "data-control": "grid"});
+  private readonly banner = el("div", {class: "banner", "data-banner": ""});
   private framesDrawn = 0;
   private timelineCache: HTMLCanvasElement | null = null;
   private timelineKey = "";
@@ -217,6 +252,19 @@ class Replay {
     this.agentPanel.root.style.display = "none";
     this.agentBtn.onclick = () => this.showAgent(this.agentOpen ? null : this.agentPanel.robot);
     this.canvas.addEventListener("click", (ev) => this.clickField(ev));
+    this.canvas.addEventListener("mousemove", (ev) => this.moveMouse(ev));
+    this.canvas.addEventListener("mouseleave", () => {
+      this.mouse = null;
+      this.mouseLabel.textContent = "";
+      this.mouseLabel.setAttribute("data-mouse", "");
+    });
+    this.gridBox.onchange = () => this.setGrid(this.gridBox.checked);
+    const gridLabel = el(
+      "label",
+      {title: "a 0.25 m grid with the metres along the edges, and a cross hair"},
+      this.gridBox,
+      " grid",
+    );
     const controls = el(
       "div",
       {class: "controls"},
@@ -227,6 +275,8 @@ class Replay {
       this.timeLabel,
       followLabel,
       this.agentBtn,
+      gridLabel,
+      this.mouseLabel,
       this.status,
     );
     this.root = el(
@@ -236,7 +286,7 @@ class Replay {
       el(
         "div",
         {class: "main"},
-        el("div", {class: "fieldbox"}, this.canvas),
+        el("div", {class: "fieldbox"}, this.canvas, this.banner),
         this.panel,
         this.agentPanel.root,
       ),
@@ -274,6 +324,66 @@ class Replay {
   /// Draws everything now (after a change of the selection or a seek by the test hook).
   private redraw(): void {
     this.render(performance.now(), true);
+  }
+
+  /// The field coordinates under a mouse event (null off the field's drawing).
+  private fieldAt(ev: MouseEvent): [number, number] | null {
+    const h = this.rec.header;
+    if (!h) return null;
+    const {s, ox, oy} = fieldScale(this.canvas.clientWidth, this.canvas.clientHeight, h);
+    return [(ev.offsetX - ox) / s, h.field.height - (ev.offsetY - oy) / s];
+  }
+
+  /// The readout of the field coordinates under the mouse (metres, the field frame).
+  private moveMouse(ev: MouseEvent): void {
+    const p = this.fieldAt(ev);
+    const h = this.rec.header;
+    if (!p || !h) return;
+    const on = p[0] >= 0 && p[1] >= 0 && p[0] <= h.field.width && p[1] <= h.field.height;
+    this.mouse = on ? p : null;
+    let text = on ? `x ${p[0].toFixed(2)}  y ${p[1].toFixed(2)} m` : "";
+    // A camera sighting under the mouse: its colour, robot and age.
+    const st = on ? this.cursor.at(this.time) : null;
+    let best = 0.08;
+    let near = "";
+    for (const [name, r] of Object.entries(st?.robots ?? {})) {
+      for (const f of r.sightings ?? []) {
+        const age = this.time - f.t;
+        if (age < 0 || age > kSightingMemory) continue;
+        for (const [x, y, colour] of f.pucks) {
+          const d = Math.hypot(x - p[0], y - p[1]);
+          if (d < best) {
+            best = d;
+            near = ` · ${colour} seen by ${name} ${age.toFixed(1)} s ago at (${x.toFixed(2)}, ${y.toFixed(2)})`;
+          }
+        }
+      }
+    }
+    text += near;
+    this.mouseLabel.textContent = text;
+    this.mouseLabel.setAttribute("data-mouse", text);
+    if (this.grid && !this.playing) this.redraw();
+  }
+
+  /// The navigator's refused or failed goals of the last 3 s before the shown time.
+  private navGoals(): {x: number; y: number; age: number; refused: boolean}[] {
+    const out: {x: number; y: number; age: number; refused: boolean}[] = [];
+    const log = this.rec.skillLog;
+    for (let i = this.rec.skillLogUpTo(this.time) - 1; i >= 0; i--) {
+      const e = log[i];
+      const age = this.time - e.t;
+      if (age > 3) break;
+      if (e.kind === "nav" && e.goal) {
+        out.push({x: e.goal[0], y: e.goal[1], age, refused: e.level === "refused"});
+      }
+    }
+    return out;
+  }
+
+  setGrid(on: boolean): void {
+    this.grid = on;
+    this.gridBox.checked = on;
+    this.redraw();
   }
 
   /// A click on a robot of the field opens the agent browser on it.
@@ -368,6 +478,28 @@ class Replay {
         const v = this.agentPanel.view();
         return v ? {...v, facts: [...v.facts], shown: [...v.shown]} : null;
       },
+      debug: () => {
+        const v = this.rec.verdict;
+        return {
+          cones: this.lastStats.cones,
+          sightings: this.lastStats.sightings,
+          freshSightings: this.lastStats.freshSightings,
+          maxSightings: this.maxSightings,
+          skills: this.skillViews.map((k) => ({...k, lines: [...k.lines]})),
+          verdict: v
+            ? {result: v.result, score: v.score, shown: this.banner.childElementCount > 0}
+            : null,
+          markers: this.rec.markers.map((m) => ({
+            t: m.t,
+            kind: m.kind,
+            label: m.label,
+            x: this.timelineX(m.t),
+          })),
+          grid: this.grid,
+          mouse: this.mouseLabel.textContent ?? "",
+        };
+      },
+      setGrid: (on: boolean) => this.setGrid(on),
     };
     // eslint-disable-next-line @typescript-eslint/no-this-alias
     const replay = this;
@@ -418,9 +550,23 @@ class Replay {
     const state = this.cursor.at(this.time);
     if (!state) return;
     const poses = this.rec.posesAt(this.time);
-    this.lastStats = drawField(
-      this.canvas, h, state, poses, this.time, this.agentOpen ? this.agentPanel.robot : "");
+    this.lastStats = drawField(this.canvas, h, state, poses, this.time, {
+      selected: this.agentOpen ? this.agentPanel.robot : "",
+      grid: this.grid,
+      mouse: this.mouse,
+      navGoals: this.navGoals(),
+    });
+    this.maxSightings = Math.max(this.maxSightings, this.lastStats.sightings);
     ++this.framesDrawn;
+    this.canvas.setAttribute("data-cones", String(this.lastStats.cones));
+    this.canvas.setAttribute("data-sightings", String(this.lastStats.sightings));
+    // The verdict banner (an exercise's recording), from the verdict's time on.
+    const banner = verdictBanner(this.rec.verdict, this.time);
+    const bannerKey = banner ? banner.textContent ?? "" : "";
+    if (bannerKey !== (this.banner.getAttribute("data-banner") ?? "")) {
+      this.banner.replaceChildren(...(banner ? [banner] : []));
+      this.banner.setAttribute("data-banner", bannerKey);
+    }
     this.canvas.setAttribute("data-devices", String(this.lastStats.devices));
     this.canvas.setAttribute("data-robots", String(this.lastStats.robots));
     this.canvas.setAttribute("data-obstacles", String(this.lastStats.obstacles));
@@ -449,6 +595,7 @@ class Replay {
       .map(([p, n]) => `${p.toLowerCase()} ${n}`)
       .join(", ");
     const orders = Object.values(s.orders).sort((a, b) => a.id - b.id);
+    const skillViews: SkillView[] = [];
     const robotRows = h.robots.map((name, i) => {
       const r = s.robots[name];
       const color = kRobotColors[i % kRobotColors.length];
@@ -457,21 +604,33 @@ class Replay {
             .map(([res, st]) => (st === "ACCEPTED" ? res : `${res}:${st.toLowerCase()}`))
             .join(" ")
         : "";
+      const skill = skillSection(this.rec, name, r, this.time, (t) => {
+        this.setPlaying(false);
+        this.seek(t);
+        this.redraw();
+      });
+      skillViews.push(skill.view);
+      const agentLine = r?.agent || !h.hackathon;
       return el(
         "div",
         {class: "robot", "data-robot": name},
         this.robotName(name, color, r?.role ?? ""),
         el("div", {class: "skill"}, r?.skill ? `${r.skill} ${r.status}` : "–"),
         r?.skillInfo ? el("div", {class: "info"}, r.skillInfo) : "",
-        el(
-          "div",
-          {class: `agent ${r?.agentLevel ?? ""}`},
-          r?.agent ? `[${fmtTime(r.agentT)}] ${r.agent}` : "no agent decision yet",
-        ),
+        // The skill's section where skills log or report states (or in the hackathon).
+        h.hackathon || this.rec.skillLog.length > 0 ? skill.node : "",
+        agentLine
+          ? el(
+              "div",
+              {class: `agent ${r?.agentLevel ?? ""}`},
+              r?.agent ? `[${fmtTime(r.agentT)}] ${r.agent}` : "no agent decision yet",
+            )
+          : "",
         locks ? el("div", {class: "locks"}, `locks: ${locks}`) : "",
         r && r.drops > 0 ? el("div", {class: "info"}, `radio drops: ${r.drops}`) : "",
       );
     });
+    this.skillViews = skillViews;
     // The hackathon (docs/hackathon.md): the rescue score leads; the refbox's parts (phase,
     // points, delivery gate, orders) show only when the refbox plays (it stays in PRE_GAME by
     // default, lamps and all).
@@ -697,8 +856,17 @@ class Replay {
         g.textBaseline = "top";
         g.fillText(`rescue ${last} points`, w - 10, 2);
       }
-      const rows = {award: 0.35, failure: 0.6, collision: 0.85, rescue: 0.35};
-      const colors = {award: "#2e7d32", failure: "#c0392b", collision: "#ef6c00", rescue: "#00897b"};
+      // Rows: the skills' log lines at the top, awards and rescues, failures and the navigator's
+      // refusals, collisions at the bottom.
+      const rows = {log: 0.2, award: 0.45, failure: 0.68, nav: 0.68, collision: 0.88, rescue: 0.45};
+      const colors = {
+        award: "#2e7d32",
+        failure: "#c0392b",
+        collision: "#ef6c00",
+        rescue: "#00897b",
+        log: "#1f5fa8",
+        nav: "#8e24aa",
+      };
       for (const m of this.rec.markers) {
         const x = this.timelineX(m.t);
         g.strokeStyle = colors[m.kind];

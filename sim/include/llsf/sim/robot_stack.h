@@ -52,6 +52,18 @@ struct SymbolicRequest {
   double radius_m = 0.0;       ///< kPick: how far from `point` a puck may be
 };
 
+/// A navigation that ended without arriving: the navigator refused the goal (kInvalidGoal: inside
+/// an obstacle, too close to one, an unknown place) or gave up (kNoPath, kBlocked, kStuck). Aborts
+/// (a new goal, stop()) are not failures.
+struct NavFailure {
+  SimTime time;
+  planner::NavOutcome outcome = planner::NavOutcome::kIdle;
+  std::string message;     ///< the navigator's reason
+  core::Pose2D goal;       ///< the goal pose (the place's pose for goto_place)
+  std::string place;       ///< goto_place's name; empty for goto_pose
+  bool goal_known = true;  ///< false for an unknown place (`goal` means nothing then)
+};
+
 /// A message a robot received, with its sender.
 struct Received {
   std::unique_ptr<google::protobuf::Message> message;
@@ -174,6 +186,14 @@ class RobotStack final : public lua::RobotApi {
   bool jammed() const { return jam_device_ >= 0; }
   int jam_device() const { return jam_device_; }
   int jams() const { return jams_; }
+  /// The hackathon's colour camera (its sightings, frame time and pose), nullptr outside it.
+  const ColourCamera* colour_camera() const { return colour_camera_ ? &*colour_camera_ : nullptr; }
+  /// How many navigations failed so far (NavFailure), for recordings and tools.
+  std::int64_t nav_failures() const { return nav_failure_count_; }
+  /// The failure number `n` (0-based, < nav_failures()) if it is among the last
+  /// kNavFailureMemory; nullptr otherwise. Valid until the next failure.
+  const NavFailure* nav_failure(std::int64_t n) const;
+  static constexpr int kNavFailureMemory = 8;
 
  private:
   enum class Drive : std::uint8_t { kIdle, kNavigator, kMotor };
@@ -205,6 +225,13 @@ class RobotStack final : public lua::RobotApi {
   bool motor_started_ = false;  ///< a new run of direct motor commands began
   int jam_device_ = -1;
   int jams_ = 0;
+  // Navigation failures (a ring of the last kNavFailureMemory) and the current goal's place.
+  std::array<NavFailure, kNavFailureMemory> nav_failure_ring_{};
+  std::int64_t nav_failure_count_ = 0;
+  std::string goal_place_;
+  bool goal_known_ = true;
+  /// Remembers the navigation's end if it failed (called where the outcome can change).
+  void note_nav_end(SimTime now);
   /// Applies the motor caps and the jam to a command; may start or end a jam.
   kinematic::MotorCommand handle(kinematic::MotorCommand c, bool motor);
 

@@ -29,6 +29,15 @@ struct SkillStatusChange {
   std::string result;  ///< what the skills reported when the string ended
 };
 
+/// A change of the state of a skill string's first skill (its state machine), for listeners.
+struct SkillStateChange {
+  SimTime time;
+  std::string robot;
+  std::string skill;  ///< the skill string's first skill ("rescue" in "rescue{}")
+  std::string from;   ///< the state before ("" when the skill was not running)
+  std::string to;     ///< the state now ("" when the skill is not running or has no FSM)
+};
+
 /// Runs a skill engine as robot `index`'s brain (on_skill_cycle). Its owner plugs it into the
 /// game (GameDriver::plug_skills, or Game::set_brain) and unplugs it before destroying it; the
 /// game must outlive it.
@@ -51,10 +60,17 @@ class SkillBrain final : public RobotBrain {
     listener_ = std::move(listener);
   }
 
+  /// Called when the state of the skill string's first skill changes (checked after exec() and
+  /// every cycle; one query of the engine per cycle, only while a listener is set).
+  void set_state_listener(std::function<void(const SkillStateChange&)> listener) {
+    state_listener_ = std::move(listener);
+  }
+
   void on_skill_cycle(lua::RobotApi& robot) override;
 
  private:
   void report();
+  void report_state();
 
   Game& game_;
   int index_;
@@ -62,6 +78,9 @@ class SkillBrain final : public RobotBrain {
   std::function<void(const SkillStatusChange&)> listener_;
   lua::SkillStatus last_ = lua::SkillStatus::kInactive;
   std::string last_string_;
+  std::function<void(const SkillStateChange&)> state_listener_;
+  std::string state_skill_;  ///< the skill whose state was last reported
+  std::string state_;        ///< its state as last reported
 };
 
 }  // namespace llsf::sim

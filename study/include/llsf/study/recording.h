@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: MIT
 // Recordings of games for replay (the viewer) and analysis: the poses of every robot (true and
 // believed) and puck at 10 Hz plus every event -- refbox phases and points, lamp changes, RFID,
-// collisions, skill status changes, agent decisions, lock grants and refusals, radio drops -- in
+// collisions, skill status changes, agent decisions, lock grants and refusals, radio drops; for
+// skills also their states, log lines, the colour camera's sightings, the navigator's refusals
+// and failures, and an exercise's verdict -- in
 // gzip-compressed JSON lines, versioned. docs/recording.md documents the format.
 #pragma once
 
@@ -64,6 +66,16 @@ class Recorder {
   void agent_trace(int robot, const clips::TraceEvent& event);
   /// Simulated time between two `facts` snapshots of one robot.
   static constexpr core::SimTime kFactSnapshotPeriod = core::SimTime::from_sec(30);
+  /// A change of the state of a robot's skill (sim::SkillBrain::set_state_listener):
+  /// {"e":"skill_state","robot":..,"skill":..,"from":..,"to":..}.
+  void skill_state(const sim::SkillStateChange& change);
+  /// A line a robot's skill logged (print, printf, print_warn, ...; lua::SkillEngine's log sink):
+  /// {"e":"log","robot":..,"level":..,"text":..}.
+  void log(core::SimTime t, const std::string& robot, lua::LogLevel level, std::string_view text);
+  /// The judged outcome of a game (an exercise): {"e":"verdict","result":..,"score":..,"why":..}
+  /// (`why` only when not empty). Write it before close().
+  void verdict(core::SimTime t, const std::string& result, const std::string& score,
+               const std::string& why = {});
   /// A free-form event from an agent or tool ({"t":..,"e":"note","robot":..,"text":..}).
   void note(core::SimTime t, const std::string& robot, const std::string& text);
   /// Flushes and closes the file (idempotent).
