@@ -180,7 +180,10 @@ base.print_warn = function(...) log(2, args_text(...)) end
 base.print_error = function(...) log(3, args_text(...)) end
 base.printf = function(f, ...)
   local ok, text = raw_pcall(fmt, f, ...)
-  if not ok then raise_at_skill("printf: " .. tostring(text)) end
+  if not ok then
+    text = tostring(text):gsub("to '[%w.]*format'", "to 'printf'")
+    raise_at_skill(text)
+  end
   log(1, text)
 end
 
@@ -228,10 +231,11 @@ local function distance(a, b)
 end
 
 -- The candidate (a list of names) nearest to `name` if it is near enough to be a typo: at most
--- 1 edit for names up to 4 characters, 2 up to 8, else 3; ties go to the first in name order.
+-- 1 edit for names of 3 or 4 characters, 2 up to 8, else 3 (names of 1 or 2 characters: only
+-- another case); ties go to the first in name order.
 local function nearest(name, candidates)
   if type(name) ~= "string" or #name > 64 then return nil end
-  local limit = #name <= 4 and 1 or #name <= 8 and 2 or 3
+  local limit = #name <= 2 and 0 or #name <= 4 and 1 or #name <= 8 and 2 or 3
   local best, best_d = nil, limit + 1
   local names = {}
   for _, c in ipairs(candidates) do
@@ -252,9 +256,11 @@ local function did_you_mean(name, candidates)
   return n and fmt(" (did you mean '%s'?)", n) or ""
 end
 
-local function state_names(fsm)
+local function state_names(fsm)  -- the skill's own states first, then FINAL and FAILED
   local names = {}
-  for i, st in ipairs(fsm.state_list) do names[i] = st.name end
+  for i = 3, #fsm.state_list do names[#names + 1] = fsm.state_list[i].name end
+  names[#names + 1] = "FINAL"
+  names[#names + 1] = "FAILED"
   return names
 end
 
