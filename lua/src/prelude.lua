@@ -274,9 +274,9 @@ end
 
 -- Globals skills do not have, with what to use instead.
 local unavailable = {
-  os = "no files, processes or wall clock in skills: for time use clock.now() (game seconds) " ..
+  os = "no files, processes or wall clock: for time use clock.now() (game seconds) " ..
        "or a transition's timeout=SECS",
-  io = "no files or terminal in skills: print(...) / printf(fmt, ...) write to the log",
+  io = "no files or terminal: print(...) / printf(fmt, ...) write to the log",
   require = "skills load no modules: name another skill in depends_skills = {\"skill\"} and " ..
             "call it from a SkillJumpState (skills={{skill}})",
   package = "skills load no modules: name another skill in depends_skills = {\"skill\"}",
@@ -284,16 +284,15 @@ local unavailable = {
   loadfile = "skills load no other files: name another skill in depends_skills = {\"skill\"}",
   load = "skills compile no code at run time: write a function instead (a cond may be a " ..
          "function or a string the engine compiles at load time)",
-  loadstring = "skills compile no code at run time (and loadstring is Lua 5.1's load): write " ..
-               "a function instead",
-  debug = "the debug library is not available in skills: print(...) what you want to see",
-  coroutine = "coroutines are not available in skills: wait in a state with a transition " ..
-              "(cond=..., timeout=...)",
+  loadstring = "skills compile no code at run time (and loadstring is Lua 5.1's): write a " ..
+               "function instead",
+  debug = "print(...) what you want to see",
+  coroutine = "wait in a state with a transition (cond=..., timeout=...)",
   collectgarbage = "the engine manages memory: drop references (t = nil) instead",
-  _G = "skills have no _G: their own globals are in _M",
-  unpack = "unpack is Lua 5.1's: use table.unpack",
-  setfenv = "setfenv is Lua 5.1's and not available",
-  getfenv = "getfenv is Lua 5.1's and not available",
+  _G = "a skill's own globals are in _M",
+  unpack = "it is Lua 5.1's: use table.unpack",
+  setfenv = "it is Lua 5.1's (a skill's globals are in _M)",
+  getfenv = "it is Lua 5.1's (a skill's globals are in _M)",
 }
 
 local function where(level)

@@ -69,7 +69,7 @@ TEST_CASE("exercise: each mistake gets its own message at the participant's file
       {"typo_runtime.lua", "01", kExitFailed, "undeclared global 'poes' (did you mean 'pose'?)",
        "a typo? Use the name the message suggests"},
       {"uses_os.lua", "01", kExitFailed,
-       "'os' is not available in skills: no files, processes or wall clock in skills: for time "
+       "'os' is not available in skills: no files, processes or wall clock: for time "
        "use clock.now() (game seconds) or a transition's timeout=SECS",
        "skills run in a sandbox"},
       {"uses_require.lua", "01", kExitBadInput,

@@ -132,7 +132,7 @@ TEST_CASE("globals skills do not have say so and what to use instead, at the lin
   Engine e(skill_with("local f = io.open('/etc/passwd')\n"));
   CHECK(contains(e.load_error(),
                  "mine.lua:9: 'io' is not available in skills: no files or "
-                 "terminal in skills: print(...) / printf(fmt, ...) write to the "
+                 "terminal: print(...) / printf(fmt, ...) write to the "
                  "log"));
 }
 
