@@ -76,6 +76,8 @@ struct SkillEngine::Impl {
   /// When the armed cycle's wall-time budget ends (config.max_cycle_wall_s).
   std::chrono::steady_clock::time_point wall_deadline;
   std::vector<SkillFile> files;
+  /// (shortened, whole) shown path of every skill file whose path Lua shortens.
+  std::vector<std::pair<std::string, std::string>> long_paths;
   int loads = 0;
 
   SkillStatus status = SkillStatus::kInactive;
@@ -99,6 +101,9 @@ struct SkillEngine::Impl {
 
   /// The path messages show for the skill file `path` (config.display_paths, else `path`).
   const std::string& display_path(const std::string& path) const;
+  /// `text` with every shortened path of a skill file ("...tail", as Lua writes chunk names
+  /// over LUA_IDSIZE) written out in full.
+  std::string full_paths(std::string text) const;
   /// Scans the skill directories (sorted by name; later directories win).
   std::vector<SkillFile> scan() const;
   /// Closes the interpreter and builds a new one with every skill loaded.

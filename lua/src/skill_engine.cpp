@@ -260,6 +260,13 @@ int native_log(lua_State* L) {
   std::size_t n = 0;
   const char* text = luaL_checklstring(L, 2, &n);
   SkillEngine::Impl& e = SkillEngine::Impl::of(L);
+  if (!e.long_paths.empty()) {
+    // Rare: the text again with whole paths, kept in a member (a Lua error below must not skip
+    // a destructor) and on the Lua stack.
+    e.cpp_error = e.full_paths(std::string(text, n));
+    lua_pushlstring(L, e.cpp_error.data(), e.cpp_error.size());
+    text = lua_tolstring(L, -1, &n);
+  }
   if (!e.log_sink && e.loading_files) {
     if (e.pending_log.size() < kMaxPendingLog) {
       e.pending_log.emplace_back(static_cast<LogLevel>(std::clamp<lua_Integer>(level, 0, 3)),
@@ -327,6 +334,11 @@ void SkillEngine::Impl::close() {
   L = nullptr;
   engine_ref = chunk_ref = LUA_NOREF;
   heap.used = 0;
+}
+
+std::string SkillEngine::Impl::full_paths(std::string text) const {
+  for (const auto& [shortened, full] : long_paths) text = replace_all(text, shortened, full);
+  return text;
 }
 
 const std::string& SkillEngine::Impl::display_path(const std::string& path) const {
@@ -452,6 +464,16 @@ void SkillEngine::Impl::build() {
   close();
   files = scan();
   ++loads;
+  // Lua shortens chunk names over LUA_IDSIZE - 1 characters to "..." and their last
+  // LUA_IDSIZE - 4 characters (luaO_chunkid); messages get the whole path back (full_paths()).
+  long_paths.clear();
+  for (const SkillFile& f : files) {
+    const std::string& shown = display_path(f.path);
+    constexpr std::size_t kKept = LUA_IDSIZE - 4;
+    if (shown.size() + 1 > static_cast<std::size_t>(LUA_IDSIZE)) {
+      long_paths.emplace_back("..." + shown.substr(shown.size() - kKept), shown);
+    }
+  }
   heap.limit = config.memory_limit_bytes;
   L = lua_newstate(limited_alloc, &heap);
   LLSF_DEMAND_MSG(L != nullptr, "cannot create a Lua state");
@@ -544,6 +566,7 @@ void SkillEngine::Impl::build() {
       }
     }
     if (!load_error.empty()) {
+      load_error = full_paths(load_error);
       lua_pushstring(L, f.name.c_str());
       lua_pushstring(L, load_error.c_str());
       if (call_entry("set_load_error", 2, 0) != LUA_OK) {
@@ -625,12 +648,12 @@ SkillStatus SkillEngine::cycle() {
   lua_rawgeti(e.L, LUA_REGISTRYINDEX, e.chunk_ref);
   if (e.call_entry("run_cycle", 1, 3) != LUA_OK) {
     e.status = SkillStatus::kFailed;
-    e.error = e.explain(pop_message(e.L));
+    e.error = e.full_paths(e.explain(pop_message(e.L)));
   } else {
     const lua_Integer s = lua_tointeger(e.L, -3);
     e.status = static_cast<SkillStatus>(std::clamp<lua_Integer>(s, 0, 3));
     if (e.status == SkillStatus::kFailed) {
-      e.error = e.explain(lua_isstring(e.L, -2) ? lua_tostring(e.L, -2) : "FAILED");
+      e.error = e.full_paths(e.explain(lua_isstring(e.L, -2) ? lua_tostring(e.L, -2) : "FAILED"));
     }
     if (e.status != SkillStatus::kRunning) {
       const char* r = lua_tostring(e.L, -1);
@@ -685,7 +708,7 @@ SkillStatus SkillEngine::skill_status(std::string_view skill) const {
 std::string SkillEngine::skill_error(std::string_view skill) const {
   std::string out;
   with_skill_info(*impl_, skill, [&](SkillStatus, std::string err, auto&&...) { out = err; });
-  return out;
+  return impl_->full_paths(out);
 }
 
 std::string SkillEngine::skill_state(std::string_view skill) const {

@@ -312,3 +312,31 @@ TEST_CASE("a print while the file loads reaches the sink set afterwards") {
   CHECK(e.log[0] == "loaded\t3");
   CHECK(e.log[1] == "warn: careful");
 }
+
+TEST_CASE("a shown path longer than Lua keeps (60 characters) is written out in full") {
+  FakeRobot robot;
+  TempDir dir;
+  dir.write("crash.lua",
+            "name = 'crash'\ndocumentation = 'x'\nfunction execute()\n"
+            "  print(select(2, pcall(function() error('boom') end)))\n"
+            "  local t = nil\n  return t.x\nend\n");
+  dir.write("broken.lua", "name = 'broken'\ndocumentation = 'x'\nfunction execute( end\n");
+  const std::string long_dir = "/home/participant/hackathon/team-with-a-long-name/exercises/02/";
+  lua::SkillEngineConfig cfg;
+  cfg.skill_dirs = {dir.path.string()};
+  cfg.display_paths[dir.file("crash.lua")] = long_dir + "my_crash.lua";
+  cfg.display_paths[dir.file("broken.lua")] = long_dir + "my_broken.lua";
+  lua::SkillEngine engine(cfg, robot);
+  std::vector<std::string> log;
+  engine.set_log_sink([&](lua::LogLevel, std::string_view line) { log.emplace_back(line); });
+  const std::string load_error = load_error_of(engine, "broken");
+  INFO(load_error);
+  CHECK(load_error.rfind(long_dir + "my_broken.lua:3:", 0) == 0);
+  REQUIRE(engine.exec("crash{}"));
+  CHECK(engine.cycle() == SkillStatus::kFailed);
+  INFO(engine.error());
+  CHECK(contains(engine.error(), long_dir + "my_crash.lua:6: attempt to index a nil value"));
+  CHECK_FALSE(contains(engine.error(), "..."));
+  REQUIRE(log.size() == 1);
+  CHECK(log[0] == long_dir + "my_crash.lua:4: boom");
+}

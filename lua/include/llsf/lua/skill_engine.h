@@ -59,7 +59,7 @@ struct SkillEngineConfig {
   /// A skill file's real path (as found in `skill_dirs`, e.g. "/tmp/llsfex-1-1/s.lua") -> the
   /// path every message, warning and traceback of that file shows instead (e.g. the
   /// participant's "my_skill.lua" of which the file is a copy). Files not listed show their real
-  /// path. Not a YAML key. Lua shortens a shown path over 60 characters from the left ("...").
+  /// path (paths Lua shortens, "...tail", are written out in full). Not a YAML key.
   std::map<std::string, std::string> display_paths;
 
   /// Throws core::ConfigError naming the bad field.
