@@ -295,8 +295,16 @@ local unavailable = {
   getfenv = "it is Lua 5.1's (a skill's globals are in _M)",
 }
 
+-- "file:line" of the code `level` levels up (1: the caller of where()'s caller), or of the
+-- nearest skill code above it if that is the prelude's own (define_states adds a state's timeout
+-- through add_transitions).
 local function where(level)
-  local info = debug_getinfo(level + 1, "Sl")
+  local l = level + 1
+  local info = debug_getinfo(l, "Sl")
+  while info and info.short_src == prelude_src do
+    l = l + 1
+    info = debug_getinfo(l, "Sl")
+  end
   if not info then return "?" end
   return info.short_src .. ":" .. tostring(info.currentline)
 end
