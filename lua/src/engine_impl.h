@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "llsf/lua/skill_engine.h"
@@ -32,6 +33,12 @@ struct LuaHeap {
   bool exhausted = false;
   /// Set when an allocation was refused for the heap limit.
   bool limit_hit = false;
+  /// The interpreter, and whether a protected call runs in it: only then is a refusal located.
+  lua_State* state = nullptr;
+  bool in_call = false;
+  /// "file:line" of the skill code running when an allocation was last refused (the innermost
+  /// frame of a skill file); empty if none. Memory errors carry no position of their own.
+  char refused_at[256] = {};
 };
 
 /// Bytes an interpreter may still allocate after its allocation budget ran out (error messages,
@@ -40,6 +47,9 @@ inline constexpr std::int64_t kAllocationGrace = 1 << 20;
 /// The count hook runs every kHookInterval VM instructions (or every instruction_budget
 /// instructions if that is smaller) and adds them to Impl::used.
 inline constexpr std::int64_t kHookInterval = 1000;
+
+/// Lines kept while the files load without a log sink (SkillEngine::Impl::pending_log).
+inline constexpr std::size_t kMaxPendingLog = 200;
 
 /// One skill file as last loaded (for hot reload).
 struct SkillFile {
@@ -66,6 +76,8 @@ struct SkillEngine::Impl {
   /// When the armed cycle's wall-time budget ends (config.max_cycle_wall_s).
   std::chrono::steady_clock::time_point wall_deadline;
   std::vector<SkillFile> files;
+  /// (shortened, whole) shown path of every skill file whose path Lua shortens.
+  std::vector<std::pair<std::string, std::string>> long_paths;
   int loads = 0;
 
   SkillStatus status = SkillStatus::kInactive;
@@ -73,6 +85,11 @@ struct SkillEngine::Impl {
   std::string result;  // fsm.result of the string's skills when it ended
   std::string skill_string;
   std::function<void(LogLevel, std::string_view)> log_sink;
+  /// Lines logged while the files load with no sink set yet (a skill file's top-level print):
+  /// delivered by set_log_sink(), at most kMaxPendingLog of them.
+  std::vector<std::pair<LogLevel, std::string>> pending_log;
+  int pending_dropped = 0;
+  bool loading_files = false;
 
   // Caches for the bindings (see the file comment).
   NavState nav;
@@ -82,6 +99,11 @@ struct SkillEngine::Impl {
   /// The engine that owns `L` (stored in the state's extra space).
   static Impl& of(lua_State* L) { return **static_cast<Impl**>(lua_getextraspace(L)); }
 
+  /// The path messages show for the skill file `path` (config.display_paths, else `path`).
+  const std::string& display_path(const std::string& path) const;
+  /// `text` with every shortened path of a skill file ("...tail", as Lua writes chunk names
+  /// over LUA_IDSIZE) written out in full.
+  std::string full_paths(std::string text) const;
   /// Scans the skill directories (sorted by name; later directories win).
   std::vector<SkillFile> scan() const;
   /// Closes the interpreter and builds a new one with every skill loaded.

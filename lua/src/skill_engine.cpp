@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -111,8 +112,31 @@ namespace {
 
 constexpr const char* kPreludeChunkName = "=llsf/prelude.lua";
 
+// Where a refused allocation happened: the innermost frame of a skill file (chunk names "@path")
+// and its current line, for Impl::explain(). Lua's memory error has no position, and Lua calls no
+// message handler for it, so the stack is read here, in the allocator, before the error unwinds
+// it. lua_getstack/lua_getinfo("Sl") only read CallInfos and prototypes and allocate nothing.
+// Lua 5.4.4 (Debian bookworm) keeps the old stack valid while it allocates a bigger one; later
+// releases turn stack pointers into offsets around that allocation, so there nothing is read.
+void note_refusal(LuaHeap* heap) {
+#if LUA_VERSION_RELEASE_NUM <= 50404
+  if (heap->state == nullptr || !heap->in_call) return;
+  lua_Debug ar{};
+  for (int level = 0; lua_getstack(heap->state, level, &ar) != 0; ++level) {
+    if (lua_getinfo(heap->state, "Sl", &ar) == 0) break;
+    if (ar.currentline > 0 && ar.source != nullptr && ar.source[0] == '@') {
+      std::snprintf(heap->refused_at, sizeof heap->refused_at, "%s:%d", ar.short_src,
+                    ar.currentline);
+      return;
+    }
+  }
+#else
+  static_cast<void>(heap);
+#endif
+}
+
 // Allocator with a heap limit and an allocation budget: refusing an allocation makes Lua raise
-// "not enough memory" (Impl::explain() names the budget in the message).
+// "not enough memory" (Impl::explain() names the budget and the line in the message).
 void* limited_alloc(void* ud, void* ptr, std::size_t osize, std::size_t nsize) {
   auto* heap = static_cast<LuaHeap*>(ud);
   const std::int64_t old_size = ptr != nullptr ? static_cast<std::int64_t>(osize) : 0;
@@ -125,6 +149,7 @@ void* limited_alloc(void* ud, void* ptr, std::size_t osize, std::size_t nsize) {
   if (grow > 0) {
     if (heap->used + grow > heap->limit) {
       heap->limit_hit = true;
+      note_refusal(heap);
       return nullptr;
     }
     if (heap->budget > 0 && heap->allocated + grow > heap->budget) {
@@ -132,6 +157,7 @@ void* limited_alloc(void* ud, void* ptr, std::size_t osize, std::size_t nsize) {
         heap->exhausted = true;
         heap->budget = heap->allocated + kAllocationGrace;
       }
+      note_refusal(heap);
       return nullptr;
     }
   }
@@ -234,7 +260,21 @@ int native_log(lua_State* L) {
   std::size_t n = 0;
   const char* text = luaL_checklstring(L, 2, &n);
   SkillEngine::Impl& e = SkillEngine::Impl::of(L);
-  if (e.log_sink) {
+  if (!e.long_paths.empty()) {
+    // Rare: the text again with whole paths, kept in a member (a Lua error below must not skip
+    // a destructor) and on the Lua stack.
+    e.cpp_error = e.full_paths(std::string(text, n));
+    lua_pushlstring(L, e.cpp_error.data(), e.cpp_error.size());
+    text = lua_tolstring(L, -1, &n);
+  }
+  if (!e.log_sink && e.loading_files) {
+    if (e.pending_log.size() < kMaxPendingLog) {
+      e.pending_log.emplace_back(static_cast<LogLevel>(std::clamp<lua_Integer>(level, 0, 3)),
+                                 std::string(text, n));
+    } else {
+      ++e.pending_dropped;
+    }
+  } else if (e.log_sink) {
     bool failed = false;
     try {
       e.log_sink(static_cast<LogLevel>(std::clamp<lua_Integer>(level, 0, 3)),
@@ -265,6 +305,15 @@ bool is_identifier(const std::string& s) {
   });
 }
 
+std::string replace_all(std::string text, const std::string& from, const std::string& to) {
+  if (from.empty() || from == to) return text;
+  for (std::size_t at = text.find(from); at != std::string::npos;
+       at = text.find(from, at + to.size())) {
+    text.replace(at, from.size(), to);
+  }
+  return text;
+}
+
 std::string pop_message(lua_State* L) {
   const char* msg = lua_tostring(L, -1);
   std::string out = msg != nullptr ? msg : "(error object is not a string)";
@@ -280,10 +329,27 @@ SkillEngine::Impl::Impl(const SkillEngineConfig& cfg, RobotApi& robot_api)
 SkillEngine::Impl::~Impl() { close(); }
 
 void SkillEngine::Impl::close() {
+  heap.state = nullptr;
   if (L != nullptr) lua_close(L);
   L = nullptr;
   engine_ref = chunk_ref = LUA_NOREF;
   heap.used = 0;
+}
+
+std::string SkillEngine::Impl::full_paths(std::string text) const {
+  for (const auto& [shortened, full] : long_paths) text = replace_all(text, shortened, full);
+  return text;
+}
+
+const std::string& SkillEngine::Impl::display_path(const std::string& path) const {
+  const auto it = config.display_paths.find(path);
+  if (it != config.display_paths.end()) return it->second;
+  // The same file written another way ("dir//s.lua", "dir/./s.lua").
+  const fs::path normal = fs::path(path).lexically_normal();
+  for (const auto& [real, shown] : config.display_paths) {
+    if (fs::path(real).lexically_normal() == normal) return shown;
+  }
+  return path;
 }
 
 void SkillEngine::Impl::arm_budget() {
@@ -293,6 +359,7 @@ void SkillEngine::Impl::arm_budget() {
   heap.budget = config.allocation_budget_bytes;
   heap.exhausted = false;
   heap.limit_hit = false;
+  heap.refused_at[0] = '\0';
   wall_deadline = std::chrono::steady_clock::now() +
                   std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                       std::chrono::duration<double>(config.max_cycle_wall_s));
@@ -301,7 +368,9 @@ void SkillEngine::Impl::arm_budget() {
 
 int SkillEngine::Impl::protected_call(int nargs, int nresults) {
   arm_budget();
+  heap.in_call = true;
   const int rc = lua_pcall(L, nargs, nresults, 0);
+  heap.in_call = false;
   // Outside protected calls nothing may be refused for the budget (an unprotected error would
   // panic); the flag stays for explain().
   heap.budget = 0;
@@ -311,8 +380,17 @@ int SkillEngine::Impl::protected_call(int nargs, int nresults) {
 std::string SkillEngine::Impl::explain(std::string msg) const {
   if (!heap.exhausted && !heap.limit_hit) return msg;
   const std::string_view oom = "not enough memory";
-  const std::size_t at = msg.find(oom);
+  std::size_t at = msg.find(oom);
   if (at == std::string::npos) return msg;
+  // The skill's line, unless the message already has one ("file:12: not enough memory").
+  const std::string_view before = std::string_view(msg).substr(0, at);
+  const bool positioned = before.size() >= 4 && before.substr(before.size() - 2) == ": " &&
+                          std::isdigit(static_cast<unsigned char>(before[before.size() - 3])) != 0;
+  if (!positioned && heap.refused_at[0] != '\0') {
+    const std::string located = std::string(heap.refused_at) + ": ";
+    msg.insert(at, located);
+    at += located.size();
+  }
   if (heap.exhausted) {
     return msg.replace(at, oom.size(),
                        "allocation budget exhausted (" +
@@ -386,9 +464,20 @@ void SkillEngine::Impl::build() {
   close();
   files = scan();
   ++loads;
+  // Lua shortens chunk names over LUA_IDSIZE - 1 characters to "..." and their last
+  // LUA_IDSIZE - 4 characters (luaO_chunkid); messages get the whole path back (full_paths()).
+  long_paths.clear();
+  for (const SkillFile& f : files) {
+    const std::string& shown = display_path(f.path);
+    constexpr std::size_t kKept = LUA_IDSIZE - 4;
+    if (shown.size() + 1 > static_cast<std::size_t>(LUA_IDSIZE)) {
+      long_paths.emplace_back("..." + shown.substr(shown.size() - kKept), shown);
+    }
+  }
   heap.limit = config.memory_limit_bytes;
   L = lua_newstate(limited_alloc, &heap);
   LLSF_DEMAND_MSG(L != nullptr, "cannot create a Lua state");
+  heap.state = L;
   *static_cast<Impl**>(lua_getextraspace(L)) = this;
   lua_atpanic(L, panic);
 
@@ -444,21 +533,23 @@ void SkillEngine::Impl::build() {
     LLSF_DEMAND_MSG(false, "declare_skills: " + pop_message(L));
   }
 
+  loading_files = true;
   for (const SkillFile& f : files) {
     std::string load_error;
     std::string read_error;
+    const std::string& shown = display_path(f.path);
     const std::string text = read_file(f.path, read_error);
     if (!read_error.empty()) {
-      load_error = read_error;
+      load_error = replace_all(read_error, f.path, shown);
     } else if (!is_identifier(f.name)) {
-      load_error = f.path + ": a skill's file name must be a Lua identifier";
+      load_error = shown + ": a skill's file name must be a Lua identifier";
     } else {
       lua_pushstring(L, f.name.c_str());
-      lua_pushstring(L, f.path.c_str());
+      lua_pushstring(L, shown.c_str());
       if (call_entry("begin_module", 2, 1) != LUA_OK) {
         load_error = pop_message(L);
       } else {
-        const std::string chunkname = "@" + f.path;
+        const std::string chunkname = "@" + shown;
         if (luaL_loadbufferx(L, text.data(), text.size(), chunkname.c_str(), "t") != LUA_OK) {
           load_error = explain(pop_message(L));
           lua_pop(L, 1);  // the module env
@@ -475,6 +566,7 @@ void SkillEngine::Impl::build() {
       }
     }
     if (!load_error.empty()) {
+      load_error = full_paths(load_error);
       lua_pushstring(L, f.name.c_str());
       lua_pushstring(L, load_error.c_str());
       if (call_entry("set_load_error", 2, 0) != LUA_OK) {
@@ -482,6 +574,7 @@ void SkillEngine::Impl::build() {
       }
     }
   }
+  loading_files = false;
   if (call_entry("resolve", 0, 0) != LUA_OK) LLSF_DEMAND_MSG(false, "resolve: " + pop_message(L));
   lua_settop(L, 0);
 }
@@ -555,12 +648,12 @@ SkillStatus SkillEngine::cycle() {
   lua_rawgeti(e.L, LUA_REGISTRYINDEX, e.chunk_ref);
   if (e.call_entry("run_cycle", 1, 3) != LUA_OK) {
     e.status = SkillStatus::kFailed;
-    e.error = e.explain(pop_message(e.L));
+    e.error = e.full_paths(e.explain(pop_message(e.L)));
   } else {
     const lua_Integer s = lua_tointeger(e.L, -3);
     e.status = static_cast<SkillStatus>(std::clamp<lua_Integer>(s, 0, 3));
     if (e.status == SkillStatus::kFailed) {
-      e.error = e.explain(lua_isstring(e.L, -2) ? lua_tostring(e.L, -2) : "FAILED");
+      e.error = e.full_paths(e.explain(lua_isstring(e.L, -2) ? lua_tostring(e.L, -2) : "FAILED"));
     }
     if (e.status != SkillStatus::kRunning) {
       const char* r = lua_tostring(e.L, -1);
@@ -615,7 +708,7 @@ SkillStatus SkillEngine::skill_status(std::string_view skill) const {
 std::string SkillEngine::skill_error(std::string_view skill) const {
   std::string out;
   with_skill_info(*impl_, skill, [&](SkillStatus, std::string err, auto&&...) { out = err; });
-  return out;
+  return impl_->full_paths(out);
 }
 
 std::string SkillEngine::skill_state(std::string_view skill) const {
@@ -664,7 +757,18 @@ void SkillEngine::reload() {
 int SkillEngine::load_count() const { return impl_->loads; }
 
 void SkillEngine::set_log_sink(std::function<void(LogLevel, std::string_view)> sink) {
-  impl_->log_sink = std::move(sink);
+  Impl& e = *impl_;
+  e.log_sink = std::move(sink);
+  if (!e.log_sink) return;
+  // What the files logged while they loaded (before there was a sink).
+  std::vector<std::pair<LogLevel, std::string>> pending;
+  pending.swap(e.pending_log);
+  for (const auto& [level, text] : pending) e.log_sink(level, text);
+  if (e.pending_dropped > 0) {
+    e.log_sink(LogLevel::kWarn, std::to_string(e.pending_dropped) +
+                                    " more lines logged while the skill files loaded were dropped");
+    e.pending_dropped = 0;
+  }
 }
 
 }  // namespace llsf::lua
