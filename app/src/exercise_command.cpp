@@ -138,7 +138,9 @@ struct SeedRun {
 void friendly(const std::string& message, const std::string& tmp, const std::string& user,
               const std::string& skill, std::ostream& out, SeedRun& run) {
   std::ostringstream block;
-  print_friendly(message, tmp, user, skill, block);
+  // The engine shows `user` (display_paths), which Lua shortens to "...tail" beyond 59
+  // characters: user_paths() with `user` as the path to find gives the whole path back.
+  print_friendly(user_paths(message, user, user), tmp, user, skill, block);
   out << block.str();
   // "error    ...", "in       ...", "hint     ...": a line without such a prefix continues the
   // field before it.
@@ -181,6 +183,7 @@ SeedRun play_seed(const Exercise& ex, const ExerciseOptions& o, std::uint64_t se
   if (ec.skill_dirs.empty()) ec.skill_dirs = sim::skill_library_dirs(config.levels.skill);
   ec.skill_dirs.push_back(skill_dir.dir());
   ec.hot_reload = false;
+  ec.display_paths[skill_dir.path()] = o.skill_file;  // messages name the participant's file
   std::vector<sim::SkillBrain*> brains;  // owned by the driver
   for (int i = 0; i < game.robot_count(); ++i) brains.push_back(&driver.plug_skills(i, ec));
   const std::string& user = o.skill_file;

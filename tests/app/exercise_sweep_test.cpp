@@ -142,6 +142,21 @@ TEST_CASE("exercise --json: one object with the contract's fields") {
   CHECK(s.at("runs")[0] == runs[0]);
 }
 
+TEST_CASE("exercise --json: a long path (Lua shortens those over 59 characters) is shown whole") {
+  const auto dir = std::filesystem::temp_directory_path() /
+                   "llsfex_sweep_a_rather_long_directory/of_a_participant/with_skills";
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "my_drive_to_point.lua").string();
+  REQUIRE(path.size() > 60);
+  std::filesystem::copy_file(east_fails(), path, std::filesystem::copy_options::overwrite_existing);
+  const Run r = llsfsim({"exercise", kExercise, "--skill", path, "--seeds", "1", "--json"});
+  INFO(r.out, r.err);
+  CHECK(r.code == llsf::app::kExitFailed);
+  CHECK(Json::parse(r.out).at("runs")[0].at("error") == path + ":24: too far east");
+  std::filesystem::remove_all(std::filesystem::temp_directory_path() /
+                              "llsfex_sweep_a_rather_long_directory");
+}
+
 TEST_CASE("exercise --seeds/--json: a file that does not load is NOT RUN, exit 2") {
   const std::string path =
       write_temp("llsfex_sweep_syntax.lua", "name = \"drive_to_point\"\nfsm = (\n");
