@@ -184,7 +184,7 @@ SeedRun play_seed(const Exercise& ex, const ExerciseOptions& o, std::uint64_t se
   ec.skill_dirs.push_back(skill_dir.dir());
   ec.hot_reload = false;
   ec.display_paths[skill_dir.path()] = o.skill_file;  // messages name the participant's file
-  std::vector<sim::SkillBrain*> brains;  // owned by the driver
+  std::vector<sim::SkillBrain*> brains;               // owned by the driver
   for (int i = 0; i < game.robot_count(); ++i) brains.push_back(&driver.plug_skills(i, ec));
   const std::string& user = o.skill_file;
   for (const lua::SkillInfo& s : brains.front()->engine().skills()) {
