@@ -2,6 +2,7 @@
 // Friendly errors of the exercises (exercise_hints.h).
 #include "exercise_hints.h"
 
+#include <cctype>
 #include <filesystem>
 #include <ostream>
 #include <string>
@@ -37,9 +38,76 @@ std::string user_paths(std::string text, const std::string& tmp, const std::stri
   return text;
 }
 
+namespace {
+
+/// Whether `msg` has a Lua position ("file.lua:12: "), i.e. it is an error Lua or the engine
+/// raised at a line (not a text the skill declared with error= or self.fsm.error).
+bool has_position(const std::string& msg) {
+  for (std::size_t at = msg.find(".lua:"); at != std::string::npos;
+       at = msg.find(".lua:", at + 1)) {
+    std::size_t i = at + 5;
+    while (i < msg.size() && std::isdigit(static_cast<unsigned char>(msg[i])) != 0) ++i;
+    if (i > at + 5 && i + 1 < msg.size() && msg[i] == ':' && msg[i + 1] == ' ') return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 /// A hint for a Lua or skill error message.
 std::string hint_for(const std::string& msg, const std::string& skill) {
   auto has = [&](const char* s) { return msg.find(s) != std::string::npos; };
+  // The mistakes of docs/exercises.md, "Mistakes and their messages" (their messages are the
+  // engine's, lua/src/prelude.lua), before the generic Lua errors below.
+  if (has("is not available in skills")) {
+    return "skills run in a sandbox without os, io, require, load, dofile, debug and coroutine: "
+           "use what the message names instead (docs/skills.md, \"Sandbox\").";
+  }
+  if (has("fsm:define_states{...} is missing") || has("no state is defined yet")) {
+    return "define the states right after SkillHSM:new: fsm:define_states{ export_to=_M, "
+           "{\"DRIVE\", SkillJumpState, skills={{drive_to}}, final_to=\"FINAL\"}, ... }, then "
+           "fsm:add_transitions{...} and the state functions (function DRIVE:init() ...).";
+  }
+  if (has("undeclared global 'fsm'") || has("has no state machine")) {
+    return "create the state machine below name = ...: fsm = SkillHSM:new{name=name, "
+           "start=\"DRIVE\"}, then fsm:define_states{...} (the exercise's skill.lua shows the "
+           "layout).";
+  }
+  if (has("needs start=")) {
+    return "name the state the skill begins in: fsm = SkillHSM:new{name=name, start=\"DRIVE\"} "
+           "(a state of your fsm:define_states{...}).";
+  }
+  if (has("declares no 'documentation'")) {
+    return "every skill says what it does: add documentation = [==[Drives to a point.]==] below "
+           "name = ... (any text).";
+  }
+  if (has("declares no 'name'")) {
+    return "add name = \"" + skill +
+           "\" as the first line: the exercise loads your file as that "
+           "skill.";
+  }
+  if (has("unknown state '")) {
+    return "a state named in a transition, final_to, fail_to, timeout or start is not defined: "
+           "fix the spelling (the message names the nearest state and lists them; names are "
+           "case-sensitive) or add the state to fsm:define_states{...}.";
+  }
+  if (has("undeclared global") && has("did you mean")) {
+    return "a typo? Use the name the message suggests (names are case-sensitive); a state's "
+           "name is a global once fsm:define_states{ export_to=_M, ... } defined it.";
+  }
+  if (has("undeclared global")) {
+    return "a name the skill never defined: make it a local (local n = 0) before use, declare "
+           "interfaces in depends_interfaces and skills in depends_skills (names are "
+           "case-sensitive).";
+  }
+  if (has("fsm.result must be")) {
+    return "report text, not a table: self.fsm.result = string.format(\"%.2f %.2f\", x, y) "
+           "(field coordinates), or a number.";
+  }
+  if (has("to 'printf'") || has("to 'format'") || has("to 'string.format'")) {
+    return "the format does not fit the value: %d needs a whole number (use %.2f for 1.5, %s "
+           "for anything, math.floor(v) to round down).";
+  }
   if (has("pattern matching)") || has("plain search)")) {
     return "a string search that takes too long: a pattern with several `*`, `+` or `-` on a "
            "long string backtracks a lot; search a shorter string or use a simpler pattern "
@@ -67,8 +135,9 @@ std::string hint_for(const std::string& msg, const std::string& skill) {
            "transition (cond=..., timeout=...) that waits instead.";
   }
   if (has("not enough memory")) {
-    return "the skill used more memory than allowed (its heap limit): a table that grows every "
-           "cycle?";
+    return "the skill holds more memory than allowed (its heap limit): a table that grows every "
+           "cycle (the line named is where the memory ran out)? Keep only what you need, e.g. "
+           "the last few sightings.";
   }
   if (has("does not match its file name")) {
     return "the exercise loads your file as the skill '" + skill + "': keep the line name = \"" +
@@ -110,6 +179,14 @@ std::string hint_for(const std::string& msg, const std::string& skill) {
   if (has(")/")) {
     return "a skill your skill called failed: send the state to a recovery state with "
            "fail_to=\"STATE\" and try again, instead of failing.";
+  }
+  if (has("bad argument #")) {
+    return "a library function got a wrong argument: the message says which (#1 is the first) "
+           "and what it expected.";
+  }
+  if (has_position(msg)) {
+    return "a Lua error at this line: the message says which value was wrong (print it with "
+           "print(...) just before the line to see it).";
   }
   return "your skill failed with this error (a transition to FAILED or self.fsm.error).";
 }

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "llsf/lua/skill_engine.h"
@@ -32,6 +33,12 @@ struct LuaHeap {
   bool exhausted = false;
   /// Set when an allocation was refused for the heap limit.
   bool limit_hit = false;
+  /// The interpreter, and whether a protected call runs in it: only then is a refusal located.
+  lua_State* state = nullptr;
+  bool in_call = false;
+  /// "file:line" of the skill code running when an allocation was last refused (the innermost
+  /// frame of a skill file); empty if none. Memory errors carry no position of their own.
+  char refused_at[256] = {};
 };
 
 /// Bytes an interpreter may still allocate after its allocation budget ran out (error messages,
@@ -40,6 +47,9 @@ inline constexpr std::int64_t kAllocationGrace = 1 << 20;
 /// The count hook runs every kHookInterval VM instructions (or every instruction_budget
 /// instructions if that is smaller) and adds them to Impl::used.
 inline constexpr std::int64_t kHookInterval = 1000;
+
+/// Lines kept while the files load without a log sink (SkillEngine::Impl::pending_log).
+inline constexpr std::size_t kMaxPendingLog = 200;
 
 /// One skill file as last loaded (for hot reload).
 struct SkillFile {
@@ -73,6 +83,11 @@ struct SkillEngine::Impl {
   std::string result;  // fsm.result of the string's skills when it ended
   std::string skill_string;
   std::function<void(LogLevel, std::string_view)> log_sink;
+  /// Lines logged while the files load with no sink set yet (a skill file's top-level print):
+  /// delivered by set_log_sink(), at most kMaxPendingLog of them.
+  std::vector<std::pair<LogLevel, std::string>> pending_log;
+  int pending_dropped = 0;
+  bool loading_files = false;
 
   // Caches for the bindings (see the file comment).
   NavState nav;

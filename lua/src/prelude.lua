@@ -180,7 +180,10 @@ base.print_warn = function(...) log(2, args_text(...)) end
 base.print_error = function(...) log(3, args_text(...)) end
 base.printf = function(f, ...)
   local ok, text = raw_pcall(fmt, f, ...)
-  if not ok then raise_at_skill("printf: " .. tostring(text)) end
+  if not ok then
+    text = tostring(text):gsub("to '[%w.]*format'", "to 'printf'")
+    raise_at_skill(text)
+  end
   log(1, text)
 end
 
@@ -228,10 +231,11 @@ local function distance(a, b)
 end
 
 -- The candidate (a list of names) nearest to `name` if it is near enough to be a typo: at most
--- 1 edit for names up to 4 characters, 2 up to 8, else 3; ties go to the first in name order.
+-- 1 edit for names of 3 or 4 characters, 2 up to 8, else 3 (names of 1 or 2 characters: only
+-- another case); ties go to the first in name order.
 local function nearest(name, candidates)
   if type(name) ~= "string" or #name > 64 then return nil end
-  local limit = #name <= 4 and 1 or #name <= 8 and 2 or 3
+  local limit = #name <= 2 and 0 or #name <= 4 and 1 or #name <= 8 and 2 or 3
   local best, best_d = nil, limit + 1
   local names = {}
   for _, c in ipairs(candidates) do
@@ -252,9 +256,11 @@ local function did_you_mean(name, candidates)
   return n and fmt(" (did you mean '%s'?)", n) or ""
 end
 
-local function state_names(fsm)
+local function state_names(fsm)  -- the skill's own states first, then FINAL and FAILED
   local names = {}
-  for i, st in ipairs(fsm.state_list) do names[i] = st.name end
+  for i = 3, #fsm.state_list do names[#names + 1] = fsm.state_list[i].name end
+  names[#names + 1] = "FINAL"
+  names[#names + 1] = "FAILED"
   return names
 end
 
@@ -268,9 +274,9 @@ end
 
 -- Globals skills do not have, with what to use instead.
 local unavailable = {
-  os = "no files, processes or wall clock in skills: for time use clock.now() (game seconds) " ..
+  os = "no files, processes or wall clock: for time use clock.now() (game seconds) " ..
        "or a transition's timeout=SECS",
-  io = "no files or terminal in skills: print(...) / printf(fmt, ...) write to the log",
+  io = "no files or terminal: print(...) / printf(fmt, ...) write to the log",
   require = "skills load no modules: name another skill in depends_skills = {\"skill\"} and " ..
             "call it from a SkillJumpState (skills={{skill}})",
   package = "skills load no modules: name another skill in depends_skills = {\"skill\"}",
@@ -278,16 +284,15 @@ local unavailable = {
   loadfile = "skills load no other files: name another skill in depends_skills = {\"skill\"}",
   load = "skills compile no code at run time: write a function instead (a cond may be a " ..
          "function or a string the engine compiles at load time)",
-  loadstring = "skills compile no code at run time (and loadstring is Lua 5.1's load): write " ..
-               "a function instead",
-  debug = "the debug library is not available in skills: print(...) what you want to see",
-  coroutine = "coroutines are not available in skills: wait in a state with a transition " ..
-              "(cond=..., timeout=...)",
+  loadstring = "skills compile no code at run time (and loadstring is Lua 5.1's): write a " ..
+               "function instead",
+  debug = "print(...) what you want to see",
+  coroutine = "wait in a state with a transition (cond=..., timeout=...)",
   collectgarbage = "the engine manages memory: drop references (t = nil) instead",
-  _G = "skills have no _G: their own globals are in _M",
-  unpack = "unpack is Lua 5.1's: use table.unpack",
-  setfenv = "setfenv is Lua 5.1's and not available",
-  getfenv = "getfenv is Lua 5.1's and not available",
+  _G = "a skill's own globals are in _M",
+  unpack = "it is Lua 5.1's: use table.unpack",
+  setfenv = "it is Lua 5.1's (a skill's globals are in _M)",
+  getfenv = "it is Lua 5.1's (a skill's globals are in _M)",
 }
 
 local function where(level)

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -111,8 +112,31 @@ namespace {
 
 constexpr const char* kPreludeChunkName = "=llsf/prelude.lua";
 
+// Where a refused allocation happened: the innermost frame of a skill file (chunk names "@path")
+// and its current line, for Impl::explain(). Lua's memory error has no position, and Lua calls no
+// message handler for it, so the stack is read here, in the allocator, before the error unwinds
+// it. lua_getstack/lua_getinfo("Sl") only read CallInfos and prototypes and allocate nothing.
+// Lua 5.4.4 (Debian bookworm) keeps the old stack valid while it allocates a bigger one; later
+// releases turn stack pointers into offsets around that allocation, so there nothing is read.
+void note_refusal(LuaHeap* heap) {
+#if LUA_VERSION_RELEASE_NUM <= 50404
+  if (heap->state == nullptr || !heap->in_call) return;
+  lua_Debug ar{};
+  for (int level = 0; lua_getstack(heap->state, level, &ar) != 0; ++level) {
+    if (lua_getinfo(heap->state, "Sl", &ar) == 0) break;
+    if (ar.currentline > 0 && ar.source != nullptr && ar.source[0] == '@') {
+      std::snprintf(heap->refused_at, sizeof heap->refused_at, "%s:%d", ar.short_src,
+                    ar.currentline);
+      return;
+    }
+  }
+#else
+  static_cast<void>(heap);
+#endif
+}
+
 // Allocator with a heap limit and an allocation budget: refusing an allocation makes Lua raise
-// "not enough memory" (Impl::explain() names the budget in the message).
+// "not enough memory" (Impl::explain() names the budget and the line in the message).
 void* limited_alloc(void* ud, void* ptr, std::size_t osize, std::size_t nsize) {
   auto* heap = static_cast<LuaHeap*>(ud);
   const std::int64_t old_size = ptr != nullptr ? static_cast<std::int64_t>(osize) : 0;
@@ -125,6 +149,7 @@ void* limited_alloc(void* ud, void* ptr, std::size_t osize, std::size_t nsize) {
   if (grow > 0) {
     if (heap->used + grow > heap->limit) {
       heap->limit_hit = true;
+      note_refusal(heap);
       return nullptr;
     }
     if (heap->budget > 0 && heap->allocated + grow > heap->budget) {
@@ -132,6 +157,7 @@ void* limited_alloc(void* ud, void* ptr, std::size_t osize, std::size_t nsize) {
         heap->exhausted = true;
         heap->budget = heap->allocated + kAllocationGrace;
       }
+      note_refusal(heap);
       return nullptr;
     }
   }
@@ -234,7 +260,14 @@ int native_log(lua_State* L) {
   std::size_t n = 0;
   const char* text = luaL_checklstring(L, 2, &n);
   SkillEngine::Impl& e = SkillEngine::Impl::of(L);
-  if (e.log_sink) {
+  if (!e.log_sink && e.loading_files) {
+    if (e.pending_log.size() < kMaxPendingLog) {
+      e.pending_log.emplace_back(static_cast<LogLevel>(std::clamp<lua_Integer>(level, 0, 3)),
+                                 std::string(text, n));
+    } else {
+      ++e.pending_dropped;
+    }
+  } else if (e.log_sink) {
     bool failed = false;
     try {
       e.log_sink(static_cast<LogLevel>(std::clamp<lua_Integer>(level, 0, 3)),
@@ -289,6 +322,7 @@ SkillEngine::Impl::Impl(const SkillEngineConfig& cfg, RobotApi& robot_api)
 SkillEngine::Impl::~Impl() { close(); }
 
 void SkillEngine::Impl::close() {
+  heap.state = nullptr;
   if (L != nullptr) lua_close(L);
   L = nullptr;
   engine_ref = chunk_ref = LUA_NOREF;
@@ -313,6 +347,7 @@ void SkillEngine::Impl::arm_budget() {
   heap.budget = config.allocation_budget_bytes;
   heap.exhausted = false;
   heap.limit_hit = false;
+  heap.refused_at[0] = '\0';
   wall_deadline = std::chrono::steady_clock::now() +
                   std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                       std::chrono::duration<double>(config.max_cycle_wall_s));
@@ -321,7 +356,9 @@ void SkillEngine::Impl::arm_budget() {
 
 int SkillEngine::Impl::protected_call(int nargs, int nresults) {
   arm_budget();
+  heap.in_call = true;
   const int rc = lua_pcall(L, nargs, nresults, 0);
+  heap.in_call = false;
   // Outside protected calls nothing may be refused for the budget (an unprotected error would
   // panic); the flag stays for explain().
   heap.budget = 0;
@@ -331,8 +368,17 @@ int SkillEngine::Impl::protected_call(int nargs, int nresults) {
 std::string SkillEngine::Impl::explain(std::string msg) const {
   if (!heap.exhausted && !heap.limit_hit) return msg;
   const std::string_view oom = "not enough memory";
-  const std::size_t at = msg.find(oom);
+  std::size_t at = msg.find(oom);
   if (at == std::string::npos) return msg;
+  // The skill's line, unless the message already has one ("file:12: not enough memory").
+  const std::string_view before = std::string_view(msg).substr(0, at);
+  const bool positioned = before.size() >= 4 && before.substr(before.size() - 2) == ": " &&
+                          std::isdigit(static_cast<unsigned char>(before[before.size() - 3])) != 0;
+  if (!positioned && heap.refused_at[0] != '\0') {
+    const std::string located = std::string(heap.refused_at) + ": ";
+    msg.insert(at, located);
+    at += located.size();
+  }
   if (heap.exhausted) {
     return msg.replace(at, oom.size(),
                        "allocation budget exhausted (" +
@@ -409,6 +455,7 @@ void SkillEngine::Impl::build() {
   heap.limit = config.memory_limit_bytes;
   L = lua_newstate(limited_alloc, &heap);
   LLSF_DEMAND_MSG(L != nullptr, "cannot create a Lua state");
+  heap.state = L;
   *static_cast<Impl**>(lua_getextraspace(L)) = this;
   lua_atpanic(L, panic);
 
@@ -464,6 +511,7 @@ void SkillEngine::Impl::build() {
     LLSF_DEMAND_MSG(false, "declare_skills: " + pop_message(L));
   }
 
+  loading_files = true;
   for (const SkillFile& f : files) {
     std::string load_error;
     std::string read_error;
@@ -503,6 +551,7 @@ void SkillEngine::Impl::build() {
       }
     }
   }
+  loading_files = false;
   if (call_entry("resolve", 0, 0) != LUA_OK) LLSF_DEMAND_MSG(false, "resolve: " + pop_message(L));
   lua_settop(L, 0);
 }
@@ -685,7 +734,18 @@ void SkillEngine::reload() {
 int SkillEngine::load_count() const { return impl_->loads; }
 
 void SkillEngine::set_log_sink(std::function<void(LogLevel, std::string_view)> sink) {
-  impl_->log_sink = std::move(sink);
+  Impl& e = *impl_;
+  e.log_sink = std::move(sink);
+  if (!e.log_sink) return;
+  // What the files logged while they loaded (before there was a sink).
+  std::vector<std::pair<LogLevel, std::string>> pending;
+  pending.swap(e.pending_log);
+  for (const auto& [level, text] : pending) e.log_sink(level, text);
+  if (e.pending_dropped > 0) {
+    e.log_sink(LogLevel::kWarn, std::to_string(e.pending_dropped) +
+                                    " more lines logged while the skill files loaded were dropped");
+    e.pending_dropped = 0;
+  }
 }
 
 }  // namespace llsf::lua

@@ -164,12 +164,13 @@ TEST_CASE("the allocation budget stops copying big strings in a loop; pcall cann
       "  local s = string.rep('x', 4 << 20)\n"
       "  for i = 1, 1000 do local ok = pcall(function() return s .. s end) end");
   CHECK(r.status == SkillStatus::kFailed);
+  // The line that was running when the allocation was refused (Lua's memory error has none).
   CHECK(r.error ==
-        "probe: allocation budget exhausted (33554432 bytes allocated per cycle; copying big "
-        "strings in a loop?)");
+        "probe: probe.lua:5: allocation budget exhausted (33554432 bytes allocated per cycle; "
+        "copying big strings in a loop?)");
   r = run_probe("  local s = 'x' while true do s = s .. s end");
   CHECK(r.status == SkillStatus::kFailed);
-  CHECK(r.error == "probe: not enough memory (heap limit of 16777216 bytes)");
+  CHECK(r.error == "probe: probe.lua:4: not enough memory (heap limit of 16777216 bytes)");
 }
 
 TEST_CASE("the library tables are read-only: one skill cannot change another's string.format") {

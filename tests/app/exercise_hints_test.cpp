@@ -1,0 +1,130 @@
+// SPDX-License-Identifier: MIT
+// `llsfsim exercise` on the deliberate mistakes of tests/app/exercises/mistakes/ (one file per
+// mistake, the line marked "-- MISTAKE"): each is reported with the participant's file and
+// line, its own message and its own hint, or with a warning (docs/exercises.md, "Mistakes and
+// their messages"). The runs are short: load errors stop before the game, the others fail or end
+// in the first seconds of game time.
+#include <doctest/doctest.h>
+
+#include <fstream>
+#include <string>
+
+#include "app/cli_fixture.h"
+#include "llsf/app/cli.h"
+
+namespace {
+
+using llsf::test::has;
+using llsf::test::llsfsim;
+using llsf::test::Run;
+
+const std::string kMistakes = LLSF_SOURCE_DIR "/tests/app/exercises/mistakes/";
+
+/// The line number of the "-- MISTAKE" marker in `path`.
+int marked(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    if (line.find("-- MISTAKE") != std::string::npos) return n;
+  }
+  FAIL("no -- MISTAKE marker in ", path);
+  return 0;
+}
+
+struct Mistake {
+  const char* file;
+  const char* exercise;
+  int code;             ///< exit code
+  const char* message;  ///< follows "error    PATH:LINE: "
+  const char* hint;     ///< follows "hint     "
+};
+
+}  // namespace
+
+TEST_CASE("exercise: each mistake gets its own message at the participant's file:line and hint") {
+  using llsf::app::kExitBadInput;
+  using llsf::app::kExitFailed;
+  const Mistake mistakes[] = {
+      {"undefined_state.lua", "01", kExitBadInput,
+       "add_transitions: {\"DRIVE\", \"CHEK\"} goes to an unknown state 'CHEK' (did you mean "
+       "'CHECK'? states: DRIVE, CHECK, FINAL, FAILED)",
+       "a state named in a transition"},
+      {"no_define_states.lua", "01", kExitBadInput,
+       "the state machine has no states: fsm:define_states{...} is missing (start state 'DRIVE' "
+       "is not defined)",
+       "define the states right after SkillHSM:new"},
+      {"no_fsm.lua", "01", kExitBadInput,
+       "undeclared global 'fsm': create the state machine first: fsm = SkillHSM:new{name=name, "
+       "start=\"STATE\"}",
+       "create the state machine below name = ..."},
+      {"no_documentation.lua", "01", kExitBadInput,
+       "the skill declares no 'documentation' string: add documentation = [==[what the skill "
+       "does]==] next to name = ...",
+       "every skill says what it does"},
+      {"no_start.lua", "01", kExitBadInput,
+       "SkillHSM:new{...} needs start=\"STATE\", the state the skill begins in",
+       "name the state the skill begins in"},
+      {"typo_state.lua", "01", kExitBadInput, "undeclared global 'DRVE' (did you mean 'DRIVE'?)",
+       "a typo? Use the name the message suggests"},
+      {"typo_runtime.lua", "01", kExitFailed, "undeclared global 'poes' (did you mean 'pose'?)",
+       "a typo? Use the name the message suggests"},
+      {"uses_os.lua", "01", kExitFailed,
+       "'os' is not available in skills: no files, processes or wall clock: for time "
+       "use clock.now() (game seconds) or a transition's timeout=SECS",
+       "skills run in a sandbox"},
+      {"uses_require.lua", "01", kExitBadInput,
+       "'require' is not available in skills: skills load no modules: name another skill in "
+       "depends_skills",
+       "skills run in a sandbox"},
+      {"printf_float.lua", "01", kExitFailed,
+       "bad argument #2 to 'printf' (number has no integer representation)",
+       "the format does not fit the value: %d needs a whole number"},
+      {"out_of_memory.lua", "01", kExitFailed, "not enough memory (heap limit of 67108864 bytes)",
+       "the skill holds more memory than allowed"},
+      {"result_table.lua", "02", kExitFailed,
+       "fsm.result must be a string (e.g. \"1.20 3.40\") or a number, not a table",
+       "report text, not a table"},
+  };
+  for (const Mistake& m : mistakes) {
+    const std::string path = kMistakes + m.file;
+    const Run r = llsfsim({"exercise", m.exercise, "--skill", path, "-q"});
+    INFO(m.file, "\n", r.out, r.err);
+    CHECK(r.code == m.code);
+    CHECK(has(r.out, "error    " + path + ":" + std::to_string(marked(path)) + ": " + m.message));
+    CHECK(has(r.out, std::string("hint     ") + m.hint));
+    CHECK(has(r.out, m.code == kExitBadInput ? "result   NOT RUN" : "result   FAIL"));
+    CHECK_FALSE(has(r.out, "prelude.lua"));
+    CHECK_FALSE(has(r.out, "llsfex-"));  // never the temporary copy's path
+    CHECK_FALSE(has(r.out, "your skill failed with this error"));  // not the catch-all
+  }
+}
+
+TEST_CASE("exercise: silent mistakes are warnings with the line; a load-time print is shown") {
+  struct Warning {
+    const char* file;
+    const char* text;  ///< follows ":LINE: " in a "warn: " line
+  };
+  const Warning warnings[] = {
+      {"bounce.lua",
+       "drive_to_point: states PLAN -> CHECK -> PLAN keep switching without waiting ("},
+      {"args_ignored.lua",
+       "drive_to_point: state 'DRIVE' sets self.args[\"drive_to\"], but it runs no sub-skill (it "
+       "is a JumpState), so the arguments are ignored"},
+  };
+  for (const Warning& w : warnings) {
+    const std::string path = kMistakes + w.file;
+    const Run r = llsfsim({"exercise", "01", "--skill", path, "-q"});
+    INFO(w.file, "\n", r.out, r.err);
+    CHECK(r.code == llsf::app::kExitFailed);
+    const std::size_t at = r.out.find(" warn: ");
+    REQUIRE(at != std::string::npos);
+    const std::string line = r.out.substr(at, r.out.find('\n', at) - at);
+    CHECK(has(line, ":" + std::to_string(marked(path)) + ": " + w.text));
+    // Once per call of the skill, not once per cycle.
+    CHECK(r.out.find(" warn: ", at + 1) == std::string::npos);
+  }
+
+  const Run r = llsfsim({"exercise", "01", "--skill", kMistakes + "print_at_load.lua"});
+  INFO(r.out, r.err);
+  CHECK(has(r.out, "[    0.00 s] robot1 info: loading drive_to_point, version 3\n"));
+}

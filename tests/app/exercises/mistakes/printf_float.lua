@@ -1,0 +1,16 @@
+-- SPDX-License-Identifier: MIT
+-- Mistake (tests/app/exercise_hints_test.cpp): printf("%d", 1.5) (%d needs an integer).
+-- Exercise 01.
+name               = "drive_to_point"
+fsm                = SkillHSM:new{name=name, start="DRIVE"}
+depends_skills     = {"drive_to"}
+documentation      = [==[Drives the robot to a point of the field.]==]
+
+fsm:define_states{ export_to=_M,
+   {"DRIVE", SkillJumpState, skills={{drive_to}}, final_to="FINAL", fail_to="FAILED"},
+}
+
+function DRIVE:init()
+   printf("driving to x=%d", self.fsm.vars.x + 0.5)  -- MISTAKE
+   self.args["drive_to"] = {x = self.fsm.vars.x, y = self.fsm.vars.y}
+end

@@ -1,0 +1,19 @@
+-- SPDX-License-Identifier: MIT
+-- Mistake (tests/app/exercise_hints_test.cpp): a typo in an interface's name (poes for pose),
+-- found when the state runs. Exercise 01.
+name               = "drive_to_point"
+fsm                = SkillHSM:new{name=name, start="DRIVE"}
+depends_skills     = {"drive_to"}
+depends_interfaces = {
+   {v = "pose", type = "Position3DInterface"},
+}
+documentation      = [==[Drives the robot to a point of the field.]==]
+
+fsm:define_states{ export_to=_M,
+   {"DRIVE", SkillJumpState, skills={{drive_to}}, final_to="FINAL", fail_to="FAILED"},
+}
+
+function DRIVE:init()
+   local x, y = poes:get()  -- MISTAKE
+   self.args["drive_to"] = {x = self.fsm.vars.x, y = self.fsm.vars.y}
+end

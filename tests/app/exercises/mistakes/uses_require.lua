@@ -1,0 +1,12 @@
+-- SPDX-License-Identifier: MIT
+-- Mistake (tests/app/exercise_hints_test.cpp): require(...) in a skill (not available).
+-- Exercise 01.
+local helpers = require("helpers")  -- MISTAKE
+name               = "drive_to_point"
+fsm                = SkillHSM:new{name=name, start="DRIVE"}
+depends_skills     = {"drive_to"}
+documentation      = [==[Drives the robot to a point of the field.]==]
+
+fsm:define_states{ export_to=_M,
+   {"DRIVE", SkillJumpState, skills={{drive_to}}, final_to="FINAL", fail_to="FAILED"},
+}
