@@ -106,7 +106,7 @@ int list_exercises(const std::string& root, std::ostream& out, std::ostream& err
   return kExitOk;
 }
 
-/// What one seed's game came to: the verdict's parts (the `runs` of `--json`).
+/// A seed's result, and a sweep's verdict.
 enum class Outcome : std::uint8_t { kPass, kFail, kNotRun };
 
 const char* outcome_name(Outcome r) {
@@ -121,6 +121,8 @@ const char* outcome_name(Outcome r) {
   return "";
 }
 
+/// What one seed's game came to: the verdict's parts (a row of the table, a `runs` entry of
+/// `--json`).
 struct SeedRun {
   std::uint64_t seed = 0;
   Outcome result = Outcome::kNotRun;
@@ -168,7 +170,8 @@ void friendly(const std::string& message, const std::string& tmp, const std::str
 
 /// Plays exercise `ex` with the participant's file `o.skill_file` on `seed`, printing what
 /// happens on `out` (progress, log lines, the verdict) as a single run does, and returns the
-/// outcome. Thread-safe for distinct `out`/`err` streams when `o` asks for no server.
+/// outcome. Thread-safe for distinct `out`/`err` streams when `o` asks for no server and no
+/// recording.
 SeedRun play_seed(const Exercise& ex, const ExerciseOptions& o, std::uint64_t seed,
                   std::ostream& out, std::ostream& err) {
   SeedRun run;
