@@ -1,12 +1,13 @@
 // SPDX-License-Identifier: MIT
 // `llsfsim exercise`: every exercise's reference solution (tests/app/exercises/, kept out of
-// exercises/) passes on each of its 20 seeds, every unchanged skeleton fails with the friendly
-// verdict, and broken skills (syntax error, endless loop, runtime error) are reported with
-// file:line.
+// exercises/) passes on each of its 20 seeds (one `--seeds 1-20 --json` sweep per exercise), every
+// unchanged skeleton fails with the friendly verdict, and broken skills (syntax error, endless
+// loop, runtime error) are reported with file:line.
 #include <doctest/doctest.h>
 
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -28,17 +29,29 @@ std::string write_temp(const std::string& name, const std::string& text) {
   return path.string();
 }
 
-/// Plays `exercise` with `skill` on seeds 1..n; returns how many passed.
+/// Plays `exercise` with `skill` on seeds 1..n in one sweep (`--seeds 1-n --json`, the games on
+/// threads); returns how many passed. Every passed seed's `value` meets the goal.
 int passes(const std::string& exercise, const std::string& skill, int n) {
-  int ok = 0;
-  for (int seed = 1; seed <= n; ++seed) {
-    const Run r = llsfsim({"exercise", kExercises + exercise, "--skill", skill, "--seed",
-                           std::to_string(seed), "-q"});
-    INFO(exercise, " seed ", seed, "\n", r.out, r.err);
-    CHECK(r.code != llsf::app::kExitBadInput);
-    if (r.code == llsf::app::kExitOk) ++ok;
+  const Run r = llsfsim({"exercise", kExercises + exercise, "--skill", skill, "--seeds",
+                         "1-" + std::to_string(n), "--json"});
+  INFO(exercise, "\n", r.out, r.err);
+  CHECK(r.code != llsf::app::kExitBadInput);
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  CHECK(j.at("total") == n);
+  const std::string goal = j.at("goal");
+  for (const nlohmann::json& run : j.at("runs")) {
+    INFO("seed ", run.at("seed"), ": ", run.dump());
+    CHECK(run.at("result") == "PASS");
+    REQUIRE(run.at("value").is_number());
+    if (goal == "points") {
+      CHECK(run.at("value").is_number_integer());
+      CHECK(run.at("value").get<int>() > 0);
+    } else {
+      CHECK(run.at("value").get<double>() <= 0.3);
+    }
   }
-  return ok;
+  CHECK((j.at("verdict") == "PASS") == (j.at("passed") == n));
+  return j.at("passed").get<int>();
 }
 
 }  // namespace
