@@ -4,15 +4,23 @@
 // the exercise's hackathon world, prints progress and a score, and judges the game by the
 // exercise's rule. Lua errors are shown as `file:line: message` with a hint, never as a dump.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
+#include <deque>
+#include <exception>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <memory>
+#include <mutex>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <ostream>
 #include <regex>
@@ -21,7 +29,9 @@
 #include <thread>
 #include <vector>
 
+#include "batch_progress.h"
 #include "commands.h"
+#include "exercise.h"
 #include "exercise_hints.h"
 #include "hackathon_client.h"
 #include "live.h"
@@ -33,6 +43,7 @@
 #include "llsf/sim/driver.h"
 #include "llsf/sim/game.h"
 #include "llsf/sim/skill_brain.h"
+#include "llsf/study/batch.h"
 #include "llsf/study/recording.h"
 #include "llsf/study/scenario.h"
 #include "llsf/study/stats_store.h"
@@ -45,197 +56,15 @@ namespace {
 namespace fs = std::filesystem;
 using core::SimTime;
 
-// --- The exercise file ----------------------------------------------------------------------
-
-/// How an exercise is judged (exactly one kind per exercise).
-struct Goal {
-  enum class Kind : std::uint8_t {
-    kReach,   ///< the skill ends FINAL with the robot within `within_m` of the target
-    kFind,    ///< the skill ends FINAL reporting (fsm.result) a puck of `colour` within `within_m`
-    kPoints,  ///< the hackathon points reach `points` (the skill must not fail)
-  };
-  Kind kind = Kind::kPoints;
-  std::vector<core::Vec2> targets;  ///< kReach: the seed picks one (stream "exercise/target")
-  double within_m = 0.2;
-  std::string colour;  ///< kFind
-  int points = 0;      ///< kPoints
-};
-
-/// One exercise: exercise.yaml read and validated.
-struct Exercise {
-  std::string name;   ///< the directory name, e.g. "01-drive-to-point"
-  std::string title;  ///< "Drive to a point"
-  std::string dir;
-  std::string file;     ///< .../exercise.yaml
-  std::string skill;    ///< the skill name the participant's file is loaded as
-  bool repeat = false;  ///< call the skill again after FINAL until the time is up
-  double progress_s = 10.0;
-  Goal goal;
-  study::Scenario scenario;
-};
-
-bool is_identifier(const std::string& s) {
-  static const std::regex re("[A-Za-z_][A-Za-z0-9_]*");
-  return std::regex_match(s, re);
-}
-
-Exercise load_exercise(const std::string& dir) {
-  Exercise ex;
-  ex.dir = dir;
-  ex.name = fs::path(dir).lexically_normal().filename().string();
-  if (ex.name.empty()) ex.name = fs::path(dir).lexically_normal().parent_path().filename().string();
-  ex.file = (fs::path(dir) / "exercise.yaml").string();
-  const core::ConfigNode root = core::ConfigNode::load_file(ex.file);
-  root.require_map();
-  ex.title = root.at("title").as_string();
-  ex.skill = root.at("skill").as_string();
-  if (!is_identifier(ex.skill)) root["skill"].fail("must be a Lua identifier (the skill's name)");
-  root.read("repeat", ex.repeat);
-  root.read("progress_s", ex.progress_s, core::positive());
-  core::ConfigNode sc = root.at("scenario");
-  const core::ConfigNode g = root.at("goal");
-  root.no_other_keys();
-
-  // The world: a scenario map (docs/scenarios.md) that must switch on the hackathon.
-  sc.require_map();
-  if (!sc["name"].defined()) sc.set("name", core::ConfigNode::parse("'" + ex.name + "'", ex.file));
-  ex.scenario = study::read_scenario_map(sc, ex.file);
-  if (!ex.scenario.game.hackathon) {
-    sc.fail("an exercise plays the hackathon variant: add `hackathon: {}` (docs/hackathon.md)");
-  }
-  for (const study::RobotSpec& r : ex.scenario.robots) {
-    if (!r.agent.empty()) sc["robots"].fail("robots of an exercise run the skill, not an agent");
-  }
-
-  // The scoring rule.
-  g.require_map();
-  const core::ConfigNode reach = g["reach"];
-  const core::ConfigNode find = g["find"];
-  static_cast<void>(g["points_at_least"]);  // asked for: the third known key
-  g.no_other_keys();
-  if (g.size() != 1) g.fail("give exactly one of reach, find, points_at_least");
-  const kinematic::FieldConfig& field = ex.scenario.game.world.field;
-  if (reach.defined()) {
-    const core::ConfigNode& r = reach;
-    r.require_map();
-    ex.goal.kind = Goal::Kind::kReach;
-    const core::ConfigNode t = r.at("targets");
-    if (!t.is_sequence() || t.size() == 0) t.fail("expected a list of {x, y}");
-    for (const core::ConfigNode& p : t.elements()) {
-      p.require_map();
-      const core::Vec2 v(p.at("x").as_double(), p.at("y").as_double());
-      p.no_other_keys();
-      if (v.x() < 0.0 || v.y() < 0.0 || v.x() > field.width_m || v.y() > field.height_m) {
-        p.fail(fmt::format("({:.2f}, {:.2f}) is not on the field", v.x(), v.y()));
-      }
-      ex.goal.targets.push_back(v);
-    }
-    r.read("within_m", ex.goal.within_m, core::positive());
-    r.no_other_keys();
-  } else if (find.defined()) {
-    const core::ConfigNode& f = find;
-    f.require_map();
-    ex.goal.kind = Goal::Kind::kFind;
-    ex.goal.colour = f.at("colour").as_string();
-    if (ex.scenario.game.hackathon->colour_index(ex.goal.colour) < 0) {
-      f["colour"].fail("'" + ex.goal.colour + "' is not a colour of scenario.hackathon.colours");
-    }
-    ex.goal.within_m = 0.3;
-    f.read("within_m", ex.goal.within_m, core::positive());
-    f.no_other_keys();
-  } else {
-    ex.goal.kind = Goal::Kind::kPoints;
-    g.read("points_at_least", ex.goal.points, core::non_negative());
-  }
-  return ex;
-}
-
-std::string describe_goal(const Exercise& ex) {
-  switch (ex.goal.kind) {
-    case Goal::Kind::kReach:
-      return fmt::format("end FINAL with the robot within {:.2f} m of the target (x, y)",
-                         ex.goal.within_m);
-    case Goal::Kind::kFind:
-      return fmt::format(
-          "end FINAL with self.fsm.result = \"X Y\" within {:.2f} m of a {} puck's centre",
-          ex.goal.within_m, ex.goal.colour);
-    case Goal::Kind::kPoints:
-      return fmt::format(
-          ">= {} points in {:.0f} s (a puck of a counted colour released in the "
-          "safe area: +{}, a decoy: -{}); the skill must not fail",
-          ex.goal.points, ex.scenario.duration.seconds(),
-          ex.scenario.game.hackathon->points_per_puck, ex.scenario.game.hackathon->decoy_penalty);
-  }
-  return "";
-}
-
-// --- Finding exercises ----------------------------------------------------------------------
-
-std::string exercises_root(const std::string& option) {
-  if (!option.empty()) return option;
-  const char* env = std::getenv("LLSF_EXERCISES_DIR");
-  if (env != nullptr && *env != '\0') return env;
-  return core::data_dir() + "/exercises";
-}
-
-std::vector<std::string> exercise_names(const std::string& root) {
-  std::vector<std::string> names;
-  std::error_code ec;
-  for (const auto& e : fs::directory_iterator(root, ec)) {
-    if (e.is_directory() && fs::exists(e.path() / "exercise.yaml")) {
-      names.push_back(e.path().filename().string());
-    }
-  }
-  std::sort(names.begin(), names.end());
-  return names;
-}
-
-/// The directory of exercise `name`: a directory with an exercise.yaml, or an exercise of
-/// `root` by its name or a unique prefix of it ("01", "01-drive"); "" if none.
-std::string find_exercise(const std::string& name, const std::string& root, std::string& why) {
-  if (fs::is_directory(name) && fs::exists(fs::path(name) / "exercise.yaml")) return name;
-  std::vector<std::string> hits;
-  for (const std::string& n : exercise_names(root)) {
-    if (n == name) return (fs::path(root) / n).string();
-    if (n.rfind(name, 0) == 0) hits.push_back(n);
-  }
-  if (hits.size() == 1) return (fs::path(root) / hits.front()).string();
-  why = hits.empty() ? "unknown exercise '" + name + "'" : "'" + name + "' names several exercises";
-  return "";
-}
-
-/// A temporary skill directory holding the participant's file as `<skill>.lua`; removed on
-/// destruction.
-class SkillDir {
- public:
-  SkillDir(const std::string& source, const std::string& skill) {
-    static int counter = 0;
-    dir_ =
-        (fs::temp_directory_path() / fmt::format("llsfex-{}-{}", ::getpid(), ++counter)).string();
-    fs::create_directories(dir_);
-    path_ = (fs::path(dir_) / (skill + ".lua")).string();
-    fs::copy_file(source, path_, fs::copy_options::overwrite_existing);
-  }
-  ~SkillDir() {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-  SkillDir(const SkillDir&) = delete;
-  SkillDir& operator=(const SkillDir&) = delete;
-  const std::string& dir() const { return dir_; }
-  const std::string& path() const { return path_; }
-
- private:
-  std::string dir_;
-  std::string path_;
-};
-
 // --- Running --------------------------------------------------------------------------------
 
 struct ExerciseOptions {
   std::string exercise;
   std::string skill_file;
   std::optional<std::uint64_t> seed;
+  std::string seeds;  ///< --seeds LIST: a sweep
+  int jobs = 0;       ///< games at once in a sweep; 0: one per core
+  bool json = false;
   std::string root;
   LiveOptions live;  ///< --speed, --realtime, --serve, --port, --serve-exit
   std::string record;
@@ -278,38 +107,71 @@ int list_exercises(const std::string& root, std::ostream& out, std::ostream& err
   return kExitOk;
 }
 
-int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err) {
-  const std::string root = exercises_root(o.root);
-  if (o.list) return list_exercises(root, out, err);
-  if (o.exercise.empty()) {
-    err << "llsfsim exercise: name an exercise (llsfsim exercise --list shows them)\n";
-    return kExitBadInput;
-  }
-  std::string why;
-  const std::string dir = find_exercise(o.exercise, root, why);
-  if (dir.empty()) {
-    err << "llsfsim exercise: " << why << "; the exercises (" << root << "):\n";
-    for (const std::string& n : exercise_names(root)) err << "  " << n << "\n";
-    return kExitBadInput;
-  }
-  Exercise ex;
-  try {
-    ex = load_exercise(dir);
-  } catch (const core::ConfigError& e) {
-    err << "llsfsim exercise: " << e.what() << "\n";
-    return kExitBadInput;
-  }
-  if (o.skill_file.empty()) {
-    err << "llsfsim exercise: give your skill file with --skill FILE (start from a copy of "
-        << (fs::path(dir) / "skill.lua").string() << ")\n";
-    return kExitBadInput;
-  }
-  if (!fs::is_regular_file(o.skill_file)) {
-    err << "llsfsim exercise: no such skill file: " << o.skill_file << "\n";
-    return kExitBadInput;
-  }
-  const std::uint64_t seed = o.seed.value_or(ex.scenario.seeds.front());
+/// What one seed's game came to: the verdict's parts (the `runs` of `--json`).
+enum class Outcome : std::uint8_t { kPass, kFail, kNotRun };
 
+const char* outcome_name(Outcome r) {
+  switch (r) {
+    case Outcome::kPass:
+      return "PASS";
+    case Outcome::kFail:
+      return "FAIL";
+    case Outcome::kNotRun:
+      return "NOT RUN";
+  }
+  return "";
+}
+
+struct SeedRun {
+  std::uint64_t seed = 0;
+  Outcome result = Outcome::kNotRun;
+  std::optional<double> value;  ///< reach/find: the distance in m; points: the points
+  std::string score;            ///< the `score` line's text
+  std::string why;              ///< the `why` line's text (when not passed)
+  std::string error;            ///< the skill's error as `file:line: message`
+  std::string hint;             ///< the hint for `error`
+  double game_time_s = 0.0;
+  int code = kExitBadInput;  ///< the exit code of this seed alone
+};
+
+/// Prints the engine error `message` in the participant's terms (print_friendly) on `out` and
+/// keeps its `error` and `hint` lines in `run`.
+void friendly(const std::string& message, const std::string& tmp, const std::string& user,
+              const std::string& skill, std::ostream& out, SeedRun& run) {
+  std::ostringstream block;
+  print_friendly(message, tmp, user, skill, block);
+  out << block.str();
+  // "error    ...", "in       ...", "hint     ...": a line without such a prefix continues the
+  // field before it.
+  std::string* field = nullptr;
+  std::istringstream lines(block.str());
+  for (std::string line; std::getline(lines, line);) {
+    const std::string tag = line.substr(0, 9);
+    if (tag == "error    ") {
+      field = &run.error;
+    } else if (tag == "hint     ") {
+      field = &run.hint;
+    } else if (tag == "in       ") {
+      field = nullptr;
+      continue;
+    } else if (field != nullptr) {
+      *field += "\n" + line;
+      continue;
+    } else {
+      continue;
+    }
+    if (!field->empty()) *field += "\n";
+    *field += line.substr(9);
+  }
+}
+
+/// Plays exercise `ex` with the participant's file `o.skill_file` on `seed`, printing what
+/// happens on `out` (progress, log lines, the verdict) as a single run does, and returns the
+/// outcome. Thread-safe for distinct `out`/`err` streams when `o` asks for no server.
+SeedRun play_seed(const Exercise& ex, const ExerciseOptions& o, std::uint64_t seed,
+                  std::ostream& out, std::ostream& err) {
+  SeedRun run;
+  run.seed = seed;
   // The game and one skill engine per robot, each with the library plus the participant's file.
   sim::GameConfig config = ex.scenario.game;
   config.seed = seed;
@@ -326,9 +188,10 @@ int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err)
   for (const lua::SkillInfo& s : brains.front()->engine().skills()) {
     if (s.name != ex.skill || s.load_error.empty()) continue;
     out << "exercise " << ex.name << ": " << user << " does not load\n";
-    print_friendly(s.load_error, skill_dir.path(), user, ex.skill, out);
+    friendly(s.load_error, skill_dir.path(), user, ex.skill, out, run);
     out << "result   NOT RUN (fix the file and run again)\n";
-    return kExitBadInput;
+    run.code = kExitBadInput;
+    return run;
   }
 
   // What the skill is called with.
@@ -351,7 +214,9 @@ int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err)
     server = start_live_server(o.live, so, feed, out);
   } catch (const core::UserError& e) {  // cannot listen
     err << "llsfsim exercise: " << e.what() << "\n";
-    return kExitBadInput;
+    run.error = e.what();
+    run.code = kExitBadInput;
+    return run;
   }
   std::unique_ptr<study::Recorder> recorder;
   if (o.live.serve || !o.record.empty()) {
@@ -363,7 +228,9 @@ int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err)
           10.0, sink);
     } catch (const core::UserError& e) {  // the recording cannot be written
       err << "llsfsim exercise: " << e.what() << "\n";
-      return kExitBadInput;
+      run.error = e.what();
+      run.code = kExitBadInput;
+      return run;
     }
   }
 
@@ -422,7 +289,9 @@ int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err)
   for (auto& b : brains) {
     if (const lua::ExecResult r = b->exec(call); !r) {
       err << "llsfsim exercise: " << r.error << "\n";
-      return kExitBadInput;
+      run.error = r.error;
+      run.code = kExitBadInput;
+      return run;
     }
   }
   int failed = -1;  // the robot whose skill failed
@@ -485,6 +354,7 @@ int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err)
       const double d = (robot_pose(0).position() - target).norm();
       score = fmt::format("{:.2f} m from the target ({:.2f}, {:.2f}), need <= {:.2f} m", d,
                           target.x(), target.y(), ex.goal.within_m);
+      run.value = d;
       passed = final && d <= ex.goal.within_m;
       if (final && !passed) why_not = "the skill ended FINAL too far from the target";
       break;
@@ -511,6 +381,7 @@ int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err)
         score = fmt::format("reported ({:.2f}, {:.2f}): {:.2f} m from {} puck {}, need <= {:.2f} m",
                             p->x(), p->y(), best, ex.goal.colour, best_id, ex.goal.within_m);
         passed = best <= ex.goal.within_m;
+        if (best_id >= 0) run.value = best;
         if (!passed) {
           why_not = "the position is not a " + ex.goal.colour +
                     " puck's: turn the sighting (robot frame) into field coordinates with "
@@ -524,6 +395,7 @@ int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err)
       score = fmt::format("{} points: {} of {} rescued, {} decoys, need >= {}", s.points, s.rescued,
                           s.rescuable, s.decoys, ex.goal.points);
       passed = failed < 0 && s.points >= ex.goal.points;
+      run.value = s.points;
       if (failed < 0 && !passed) {
         why_not = ended ? "the skill ended before the time was up (FINAL without repeat)"
                         : "not enough points when the time was up";
@@ -541,7 +413,7 @@ int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err)
   if (failed >= 0) {
     const lua::SkillEngine& e = brains[static_cast<std::size_t>(failed)]->engine();
     out << game.robot(failed).name() << "   FAILED  " << e.skill_string() << "\n";
-    print_friendly(e.error(), skill_dir.path(), user, ex.skill, out);
+    friendly(e.error(), skill_dir.path(), user, ex.skill, out, run);
   } else if (!ended && ex.goal.kind != Goal::Kind::kPoints) {
     why_not = fmt::format("the skill was still running after {:.0f} s", end.seconds());
   }
@@ -549,7 +421,270 @@ int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err)
   if (!why_not.empty()) out << "why      " << why_not << "\n";
   out << "result   " << (passed ? "PASS" : "FAIL") << "\n";
   serve_until_stopped(o.live, server, out);
-  return passed ? kExitOk : kExitFailed;
+  run.result = passed ? Outcome::kPass : Outcome::kFail;
+  run.score = score;
+  run.why = why_not;
+  run.game_time_s = game.time().seconds();
+  run.code = passed ? kExitOk : kExitFailed;
+  return run;
+}
+
+// --- Sweeps: several seeds, a table or JSON ---------------------------------------------------
+
+/// Plays `seeds` of `ex` on up to `o.jobs` threads (default: one per core). Games are
+/// independent (each its own driver and skill engines; the wall clock never enters a game), so
+/// each seed's run is the same whatever the number of threads. Returns the runs in the order of
+/// `seeds`. Progress on `err` as seeds end: a bar when `err` is std::cerr on a terminal, else one
+/// line per seed; nothing with -q or --json.
+std::vector<SeedRun> play_seeds(const Exercise& ex, const ExerciseOptions& o,
+                                const std::vector<std::uint64_t>& seeds, std::ostream& err) {
+  ExerciseOptions quiet = o;  // the games' own output is not shown, only the table
+  quiet.quiet = true;
+  std::vector<SeedRun> runs(seeds.size());
+  const int total = static_cast<int>(seeds.size());
+  const int hardware = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const int threads = std::min(o.jobs > 0 ? o.jobs : hardware, total);
+
+  // Workers take seeds in order and queue the index of each run that ended; this thread prints
+  // the progress, so that nothing interleaves.
+  std::mutex mutex;
+  std::condition_variable ended;
+  std::deque<std::size_t> done;
+  std::exception_ptr error;
+  std::atomic<std::size_t> next{0};
+  std::atomic<bool> stop{false};
+  int running = threads;
+  {
+    std::vector<std::jthread> pool;  // joined on every way out
+    for (int w = 0; w < threads; ++w) {
+      pool.emplace_back([&] {
+        for (;;) {
+          const std::size_t i = next++;
+          if (stop || i >= seeds.size()) break;
+          try {
+            std::ostringstream game_out;
+            std::ostringstream game_err;
+            runs[i] = play_seed(ex, quiet, seeds[i], game_out, game_err);
+            const std::lock_guard lock(mutex);
+            done.push_back(i);
+          } catch (...) {
+            const std::lock_guard lock(mutex);
+            if (!error) error = std::current_exception();
+            stop = true;
+          }
+          ended.notify_one();
+        }
+        {
+          const std::lock_guard lock(mutex);
+          --running;
+        }
+        ended.notify_one();
+      });
+    }
+
+    const bool bar =
+        &err == &std::cerr && isatty(STDERR_FILENO) != 0 && !o.quiet && !o.json && total > 1;
+    const bool lines = !bar && !o.quiet && !o.json;
+    int played = 0;
+    int not_passed = 0;
+    if (bar) err << fmt::format("\r{} 0/{} seeds", progress_bar(0, total), total) << std::flush;
+    for (;;) {
+      std::unique_lock lock(mutex);
+      ended.wait(lock, [&] { return !done.empty() || running == 0; });
+      if (done.empty()) break;
+      const SeedRun& r = runs[done.front()];
+      done.pop_front();
+      lock.unlock();
+      ++played;
+      if (r.result != Outcome::kPass) ++not_passed;
+      if (bar) {
+        err << fmt::format("\r{} {}/{} seeds, {} not passed", progress_bar(played, total), played,
+                           total, not_passed)
+            << (played == total ? "\n" : "") << std::flush;
+      } else if (lines) {
+        err << fmt::format("[{}/{}] seed {}: {}, {:.2f} s of game time\n", played, total, r.seed,
+                           outcome_name(r.result), r.game_time_s)
+            << std::flush;
+      }
+    }
+  }
+  if (error) std::rethrow_exception(error);
+  return runs;
+}
+
+/// The sweep's verdict: NOT RUN if the file did not load, PASS if every seed passed, else FAIL.
+Outcome sweep_verdict(const std::vector<SeedRun>& runs) {
+  Outcome v = Outcome::kPass;
+  for (const SeedRun& r : runs) {
+    if (r.result == Outcome::kNotRun) return Outcome::kNotRun;
+    if (r.result == Outcome::kFail) v = Outcome::kFail;
+  }
+  return v;
+}
+
+int verdict_code(Outcome v) {
+  switch (v) {
+    case Outcome::kPass:
+      return kExitOk;
+    case Outcome::kFail:
+      return kExitFailed;
+    case Outcome::kNotRun:
+      return kExitBadInput;
+  }
+  return kExitInternalError;
+}
+
+std::string first_line(const std::string& text) { return text.substr(0, text.find('\n')); }
+
+/// The sweep as a table in seed order, then the verdict: "PASS 20/20", or FAIL with the
+/// counts and the seeds not passed, or NOT RUN with the load error.
+void print_sweep(const Exercise& ex, const ExerciseOptions& o, const std::vector<SeedRun>& runs,
+                 std::ostream& out) {
+  out << fmt::format("exercise {}: {}  ({} seed(s))\n", ex.name, ex.title, runs.size());
+  out << fmt::format("goal     {}\n", describe_goal(ex));
+  out << fmt::format("skill    {} as {}\n", o.skill_file, ex.skill);
+  const Outcome verdict = sweep_verdict(runs);
+  if (verdict == Outcome::kNotRun) {  // the same file on every seed: say it once
+    const SeedRun& r = runs.front();
+    out << o.skill_file << " does not load\n";
+    if (!r.error.empty()) out << "error    " << r.error << "\n";
+    if (!r.hint.empty()) out << "hint     " << r.hint << "\n";
+    out << "verdict  NOT RUN (fix the file and run again)\n";
+    return;
+  }
+  std::size_t seed_w = 4;
+  std::size_t score_w = 5;
+  for (const SeedRun& r : runs) {
+    seed_w = std::max(seed_w, std::to_string(r.seed).size());
+    score_w = std::max(score_w, r.score.size());
+  }
+  auto row = [&](const std::string& seed, const std::string& result, const std::string& score,
+                 const std::string& time, const std::string& note) {
+    std::string line = fmt::format("{:>{}}  {:<7}  {:<{}}  {:>10}  {}", seed, seed_w, result, score,
+                                   score_w, time, note);
+    while (!line.empty() && line.back() == ' ') line.pop_back();
+    out << line << "\n";
+  };
+  row("seed", "result", "score", "game time", "error / why");
+  std::vector<std::uint64_t> failed;
+  for (const SeedRun& r : runs) {
+    row(std::to_string(r.seed), outcome_name(r.result), r.score,
+        fmt::format("{:.2f} s", r.game_time_s), first_line(r.error.empty() ? r.why : r.error));
+    if (r.result != Outcome::kPass) failed.push_back(r.seed);
+  }
+  const std::size_t passed = runs.size() - failed.size();
+  if (failed.empty()) {
+    out << fmt::format("verdict  PASS {}/{}\n", passed, runs.size());
+    return;
+  }
+  out << fmt::format("verdict  FAIL {}/{} passed, {} failed: seed(s) {}\n", passed, runs.size(),
+                     failed.size(), fmt::join(failed, ", "));
+  out << fmt::format("details  llsfsim exercise {} --skill {} --seed {}\n", ex.name, o.skill_file,
+                     failed.front());
+}
+
+/// The sweep as one JSON object (the `--json` contract of docs/exercises.md).
+void print_json(const Exercise& ex, const ExerciseOptions& o, const std::vector<SeedRun>& runs,
+                std::ostream& out) {
+  using Json = nlohmann::ordered_json;
+  const bool points = ex.goal.kind == Goal::Kind::kPoints;
+  Json j;
+  j["exercise"] = ex.name;
+  j["skill"] = ex.skill;
+  j["skill_file"] = o.skill_file;
+  j["goal"] = goal_name(ex.goal.kind);
+  j["better"] = points ? "higher" : "lower";
+  Json list = Json::array();
+  int passed = 0;
+  for (const SeedRun& r : runs) {
+    Json e;
+    e["seed"] = r.seed;
+    e["result"] = outcome_name(r.result);
+    if (!r.value) {
+      e["value"] = nullptr;
+    } else if (points) {
+      e["value"] = std::lround(*r.value);
+    } else {
+      e["value"] = *r.value;
+    }
+    e["score"] = r.score;
+    e["why"] = r.why;
+    e["error"] = r.error;
+    e["hint"] = r.hint;
+    e["game_time_s"] = std::round(r.game_time_s * 1000.0) / 1000.0;
+    list.push_back(std::move(e));
+    if (r.result == Outcome::kPass) ++passed;
+  }
+  j["runs"] = std::move(list);
+  j["passed"] = passed;
+  j["total"] = runs.size();
+  j["verdict"] = outcome_name(sweep_verdict(runs));
+  // A participant's file may hold any bytes; invalid UTF-8 in a message becomes U+FFFD.
+  out << j.dump(-1, ' ', false, Json::error_handler_t::replace) << "\n";
+}
+
+int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err) {
+  const std::string root = exercises_root(o.root);
+  if (o.list) return list_exercises(root, out, err);
+  if (o.exercise.empty()) {
+    err << "llsfsim exercise: name an exercise (llsfsim exercise --list shows them)\n";
+    return kExitBadInput;
+  }
+  std::string why;
+  const std::string dir = find_exercise(o.exercise, root, why);
+  if (dir.empty()) {
+    err << "llsfsim exercise: " << why << "; the exercises (" << root << "):\n";
+    for (const std::string& n : exercise_names(root)) err << "  " << n << "\n";
+    return kExitBadInput;
+  }
+  Exercise ex;
+  try {
+    ex = load_exercise(dir);
+  } catch (const core::ConfigError& e) {
+    err << "llsfsim exercise: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  if (o.skill_file.empty()) {
+    err << "llsfsim exercise: give your skill file with --skill FILE (start from a copy of "
+        << (fs::path(dir) / "skill.lua").string() << ")\n";
+    return kExitBadInput;
+  }
+  if (!fs::is_regular_file(o.skill_file)) {
+    err << "llsfsim exercise: no such skill file: " << o.skill_file << "\n";
+    return kExitBadInput;
+  }
+  // Which seeds: --seeds LIST is a sweep; else --seed N or the exercise's first.
+  const bool sweep = !o.seeds.empty();
+  std::vector<std::uint64_t> seeds;
+  if (sweep) {
+    try {
+      seeds = study::parse_seed_list(o.seeds);
+    } catch (const core::ConfigError& e) {
+      err << "llsfsim exercise: " << e.what() << "\n";
+      return kExitBadInput;
+    }
+    if (o.live.serve || o.live.pace() > 0.0 || !o.record.empty()) {
+      err << "llsfsim exercise: --serve, --record, --realtime and --speed watch one game: give "
+             "--seed N instead of --seeds\n";
+      return kExitBadInput;
+    }
+  } else {
+    seeds.push_back(o.seed.value_or(ex.scenario.seeds.front()));
+  }
+  if (o.json && o.live.serve) {
+    err << "llsfsim exercise: --json prints only the JSON object; --serve does not go with it\n";
+    return kExitBadInput;
+  }
+
+  // One game as it is played, or a sweep's table, or JSON.
+  if (!sweep && !o.json) return play_seed(ex, o, seeds.front(), out, err).code;
+  const std::vector<SeedRun> runs = play_seeds(ex, o, seeds, err);
+  if (o.json) {
+    print_json(ex, o, runs, out);
+  } else {
+    print_sweep(ex, o, runs, out);
+  }
+  return verdict_code(sweep_verdict(runs));
 }
 
 }  // namespace
@@ -562,7 +697,17 @@ Action add_exercise_command(CLI::App& app) {
   app.add_option("--skill", o->skill_file,
                  "Your skill file (start from a copy of the exercise's skill.lua); it is loaded "
                  "as the exercise's skill, next to the skill library");
-  app.add_option("--seed", o->seed, "Seed to play (default: the exercise's first)");
+  auto* seed = app.add_option("--seed", o->seed, "Seed to play (default: the exercise's first)");
+  app.add_option("--seeds", o->seeds,
+                 "Play these seeds and print a table and the verdict over them (PASS only when "
+                 "every seed passes): a list of seeds and ranges, e.g. 1-20 or 3,5,9-12")
+      ->excludes(seed);
+  app.add_option("--jobs,-j", o->jobs,
+                 "Games played at once by --seeds (default: the number of cores)")
+      ->check(CLI::PositiveNumber);
+  app.add_flag("--json", o->json,
+               "Print only one JSON object on stdout: the exercise, each seed's result, value, "
+               "score, error and hint, and the verdict (docs/exercises.md)");
   app.add_option("--exercises", o->root,
                  "Where the exercises are (default: $LLSF_EXERCISES_DIR, else exercises/ of the "
                  "data directory)");
@@ -571,7 +716,8 @@ Action add_exercise_command(CLI::App& app) {
                    "(best with --realtime or --speed)");
   app.add_option("--record", o->record,
                  "Also write the game's recording to FILE (gzip JSON lines)");
-  app.add_flag("-q,--quiet", o->quiet, "Only the score, errors and the verdict");
+  app.add_flag("-q,--quiet", o->quiet,
+               "Only the score, errors and the verdict (--seeds: no progress lines)");
   app.add_flag("--list", o->list, "List the exercises with their goals and exit");
   app.footer(
       "Examples:\n"
@@ -579,7 +725,11 @@ Action add_exercise_command(CLI::App& app) {
       "  cp exercises/01-drive-to-point/skill.lua my_drive.lua   # edit the TODOs\n"
       "  llsfsim exercise 01 --skill my_drive.lua\n"
       "  llsfsim exercise 04 --skill my_rescue.lua --seed 7 --realtime --serve\n"
-      "Exit code: 0 PASS, 1 not passed (also a skill that fails, crashes or loops forever), 2 bad "
+      "  llsfsim exercise 01 --skill my_drive.lua --seeds 1-20        # all seeds, a table\n"
+      "  llsfsim exercise 01 --skill my_drive.lua --seeds 1-20 --json # the same as JSON\n"
+      "With --seeds, progress goes to stderr: a bar on a terminal, else one line per seed.\n"
+      "Exit code: 0 PASS (with --seeds: every seed), 1 not passed (also a skill that fails, "
+      "crashes or loops forever), 2 bad "
       "input (unknown exercise, missing file, a skill file that does not load), 3 internal error "
       "(a bug: please report it). docs/exercises.md");
   const std::shared_ptr<SubmitOptions> submit = add_submit_options(app);

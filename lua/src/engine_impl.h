@@ -82,6 +82,8 @@ struct SkillEngine::Impl {
   /// The engine that owns `L` (stored in the state's extra space).
   static Impl& of(lua_State* L) { return **static_cast<Impl**>(lua_getextraspace(L)); }
 
+  /// The path messages show for the skill file `path` (config.display_paths, else `path`).
+  const std::string& display_path(const std::string& path) const;
   /// Scans the skill directories (sorted by name; later directories win).
   std::vector<SkillFile> scan() const;
   /// Closes the interpreter and builds a new one with every skill loaded.

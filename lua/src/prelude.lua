@@ -12,6 +12,7 @@ local fmt, concat = string.format, table.concat
 local now_ns, exhausted, log = native.now_ns, native.exhausted, native.log
 
 local S_INACTIVE, S_FINAL, S_RUNNING, S_FAILED = 0, 1, 2, 3
+local fsms = setmetatable({}, {__mode = "k"})  -- every SkillHSM made by SkillHSM:new
 local kMaxStatesPerStep = 32
 
 -- What every skill module and skill string sees (read through __index; never written).
@@ -47,6 +48,27 @@ end
 -- (native.charge raises at the skill's line); string.rep, find, match, gmatch and gsub are the
 -- engine's bounded versions (patterns.cpp). Costs: docs/skills.md, "Sandbox".
 local charge = native.charge
+local prelude_src = debug_getinfo(1, "S").short_src
+-- Errors of the library functions the prelude wraps name the skill's line, not the wrapper's
+-- (Lua would say "llsf/prelude.lua:NN: bad argument ..."): `f` runs protected, and an error
+-- without a position is raised again at the nearest caller outside the prelude. Errors that
+-- carry one (a comparator's, a budget's) and non-string errors pass unchanged.
+local function raise_at_skill(e)
+  if type(e) ~= "string" or e:find("^[^\n]-:%d+: ") then error(e, 0) end
+  for level = 2, 50 do
+    local info = debug_getinfo(level, "Sl")
+    if not info then break end
+    if info.short_src ~= prelude_src and info.currentline > 0 then
+      error(info.short_src .. ":" .. info.currentline .. ": " .. e, 0)
+    end
+  end
+  error(e, 0)
+end
+local function relayed(ok, ...)
+  if ok then return ... end
+  raise_at_skill((...))
+end
+local function relay(f, ...) return relayed(raw_pcall(f, ...)) end
 local function span(i, j)  -- how many integers i..j (a float: no overflow; "10" counts too)
   i, j = tonumber(i), tonumber(j)
   if not i or not j or j < i then return 0 end
@@ -58,31 +80,31 @@ local tab = copy(table)
 tab.move = function(a1, f, e, t, a2)
   local n = span(f, e)
   charge(n, fmt("table.move of %.0f elements", n))
-  return raw_table.move(a1, f, e, t, a2)
+  return relay(raw_table.move, a1, f, e, t, a2)
 end
 tab.concat = function(t, sep, i, j)
   local n = span(i or 1, j or len_of(t))
   charge(n, fmt("table.concat of %.0f elements", n))
-  return raw_table.concat(t, sep, i, j)
+  return relay(raw_table.concat, t, sep, i, j)
 end
 tab.unpack = function(t, i, j)
   local n = span(i or 1, j or len_of(t))
   charge(n, fmt("table.unpack of %.0f elements", n))
-  return raw_table.unpack(t, i, j)
+  return relay(raw_table.unpack, t, i, j)
 end
 tab.insert = function(t, ...)
   if select("#", ...) >= 2 then
     local n = span((...), len_of(t))
     charge(n, fmt("table.insert moving %.0f elements", n))
   end
-  return raw_table.insert(t, ...)
+  return relay(raw_table.insert, t, ...)
 end
 tab.remove = function(t, ...)
   if select("#", ...) >= 1 then
     local n = span((...), len_of(t))
     charge(n, fmt("table.remove moving %.0f elements", n))
   end
-  return raw_table.remove(t, ...)
+  return relay(raw_table.remove, t, ...)
 end
 tab.sort = function(t, comp)
   local n = len_of(t)
@@ -90,21 +112,21 @@ tab.sort = function(t, comp)
     local cost = n * math.ceil(math.log(n, 2))
     charge(cost, fmt("table.sort of %d elements", n))
   end
-  return raw_table.sort(t, comp)
+  return relay(raw_table.sort, t, comp)
 end
 local str = copy(string)
 str.dump = nil
 for k, f in pairs(native.patterns) do str[k] = f end
 str.byte = function(s, i, j)
   if j ~= nil and type(s) == "string" then charge(#s, fmt("string.byte of %d bytes", #s)) end
-  return raw_string.byte(s, i, j)
+  return relay(raw_string.byte, s, i, j)
 end
 local u8 = copy(utf8)
 for _, k in ipairs{"len", "codepoint", "offset"} do
   local f = raw_utf8[k]
   u8[k] = function(s, ...)
     if type(s) == "string" then charge(#s // 8, fmt("utf8.%s of %d bytes", k, #s)) end
-    return f(s, ...)
+    return relay(f, s, ...)
   end
 end
 base.math = readonly(copy(math), "math")
@@ -113,7 +135,7 @@ base.string = readonly(str, "string")
 base.utf8 = readonly(u8, "utf8")
 base.rawset = function(t, k, v)
   if frozen[t] then error(fmt("%s is read-only (shared by every skill)", frozen[t]), 2) end
-  return rawset(t, k, v)
+  return relay(rawset, t, k, v)
 end
 -- Method calls on strings ("x"):format(...) use the sandbox's string; the metatable is hidden.
 local string_mt = getmetatable("")
@@ -125,7 +147,7 @@ base.setmetatable = function(t, mt)
   if type(mt) == "table" and rawget(mt, "__gc") ~= nil then
     error("__gc metamethods are not allowed in skills", 2)
   end
-  return setmetatable(t, mt)
+  return relay(setmetatable, t, mt)
 end
 base.S_INACTIVE, base.S_FINAL, base.S_RUNNING, base.S_FAILED =
   S_INACTIVE, S_FINAL, S_RUNNING, S_FAILED
@@ -156,7 +178,11 @@ base.print_debug = function(...) log(0, args_text(...)) end
 base.print_info = base.print
 base.print_warn = function(...) log(2, args_text(...)) end
 base.print_error = function(...) log(3, args_text(...)) end
-base.printf = function(f, ...) log(1, fmt(f, ...)) end
+base.printf = function(f, ...)
+  local ok, text = raw_pcall(fmt, f, ...)
+  if not ok then raise_at_skill("printf: " .. tostring(text)) end
+  log(1, text)
+end
 
 -- Skill handles (one per skill file, created before any file runs) and the module loading state.
 local handles = {}       -- name -> handle
@@ -179,14 +205,102 @@ local function error_text(e)
   return "(error object is a " .. type(e) .. " value)"
 end
 
+-- "Did you mean" ------------------------------------------------------------------------------
+-- Edit distance (insert, delete, substitute, swap two neighbours), ignoring case.
+local function distance(a, b)
+  a, b = a:lower(), b:lower()
+  local la, lb = #a, #b
+  if math.abs(la - lb) > 3 then return 99 end
+  local d = {}
+  for i = 0, la do d[i] = {[0] = i} end
+  for j = 0, lb do d[0][j] = j end
+  for i = 1, la do
+    for j = 1, lb do
+      local cost = a:byte(i) == b:byte(j) and 0 or 1
+      local v = math.min(d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + cost)
+      if i > 1 and j > 1 and a:byte(i) == b:byte(j - 1) and a:byte(i - 1) == b:byte(j) then
+        v = math.min(v, d[i - 2][j - 2] + 1)
+      end
+      d[i][j] = v
+    end
+  end
+  return d[la][lb]
+end
+
+-- The candidate (a list of names) nearest to `name` if it is near enough to be a typo: at most
+-- 1 edit for names up to 4 characters, 2 up to 8, else 3; ties go to the first in name order.
+local function nearest(name, candidates)
+  if type(name) ~= "string" or #name > 64 then return nil end
+  local limit = #name <= 4 and 1 or #name <= 8 and 2 or 3
+  local best, best_d = nil, limit + 1
+  local names = {}
+  for _, c in ipairs(candidates) do
+    if type(c) == "string" and c ~= name and #c <= 64 then names[#names + 1] = c end
+  end
+  table.sort(names)
+  for _, c in ipairs(names) do
+    do
+      local d = distance(name, c)
+      if d < best_d then best, best_d = c, d end
+    end
+  end
+  return best
+end
+
+local function did_you_mean(name, candidates)
+  local n = nearest(name, candidates)
+  return n and fmt(" (did you mean '%s'?)", n) or ""
+end
+
+local function state_names(fsm)
+  local names = {}
+  for i, st in ipairs(fsm.state_list) do names[i] = st.name end
+  return names
+end
+
+-- "unknown state 'DRVE' (did you mean 'DRIVE'? states: START, DRIVE, FINAL, FAILED)"
+local function unknown_state(fsm, name)
+  local names = state_names(fsm)
+  local near = nearest(name, state_names(fsm))
+  return fmt("unknown state '%s' (%sstates: %s)", tostring(name),
+             near and fmt("did you mean '%s'? ", near) or "", concat(names, ", "))
+end
+
+-- Globals skills do not have, with what to use instead.
+local unavailable = {
+  os = "no files, processes or wall clock in skills: for time use clock.now() (game seconds) " ..
+       "or a transition's timeout=SECS",
+  io = "no files or terminal in skills: print(...) / printf(fmt, ...) write to the log",
+  require = "skills load no modules: name another skill in depends_skills = {\"skill\"} and " ..
+            "call it from a SkillJumpState (skills={{skill}})",
+  package = "skills load no modules: name another skill in depends_skills = {\"skill\"}",
+  dofile = "skills load no other files: name another skill in depends_skills = {\"skill\"}",
+  loadfile = "skills load no other files: name another skill in depends_skills = {\"skill\"}",
+  load = "skills compile no code at run time: write a function instead (a cond may be a " ..
+         "function or a string the engine compiles at load time)",
+  loadstring = "skills compile no code at run time (and loadstring is Lua 5.1's load): write " ..
+               "a function instead",
+  debug = "the debug library is not available in skills: print(...) what you want to see",
+  coroutine = "coroutines are not available in skills: wait in a state with a transition " ..
+              "(cond=..., timeout=...)",
+  collectgarbage = "the engine manages memory: drop references (t = nil) instead",
+  _G = "skills have no _G: their own globals are in _M",
+  unpack = "unpack is Lua 5.1's: use table.unpack",
+  setfenv = "setfenv is Lua 5.1's and not available",
+  getfenv = "getfenv is Lua 5.1's and not available",
+}
+
 local function where(level)
   local info = debug_getinfo(level + 1, "Sl")
   if not info then return "?" end
   return info.short_src .. ":" .. tostring(info.currentline)
 end
 
-local function undeclared(h, k)
+local function undeclared(h, k, env)
   if type(k) == "string" then
+    if unavailable[k] then
+      return fmt("'%s' is not available in skills: %s", k, unavailable[k])
+    end
     if handles[k] then
       return fmt("skill '%s' is used but not declared in depends_skills", k)
     end
@@ -196,7 +310,25 @@ local function undeclared(h, k)
                  "(e.g. {v=\"%s\", type=\"%s\"})", k, k, itype)
     end
   end
-  return fmt("undeclared global '%s'", tostring(k))
+  if k == "fsm" then
+    return "undeclared global 'fsm': create the state machine first: " ..
+           "fsm = SkillHSM:new{name=name, start=\"STATE\"}"
+  end
+  -- A state used before fsm:define_states{...} made it (states are globals it exports).
+  local fsm = env and rawget(env, "fsm")
+  if type(k) == "string" and fsms[fsm] and #fsm.state_list <= 2 and k:find("^[%u_][%u%d_]*$") then
+    return fmt("undeclared global '%s': no state is defined yet: call fsm:define_states{...} " ..
+               "before using a state (function %s:init() ...)", k, k)
+  end
+  local candidates = {}
+  if env then
+    for name in next, env do candidates[#candidates + 1] = name end
+  end
+  for name in pairs(base) do candidates[#candidates + 1] = name end
+  for name in pairs(h.bindings) do candidates[#candidates + 1] = name end
+  for name in pairs(conventional_vars) do candidates[#candidates + 1] = name end
+  for name in pairs(handles) do candidates[#candidates + 1] = name end
+  return fmt("undeclared global '%s'%s", tostring(k), did_you_mean(k, candidates))
 end
 
 -- The environment of one skill module: declarations are checked as they are assigned, reads of
@@ -207,12 +339,13 @@ local function module_env(h)
   mt.__index = function(t, k)
     local v = base[k]
     if v == nil then v = h.bindings[k] end
-    if v == nil then error(undeclared(h, k), 2) end
+    if v == nil then error(undeclared(h, k, t), 2) end
     rawset(t, k, v)
     return v
   end
   mt.__newindex = function(t, k, v)
     if k == "name" then
+      h.name_where = where(2)
       if v ~= h.name then
         error(fmt("skill name '%s' does not match its file name '%s.lua'", tostring(v), h.name), 2)
       end
@@ -255,14 +388,57 @@ local SkillJumpState = readonly({kind = "skill"}, "SkillJumpState")
 base.JumpState, base.SkillJumpState = JumpState, SkillJumpState
 
 local SkillHSM = {}
-SkillHSM.__index = SkillHSM
 SkillHSM.__metatable = false  -- getmetatable(fsm) must not hand out the shared class
-local fsms = setmetatable({}, {__mode = "k"})  -- every SkillHSM made by SkillHSM:new
+-- fsm.result lives under a private key so that every assignment is checked: the exercises and
+-- the string's result() read it as text, and a table would show its address.
+local result_key = {}
+SkillHSM.__index = function(fsm, k)
+  if k == "result" then return rawget(fsm, result_key) end
+  return SkillHSM[k]
+end
+SkillHSM.__newindex = function(fsm, k, v)
+  if k == "result" then
+    if v ~= nil and type(v) ~= "string" and type(v) ~= "number" then
+      error(fmt("fsm.result must be a string (e.g. \"1.20 3.40\") or a number, not a %s: " ..
+                "self.fsm.result = string.format(\"%%.2f %%.2f\", x, y)", type(v)), 2)
+    end
+    rawset(fsm, result_key, v)
+  else
+    rawset(fsm, k, v)
+  end
+end
 base.SkillHSM = readonly(SkillHSM, "SkillHSM")
+
+-- self.args of a state that runs no sub-skill of that name is never read: a warning at the line
+-- that sets it (once per state and key).
+local function args_watch(st)
+  local warned = {}
+  return {__newindex = function(t, k, v)
+    rawset(t, k, v)
+    if warned[k] then return end
+    local names = {}
+    for i, sk in ipairs(st.skills or {}) do
+      if sk.handle.name == k then return end
+      names[i] = sk.handle.name
+    end
+    warned[k] = true
+    local what = fmt("%s: state '%s' sets self.args[\"%s\"]", st.fsm.name, st.name, tostring(k))
+    if #names == 0 then
+      log(2, fmt("%s: %s, but it runs no sub-skill (it is a JumpState), so the arguments are " ..
+                 "ignored: make it a SkillJumpState (skills={{%s}}, final_to=...) or drop " ..
+                 "self.args", where(2), what, type(k) == "string" and k or "skill"))
+    else
+      log(2, fmt("%s: %s, but it runs only %s, so the arguments are ignored%s: " ..
+                 "self.args[\"%s\"] = {...}", where(2), what, concat(names, ", "),
+                 did_you_mean(k, names), names[1]))
+    end
+  end}
+end
 
 local function new_state(fsm, name, kind)
   local st = {name = name, fsm = fsm, kind = kind, transitions = {}, preconds = {}, args = {},
               entered_ns = 0, visit = 0}
+  st.args_mt = args_watch(st)
   fsm.states[name] = st
   fsm.state_list[#fsm.state_list + 1] = st
   return st
@@ -270,7 +446,8 @@ end
 
 function SkillHSM:new(o)
   if type(o) ~= "table" or type(o.start) ~= "string" then
-    error("SkillHSM:new{name=..., start=\"STATE\"}: 'start' must name a state", 2)
+    error("SkillHSM:new{...} needs start=\"STATE\", the state the skill begins in: " ..
+          "fsm = SkillHSM:new{name=name, start=\"STATE\"}", 2)
   end
   if not loading then error("SkillHSM:new can only be called while a skill file loads", 2) end
   local fsm = setmetatable({name = o.name or loading.name, start = o.start, debug = o.debug,
@@ -329,7 +506,8 @@ function SkillHSM:define_states(spec)
   for _, st in ipairs(self.state_list) do
     for _, f in ipairs{"final_to", "fail_to"} do
       if st[f] and not self.states[st[f]] then
-        error(fmt("state '%s': %s names unknown state '%s'", st.name, f, st[f]), 2)
+        error(fmt("state '%s': %s=\"%s\" names an %s", st.name, f, st[f],
+                  unknown_state(self, st[f])), 2)
       end
     end
   end
@@ -338,8 +516,11 @@ function SkillHSM:define_states(spec)
     local st, t = p[1], p[2]
     local secs, to = t, "FAILED"
     if type(t) == "table" then secs, to = t[1], t[2] or "FAILED" end
-    if type(secs) ~= "number" or not self.states[to] then
+    if type(secs) ~= "number" then
       error(fmt("state '%s': timeout must be secs or {secs, \"STATE\"}", st.name), 2)
+    end
+    if not self.states[to] then
+      error(fmt("state '%s': timeout goes to an %s", st.name, unknown_state(self, to)), 2)
     end
     self:add_transitions{{st.name, to, timeout = secs,
                           error = type(t) == "table" and t.error or nil}}
@@ -364,10 +545,21 @@ function SkillHSM:add_transitions(spec)
     end
     local from, to = t[1], t[2]
     if to == nil then from, to = nil, t[1] end
-    if from and not self.states[from] then
-      error(fmt("add_transitions: unknown state '%s'", from), 2)
+    if #self.state_list <= 2 and not (self.states[to] and (not from or self.states[from])) then
+      error("add_transitions: no state is defined yet: call fsm:define_states{...} first", 2)
     end
-    if not self.states[to] then error(fmt("add_transitions: unknown state '%s'", to), 2) end
+    if from and not self.states[from] then
+      error(fmt("add_transitions: {\"%s\", \"%s\"} starts in an %s", from, tostring(to),
+                unknown_state(self, from)), 2)
+    end
+    if type(to) ~= "string" then
+      error(fmt("add_transitions: entry %d needs the state to go to: {\"FROM\", \"TO\", ...}", i),
+            2)
+    end
+    if not self.states[to] then
+      error(fmt("add_transitions: {%s\"%s\"} goes to an %s", from and fmt("\"%s\", ", from) or "",
+                to, unknown_state(self, to)), 2)
+    end
     local tr = {from = from, to = self.states[to], desc = t.desc, error = t.error, where = loc}
     if t.cond ~= nil then tr.cond = compile_cond(self, t.cond, "cond", loc, 3) end
     if t.precond ~= nil then tr.precond = compile_cond(self, t.precond, "precond", loc, 3) end
@@ -448,7 +640,7 @@ local function enter(fsm, st, now)
     if not jumped then break end
   end
   st.entered_ns = now
-  st.args = {}
+  st.args = setmetatable({}, st.args_mt)
   st.error = nil
   fsm.current = st
   fsm.running = st
@@ -474,10 +666,37 @@ end
 
 -- One FSM step: loop hook, sub-skills and transitions of the current state; a state entered in
 -- this step runs in the same step unless it already ran in it.
+local kSpinNs, kSpinTransitions = 2 * 1000000000, 20
+
+-- A state machine that switches states in every step for kSpinNs of game time (at least
+-- kSpinTransitions switches) while no sub-skill runs and no timeout fires never waits for
+-- anything: e.g. two states bouncing with cond=true. One warning per call of the skill.
+local function watch_spin(fsm, now, path, trs, progress)
+  if #trs == 0 or progress then fsm.spin = nil; return end
+  local sp = fsm.spin
+  if not sp then
+    sp = {since = now, n = 0}
+    fsm.spin = sp
+  end
+  sp.n = sp.n + #trs
+  if sp.warned or sp.n < kSpinTransitions or now - sp.since < kSpinNs then return end
+  sp.warned = true
+  local tr = trs[1]
+  for _, t in ipairs(trs) do
+    if t.cond == true then tr = t; break end
+  end
+  log(2, fmt("%s: %s: states %s keep switching without waiting (%d switches in %.1f s of game " ..
+             "time, no sub-skill running, no timeout): the transition {\"%s\", \"%s\", %s} " ..
+             "fires at once; make the state wait for something (cond=\"...\", timeout=SECS)",
+             tr.where, fsm.name, concat(path, " -> "), sp.n, (now - sp.since) / 1e9,
+             tr.from or "*", tr.to.name, tr.cond == true and "cond=true" or tr.label))
+end
+
 local function fsm_step(fsm)
   local now = now_ns()
   fsm.step_id = fsm.step_id + 1
   local st = fsm.current or enter(fsm, fsm.states[fsm.start], now)
+  local path, trs, progress = {st.name}, {}, false
   for _ = 1, kMaxStatesPerStep do
     if st.kind == "final" or st.kind == "failed" or st.visit == fsm.step_id then break end
     st.visit = fsm.step_id
@@ -485,7 +704,10 @@ local function fsm_step(fsm)
     if st.loop then st:loop() end
     local to, tr, err = nil, nil, nil
     if fsm.error == nil then
-      if st.skills then to, err = run_subskills(fsm, st) end
+      if st.skills then
+        progress = true
+        to, err = run_subskills(fsm, st)
+      end
       if not to then
         for _, t in ipairs(st.transitions) do
           if check(t, st, fsm, now) then to, tr = t.to, t; break end
@@ -500,9 +722,15 @@ local function fsm_step(fsm)
       to = fsm.failed  -- the skill set fsm.error: failure
     end
     if not to then break end
+    if tr then
+      trs[#trs + 1] = tr
+      if tr.timeout_ns then progress = true end
+    end
     leave(fsm, st, to, tr, err)
     st = enter(fsm, to, now)
+    path[#path + 1] = st.name
   end
+  watch_spin(fsm, now, path, trs, progress)
   if st.kind == "final" then return S_FINAL end
   if st.kind == "failed" then
     fsm.error = fsm.error or "FAILED"
@@ -546,6 +774,7 @@ reset_skill = function(h)
   end
   if h.fsm then
     h.fsm.current, h.fsm.error, h.fsm.result, h.fsm.vars = nil, nil, nil, {}
+    h.fsm.spin = nil
     for _, st in ipairs(h.fsm.state_list) do st.visit = 0 end
   end
   h.active, h.status, h.error, h.vars = false, S_INACTIVE, nil, nil
@@ -657,20 +886,32 @@ function E.finish_module(name)
   local h = handles[name]
   loading = nil
   local env = h.env
-  local function fail(msg) error(h.path .. ": " .. msg, 0) end
-  if rawget(env, "name") == nil then fail("the skill declares no 'name'") end
+  -- What is missing has no line of its own: the message names the line of `name = ...` (where
+  -- the declarations go), else line 1.
+  local at = h.name_where or (h.path .. ":1")
+  local function fail(msg) error(at .. ": " .. msg, 0) end
+  if rawget(env, "name") == nil then
+    fail(fmt("the skill declares no 'name': add name = \"%s\" at the top of the file", h.name))
+  end
   if type(rawget(env, "documentation")) ~= "string" then
-    fail("the skill declares no 'documentation' string")
+    fail("the skill declares no 'documentation' string: add documentation = [==[what the " ..
+         "skill does]==] next to name = ...")
   end
   local fsm = rawget(env, "fsm")
   if fsm ~= nil then
-    if not fsms[fsm] then fail("'fsm' must be a SkillHSM") end
+    if not fsms[fsm] then fail("'fsm' must be a SkillHSM: fsm = SkillHSM:new{name=name, start=\"STATE\"}") end
+    if #fsm.state_list <= 2 and not fsm.states[fsm.start] then
+      error(fmt("%s: the state machine has no states: fsm:define_states{...} is missing " ..
+                "(start state '%s' is not defined)", fsm.where, fsm.start), 0)
+    end
     if not fsm.states[fsm.start] then
-      error(fmt("%s: start state '%s' is not defined", fsm.where, fsm.start), 0)
+      error(fmt("%s: start=\"%s\" names an %s", fsm.where, fsm.start,
+                unknown_state(fsm, fsm.start)), 0)
     end
     h.fsm = fsm
   elseif type(rawget(env, "execute")) ~= "function" then
-    fail("the skill has neither an 'fsm' nor an execute() function")
+    fail("the skill has no state machine: add fsm = SkillHSM:new{name=name, start=\"STATE\"} " ..
+         "and its fsm:define_states{...} (or an execute() function)")
   end
   h.documentation = env.documentation
 end
@@ -728,7 +969,11 @@ function E.run_cycle(chunk)
   local status, errors, results = S_FINAL, nil, nil
   for _, h in ipairs(called) do
     local r = h.fsm and h.fsm.result
-    if r ~= nil and h.status ~= S_RUNNING then
+    if r ~= nil and type(r) ~= "string" and type(r) ~= "number" then  -- only by rawset
+      h.status = S_FAILED
+      h.error = fmt("fsm.result must be a string (e.g. \"1.20 3.40\") or a number, not a %s",
+                    type(r))
+    elseif r ~= nil and h.status ~= S_RUNNING then
       results = results or {}
       results[#results + 1] = tostring(r)
     end

@@ -265,6 +265,15 @@ bool is_identifier(const std::string& s) {
   });
 }
 
+std::string replace_all(std::string text, const std::string& from, const std::string& to) {
+  if (from.empty() || from == to) return text;
+  for (std::size_t at = text.find(from); at != std::string::npos;
+       at = text.find(from, at + to.size())) {
+    text.replace(at, from.size(), to);
+  }
+  return text;
+}
+
 std::string pop_message(lua_State* L) {
   const char* msg = lua_tostring(L, -1);
   std::string out = msg != nullptr ? msg : "(error object is not a string)";
@@ -284,6 +293,17 @@ void SkillEngine::Impl::close() {
   L = nullptr;
   engine_ref = chunk_ref = LUA_NOREF;
   heap.used = 0;
+}
+
+const std::string& SkillEngine::Impl::display_path(const std::string& path) const {
+  const auto it = config.display_paths.find(path);
+  if (it != config.display_paths.end()) return it->second;
+  // The same file written another way ("dir//s.lua", "dir/./s.lua").
+  const fs::path normal = fs::path(path).lexically_normal();
+  for (const auto& [real, shown] : config.display_paths) {
+    if (fs::path(real).lexically_normal() == normal) return shown;
+  }
+  return path;
 }
 
 void SkillEngine::Impl::arm_budget() {
@@ -447,18 +467,19 @@ void SkillEngine::Impl::build() {
   for (const SkillFile& f : files) {
     std::string load_error;
     std::string read_error;
+    const std::string& shown = display_path(f.path);
     const std::string text = read_file(f.path, read_error);
     if (!read_error.empty()) {
-      load_error = read_error;
+      load_error = replace_all(read_error, f.path, shown);
     } else if (!is_identifier(f.name)) {
-      load_error = f.path + ": a skill's file name must be a Lua identifier";
+      load_error = shown + ": a skill's file name must be a Lua identifier";
     } else {
       lua_pushstring(L, f.name.c_str());
-      lua_pushstring(L, f.path.c_str());
+      lua_pushstring(L, shown.c_str());
       if (call_entry("begin_module", 2, 1) != LUA_OK) {
         load_error = pop_message(L);
       } else {
-        const std::string chunkname = "@" + f.path;
+        const std::string chunkname = "@" + shown;
         if (luaL_loadbufferx(L, text.data(), text.size(), chunkname.c_str(), "t") != LUA_OK) {
           load_error = explain(pop_message(L));
           lua_pop(L, 1);  // the module env

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -55,6 +56,11 @@ struct SkillEngineConfig {
   std::string profile = "ideal";
   /// Whether skills give up when the robot makes no progress (their stall checks and timeouts).
   bool stuck_detection = true;
+  /// A skill file's real path (as found in `skill_dirs`, e.g. "/tmp/llsfex-1-1/s.lua") -> the
+  /// path every message, warning and traceback of that file shows instead (e.g. the
+  /// participant's "my_skill.lua" of which the file is a copy). Files not listed show their real
+  /// path. Not a YAML key. Lua shortens a shown path over 60 characters from the left ("...").
+  std::map<std::string, std::string> display_paths;
 
   /// Throws core::ConfigError naming the bad field.
   void validate() const;
