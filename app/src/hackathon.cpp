@@ -429,7 +429,10 @@ std::optional<HttpAnswer> HackathonServer::route(const HttpRequest& req) {
     for (const BoardExercise& e : exercises_) {
       a.push_back({{"name", e.name}, {"title", e.title}, {"goal", e.goal}, {"better", e.better}});
     }
-    return json_answer(200, json{{"exercises", a}, {"seeds", seed_count_}});
+    return json_answer(200, json{{"exercises", a},
+                                 {"seeds", seed_count_},
+                                 {"max_skill_bytes", options_.max_skill_bytes},
+                                 {"max_per_minute", options_.max_per_minute}});
   }
   // GET /api/hackathon/board/{exercise}
   if (n == 4 && p[2] == "board") {
