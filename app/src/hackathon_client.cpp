@@ -113,24 +113,44 @@ int submit_skill(const SubmitOptions& o, const std::string& exercise, const std:
                   {"file_name", fs::path(skill_file).filename().string()},
                   {"skill", content}};
 
+  // One request with a 30 s limit on each step (asynchronous: tcp_stream's expiry applies only to
+  // asynchronous operations).
   http::response<http::string_body> res;
   try {
     asio::io_context ioc;
     tcp::resolver resolver(ioc);
     beast::tcp_stream stream(ioc);
-    stream.expires_after(std::chrono::seconds(30));
-    stream.connect(resolver.resolve(url->host, url->port));
     http::request<http::string_body> req{http::verb::post, url->base + "/api/hackathon/submit", 11};
     req.set(http::field::host, url->host);
     req.set(http::field::content_type, "application/json");
     req.set(http::field::user_agent, "llsfsim");
     req.body() = body.dump();
     req.prepare_payload();
-    http::write(stream, req);
     beast::flat_buffer buffer;
     http::response_parser<http::string_body> parser;
     parser.body_limit(1 << 20);
-    http::read(stream, buffer, parser);
+    beast::error_code failed;
+    const auto step_limit = std::chrono::seconds(30);
+    stream.expires_after(step_limit);
+    stream.async_connect(
+        resolver.resolve(url->host, url->port), [&](beast::error_code cec, const tcp::endpoint&) {
+          if (cec) {
+            failed = cec;
+            return;
+          }
+          stream.expires_after(step_limit);
+          http::async_write(stream, req, [&](beast::error_code wec, std::size_t) {
+            if (wec) {
+              failed = wec;
+              return;
+            }
+            stream.expires_after(step_limit);
+            http::async_read(stream, buffer, parser,
+                             [&](beast::error_code rec, std::size_t) { failed = rec; });
+          });
+        });
+    ioc.run();
+    if (failed) throw beast::system_error(failed);
     res = parser.release();
     beast::error_code ignored;
     stream.socket().shutdown(tcp::socket::shutdown_both, ignored);

@@ -569,7 +569,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     }
     if (ec) {
       // A malformed request gets a 400 and the connection is closed; I/O errors just close.
-      if (ec == http::error::body_limit) {
+      if (ec == http::error::body_limit && server_.options.routes) {  // an upload too large
         send(http::request<http::string_body>{},
              error_reply(http::status::payload_too_large,
                          fmt::format("the request body is larger than {} bytes",

@@ -5,6 +5,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/tcp.hpp>
 #include <chrono>
 #include <csignal>
 #include <filesystem>
@@ -13,6 +15,7 @@
 #include <string>
 #include <thread>
 
+#include "cli_fixture.h"
 #include "hackathon.h"
 #include "llsf/study/stats_store.h"
 #include "llsf/study/submission_store.h"
@@ -347,4 +350,54 @@ TEST_CASE("sandbox: wall limit kills the whole group, CPU limit, output cap, exe
   r = llsf::app::run_sandboxed({tmp.file("no-such-program")}, tmp.path, l);
   CHECK_FALSE(r.started);
   CHECK(r.error.find("No such file") != std::string::npos);
+}
+
+TEST_CASE("exercise --submit: queued over HTTP; refusals, bad URLs and a closed port exit 2") {
+  const TempDir tmp;
+  HackathonOptions o = options(tmp);
+  o.max_skill_bytes = 2000;
+  HackathonServer server(o);
+  server.start();
+  const std::string url = server.url();
+  llsf::test::Run r = llsf::test::llsfsim(
+      {"exercise", "01", "--skill", kReference01, "--submit", url, "--team", "cli team"});
+  CHECK(r.code == 0);
+  CHECK(llsf::test::has(r.out, "for 01-drive-to-point as team 'cli team': submission 1, queued"));
+  CHECK(llsf::test::has(r.out, "#01-drive-to-point"));
+  CHECK(wait_done(server.store(), 1).passed == 2);
+
+  r = llsf::test::llsfsim({"exercise", "01", "--skill", kReference01, "--submit", url});
+  CHECK(r.code == 2);
+  CHECK(llsf::test::has(r.err, "--team NAME"));
+  r = llsf::test::llsfsim(
+      {"exercise", "7", "--skill", kReference01, "--submit", url, "--team", "t"});
+  CHECK(r.code == 2);
+  CHECK(llsf::test::has(r.err, "refused the submission (HTTP 400): unknown exercise '7'"));
+  const std::string big = tmp.file("big.lua");
+  std::ofstream(big) << std::string(3000, '-');
+  r = llsf::test::llsfsim({"exercise", "01", "--skill", big, "--submit", url, "--team", "t"});
+  CHECK(r.code == 2);
+  CHECK(llsf::test::has(r.err, "(HTTP 413): the skill file is 3000 bytes; at most 2000 bytes"));
+  const std::string latin1 = tmp.file("latin1.lua");
+  std::ofstream(latin1) << "-- gr\xfc\xdf\n";
+  r = llsf::test::llsfsim({"exercise", "01", "--skill", latin1, "--submit", url, "--team", "t"});
+  CHECK(r.code == 2);
+  CHECK(llsf::test::has(r.err, "is not UTF-8 text"));
+  r = llsf::test::llsfsim(
+      {"exercise", "01", "--skill", kReference01, "--submit", "https://x/", "--team", "t"});
+  CHECK(r.code == 2);
+  CHECK(llsf::test::has(r.err, "is not an http://HOST:PORT/ address"));
+  server.stop();
+  // A closed port: a port the kernel gave a socket that is closed again.
+  int port = 0;
+  {
+    boost::asio::io_context ioc;
+    boost::asio::ip::tcp::acceptor a(
+        ioc, boost::asio::ip::tcp::endpoint(boost::asio::ip::make_address("127.0.0.1"), 0));
+    port = a.local_endpoint().port();
+  }
+  r = llsf::test::llsfsim({"exercise", "01", "--skill", kReference01, "--submit",
+                           "http://127.0.0.1:" + std::to_string(port) + "/", "--team", "t"});
+  CHECK(r.code == 2);
+  CHECK(llsf::test::has(r.err, "cannot reach the leaderboard at http://127.0.0.1:"));
 }
