@@ -91,6 +91,11 @@ int run(std::span<const std::string> args, std::ostream& out, std::ostream& err)
         "serve", "Serve the browser viewer, stored batches and recordings over HTTP");
     commands.emplace_back(sub, add_serve_command(*sub));
   }
+  {
+    CLI::App* sub = app.add_subcommand(
+        "hackathon", "`hackathon serve`: the leaderboard where teams submit exercise skills");
+    commands.emplace_back(sub, add_hackathon_command(*sub));
+  }
   std::vector<std::string> argv_rest(args.begin() + (args.empty() ? 0 : 1), args.end());
   std::reverse(argv_rest.begin(), argv_rest.end());  // CLI11 parses a reversed vector
   try {

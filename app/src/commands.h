@@ -58,5 +58,7 @@ Action add_new_command(CLI::App& app);
 Action add_field_map_command(CLI::App& app);
 /// `llsfsim serve`: the browser viewer's HTTP/WebSocket server (server.h) until SIGINT/SIGTERM.
 Action add_serve_command(CLI::App& app);
+/// `llsfsim hackathon serve`: the hackathon leaderboard (hackathon.h) until SIGINT/SIGTERM.
+Action add_hackathon_command(CLI::App& app);
 
 }  // namespace llsf::app

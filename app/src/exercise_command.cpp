@@ -33,6 +33,7 @@
 #include "commands.h"
 #include "exercise.h"
 #include "exercise_hints.h"
+#include "hackathon_client.h"
 #include "live.h"
 #include "llsf/app/cli.h"
 #include "llsf/core/config.h"
@@ -748,7 +749,11 @@ Action add_exercise_command(CLI::App& app) {
       "crashes or loops forever), 2 bad "
       "input (unknown exercise, missing file, a skill file that does not load), 3 internal error "
       "(a bug: please report it). docs/exercises.md");
-  return [o](std::ostream& out, std::ostream& err) { return run_exercise(*o, out, err); };
+  const std::shared_ptr<SubmitOptions> submit = add_submit_options(app);
+  return [o, submit](std::ostream& out, std::ostream& err) {
+    if (!submit->url.empty()) return submit_skill(*submit, o->exercise, o->skill_file, out, err);
+    return run_exercise(*o, out, err);
+  };
 }
 
 }  // namespace llsf::app

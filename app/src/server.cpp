@@ -569,6 +569,14 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     }
     if (ec) {
       // A malformed request gets a 400 and the connection is closed; I/O errors just close.
+      if (ec == http::error::body_limit && server_.options.routes) {  // an upload too large
+        send(http::request<http::string_body>{},
+             error_reply(http::status::payload_too_large,
+                         fmt::format("the request body is larger than {} bytes",
+                                     server_.options.max_body_bytes)),
+             /*close=*/true);
+        return;
+      }
       if (ec.category() == http::make_error_code(http::error::bad_target).category()) {
         send(http::request<http::string_body>{},
              error_reply(http::status::bad_request, "bad request: " + ec.message()),
@@ -583,6 +591,29 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     if (!path) {
       send(req, error_reply(http::status::bad_request, error));
       return;
+    }
+    if (server_.options.routes) {
+      HttpRequest r;
+      r.method = std::string(req.method_string());
+      r.path = *path;
+      const std::string_view target(req.target().data(), req.target().size());
+      if (const std::size_t q = target.find('?'); q != std::string_view::npos) {
+        r.query = std::string(target.substr(q + 1));
+      }
+      r.content_type = std::string(req[http::field::content_type]);
+      r.body = std::move(req.body());
+      r.peer = peer_of(stream_.socket());
+      std::optional<HttpAnswer> answer;
+      try {
+        answer = server_.options.routes(r);
+      } catch (const std::exception& e) {
+        answer = HttpAnswer{500, "application/json", dump(json{{"error", e.what()}}) + "\n"};
+      }
+      if (answer) {
+        send(req, {static_cast<http::status>(answer->status), std::move(answer->content_type),
+                   std::move(answer->body), true});
+        return;
+      }
     }
     if (req.method() != http::verb::get) {
       send(req, error_reply(http::status::method_not_allowed, "only GET is served"));
@@ -616,7 +647,9 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     res->set(http::field::server, "llsfsim");
     res->set(http::field::content_type, reply.content_type);
     res->set(http::field::cache_control, reply.api ? "no-store" : "no-cache");
-    if (reply.status == http::status::method_not_allowed) res->set(http::field::allow, "GET");
+    if (reply.status == http::status::method_not_allowed) {
+      res->set(http::field::allow, server_.options.routes ? "GET, POST" : "GET");
+    }
     res->keep_alive(!close && req.keep_alive());
     res->body() = std::move(reply.body);
     res->prepare_payload();

@@ -9,6 +9,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -51,6 +52,23 @@ class LiveFeed {
   std::function<void()> listener_;
 };
 
+/// A request handed to ServerOptions::routes.
+struct HttpRequest {
+  std::string method;             ///< "GET", "POST", ...
+  std::vector<std::string> path;  ///< the target's decoded path segments ("/" gives none)
+  std::string query;              ///< the target after '?', as sent
+  std::string content_type;
+  std::string body;
+  std::string peer;  ///< "address:port"
+};
+
+/// An answer of ServerOptions::routes.
+struct HttpAnswer {
+  int status = 200;
+  std::string content_type = "application/json";
+  std::string body;
+};
+
 /// Where the server listens and what it serves.
 struct ServerOptions {
   std::string bind = "127.0.0.1";  ///< IPv4 or IPv6 address
@@ -76,6 +94,10 @@ struct ServerOptions {
   /// Where refusals, drops and accept errors are logged (one line, no newline; called on the
   /// server's thread). Empty: "llsfsim serve: <line>" on standard error.
   std::function<void(const std::string&)> log;
+  /// Routes tried before the built-in ones (empty: none), called on the server's thread (keep
+  /// them short): an answer, or nullopt for the built-in routes. Only with routes does the
+  /// server accept other methods than GET (which the routes must answer).
+  std::function<std::optional<HttpAnswer>(const HttpRequest&)> routes;
 };
 
 struct ServerImpl;
