@@ -402,23 +402,18 @@ base.JumpState, base.SkillJumpState = JumpState, SkillJumpState
 
 local SkillHSM = {}
 SkillHSM.__metatable = false  -- getmetatable(fsm) must not hand out the shared class
--- fsm.result lives under a private key so that every assignment is checked: the exercises and
--- the string's result() read it as text, and a table would show its address.
-local result_key = {}
-SkillHSM.__index = function(fsm, k)
-  if k == "result" then return rawget(fsm, result_key) end
-  return SkillHSM[k]
-end
+-- fsm.result: the exercises and the string's result() read it as text, and a table would show
+-- its address. Its first assignment (the key is absent until then, and again after each reset)
+-- is checked here, at the skill's line; a later one that puts another type in its place is
+-- caught when the skill ends (E.run_cycle). __index stays a table: a function there would run on
+-- every miss (fsm.error, fsm.debug, ... are read in every step).
+SkillHSM.__index = SkillHSM
 SkillHSM.__newindex = function(fsm, k, v)
-  if k == "result" then
-    if v ~= nil and type(v) ~= "string" and type(v) ~= "number" then
-      error(fmt("fsm.result must be a string (e.g. \"1.20 3.40\") or a number, not a %s: " ..
-                "self.fsm.result = string.format(\"%%.2f %%.2f\", x, y)", type(v)), 2)
-    end
-    rawset(fsm, result_key, v)
-  else
-    rawset(fsm, k, v)
+  if k == "result" and v ~= nil and type(v) ~= "string" and type(v) ~= "number" then
+    error(fmt("fsm.result must be a string (e.g. \"1.20 3.40\") or a number, not a %s: " ..
+              "self.fsm.result = string.format(\"%%.2f %%.2f\", x, y)", type(v)), 2)
   end
+  rawset(fsm, k, v)
 end
 base.SkillHSM = readonly(SkillHSM, "SkillHSM")
 
@@ -685,7 +680,10 @@ local kSpinNs, kSpinTransitions = 2 * 1000000000, 20
 -- kSpinTransitions switches) while no sub-skill runs and no timeout fires never waits for
 -- anything: e.g. two states bouncing with cond=true. One warning per call of the skill.
 local function watch_spin(fsm, now, path, trs, progress)
-  if #trs == 0 or progress then fsm.spin = nil; return end
+  if not trs or #trs == 0 or progress then
+    if fsm.spin ~= nil then fsm.spin = nil end
+    return
+  end
   local sp = fsm.spin
   if not sp then
     sp = {since = now, n = 0}
@@ -709,7 +707,9 @@ local function fsm_step(fsm)
   local now = now_ns()
   fsm.step_id = fsm.step_id + 1
   local st = fsm.current or enter(fsm, fsm.states[fsm.start], now)
-  local path, trs, progress = {st.name}, {}, false
+  -- The states passed and the transitions taken (for watch_spin), made on the first
+  -- transition: most steps stay in their state and allocate nothing.
+  local first, path, trs, progress = st.name, nil, nil, false
   for _ = 1, kMaxStatesPerStep do
     if st.kind == "final" or st.kind == "failed" or st.visit == fsm.step_id then break end
     st.visit = fsm.step_id
@@ -735,6 +735,7 @@ local function fsm_step(fsm)
       to = fsm.failed  -- the skill set fsm.error: failure
     end
     if not to then break end
+    if not path then path, trs = {first}, {} end
     if tr then
       trs[#trs + 1] = tr
       if tr.timeout_ns then progress = true end
@@ -743,7 +744,7 @@ local function fsm_step(fsm)
     st = enter(fsm, to, now)
     path[#path + 1] = st.name
   end
-  watch_spin(fsm, now, path, trs, progress)
+  if trs or fsm.spin ~= nil then watch_spin(fsm, now, path, trs, progress) end
   if st.kind == "final" then return S_FINAL end
   if st.kind == "failed" then
     fsm.error = fsm.error or "FAILED"
