@@ -9,6 +9,7 @@
 #include <memory>
 #include <string>
 
+#include "sqlite_util.h"
 #include "stats_backend.h"
 
 namespace llsf::study {
@@ -114,12 +115,8 @@ CREATE TABLE schema_migrations (
 
 // ---- RAII wrappers of the SQLite C API -------------------------------------------------------
 
-struct DbCloser {
-  void operator()(sqlite3* db) const { sqlite3_close_v2(db); }
-};
-struct StmtFinalizer {
-  void operator()(sqlite3_stmt* s) const { sqlite3_finalize(s); }
-};
+using sqlite::DbCloser;
+using sqlite::StmtFinalizer;
 using DbHandle = std::unique_ptr<sqlite3, DbCloser>;
 
 // A prepared statement. start() resets it and clears its bindings; a Statement that returned
@@ -192,38 +189,8 @@ class Statement {
   int next_ = 1;
 };
 
-void exec(sqlite3* db, const std::string& path, const char* sql) {
-  char* msg = nullptr;
-  if (sqlite3_exec(db, sql, nullptr, nullptr, &msg) != SQLITE_OK) {
-    std::string text = msg ? msg : sqlite3_errmsg(db);
-    sqlite3_free(msg);
-    throw StatsError(path + ": " + text);
-  }
-}
-
-// BEGIN IMMEDIATE .. COMMIT; rolled back unless committed (also when an exception unwinds).
-// IMMEDIATE takes the write lock at once: writers of several processes take turns, whole
-// transactions at a time.
-class Transaction {
- public:
-  Transaction(sqlite3* db, const std::string& path) : db_(db), path_(path) {
-    exec(db_, path_, "BEGIN IMMEDIATE");
-  }
-  ~Transaction() {
-    if (!done_) sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
-  }
-  Transaction(const Transaction&) = delete;
-  Transaction& operator=(const Transaction&) = delete;
-  void commit() {
-    exec(db_, path_, "COMMIT");
-    done_ = true;
-  }
-
- private:
-  sqlite3* db_;
-  const std::string& path_;
-  bool done_ = false;
-};
+using sqlite::exec;
+using sqlite::Transaction;
 
 // The store's directory is created if missing (a failure shows when SQLite opens the file).
 const std::string& with_parent_dir(const std::string& path) {

@@ -17,6 +17,7 @@
 #include <stdexcept>
 
 #include "llsf/study/stats_store.h"
+#include "sqlite_util.h"
 
 namespace llsf::study {
 
@@ -81,12 +82,8 @@ std::string iso_now() {
                        .count());
 }
 
-struct DbCloser {
-  void operator()(sqlite3* db) const { sqlite3_close_v2(db); }
-};
-struct StmtFinalizer {
-  void operator()(sqlite3_stmt* s) const { sqlite3_finalize(s); }
-};
+using sqlite::DbCloser;
+using sqlite::StmtFinalizer;
 
 // A statement prepared for one call (the store's calls are few and small).
 class Stmt {
@@ -143,36 +140,8 @@ class Stmt {
   int next_ = 1;
 };
 
-void exec(sqlite3* db, const std::string& path, const char* sql) {
-  char* msg = nullptr;
-  if (sqlite3_exec(db, sql, nullptr, nullptr, &msg) != SQLITE_OK) {
-    std::string text = msg ? msg : sqlite3_errmsg(db);
-    sqlite3_free(msg);
-    throw StatsError(path + ": " + text);
-  }
-}
-
-// BEGIN IMMEDIATE .. COMMIT; rolled back unless committed.
-class Transaction {
- public:
-  Transaction(sqlite3* db, const std::string& path) : db_(db), path_(path) {
-    exec(db_, path_, "BEGIN IMMEDIATE");
-  }
-  ~Transaction() {
-    if (!done_) sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
-  }
-  Transaction(const Transaction&) = delete;
-  Transaction& operator=(const Transaction&) = delete;
-  void commit() {
-    exec(db_, path_, "COMMIT");
-    done_ = true;
-  }
-
- private:
-  sqlite3* db_;
-  const std::string& path_;
-  bool done_ = false;
-};
+using sqlite::exec;
+using sqlite::Transaction;
 
 // The columns every query reads, in this order (read_row()).
 constexpr const char* kColumns =
