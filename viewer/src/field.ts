@@ -164,18 +164,22 @@ export function drawField(
   // The floor, a 1 m grid and the walls.
   ctx.fillStyle = "#fafaf7";
   ctx.fillRect(X(0), Y(fh), fw * s, fh * s);
-  ctx.strokeStyle = "#e6e6e0";
+  // The metre lines in `colour`.
+  const metreLines = (colour: string) => {
+    ctx.strokeStyle = colour;
+    ctx.beginPath();
+    for (let x = 1; x < fw; x++) {
+      ctx.moveTo(X(x), Y(0));
+      ctx.lineTo(X(x), Y(fh));
+    }
+    for (let y = 1; y < fh; y++) {
+      ctx.moveTo(X(0), Y(y));
+      ctx.lineTo(X(fw), Y(y));
+    }
+    ctx.stroke();
+  };
   ctx.lineWidth = 1;
-  ctx.beginPath();
-  for (let x = 1; x < fw; x++) {
-    ctx.moveTo(X(x), Y(0));
-    ctx.lineTo(X(x), Y(fh));
-  }
-  for (let y = 1; y < fh; y++) {
-    ctx.moveTo(X(0), Y(y));
-    ctx.lineTo(X(fw), Y(y));
-  }
-  ctx.stroke();
+  metreLines("#e6e6e0");
   if (options.grid) {
     // The finer grid (0.25 m) and the metres along the bottom and left edges.
     ctx.strokeStyle = "#eeeee8";
@@ -191,17 +195,7 @@ export function drawField(
       ctx.lineTo(X(fw), Y(k / 4));
     }
     ctx.stroke();
-    ctx.strokeStyle = "#cfcfc6";
-    ctx.beginPath();
-    for (let x = 1; x < fw; x++) {
-      ctx.moveTo(X(x), Y(0));
-      ctx.lineTo(X(x), Y(fh));
-    }
-    for (let y = 1; y < fh; y++) {
-      ctx.moveTo(X(0), Y(y));
-      ctx.lineTo(X(fw), Y(y));
-    }
-    ctx.stroke();
+    metreLines("#cfcfc6");
     ctx.fillStyle = "#777";
     ctx.font = "10px sans-serif";
     ctx.textAlign = "center";
