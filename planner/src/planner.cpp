@@ -188,6 +188,15 @@ std::uint_fast32_t seed32(core::RandomStream& s) {
   return static_cast<std::uint_fast32_t>(s.next_u64() >> 32);
 }
 
+/// OMPL keeps process-wide state (SelfConfig's map from SpaceInformation to its settings, whose
+/// entries hold the SpaceInformation's control block) and guards it inside the library, where
+/// ThreadSanitizer cannot see the ordering. Planners of games on several threads are therefore
+/// made and destroyed one at a time under this mutex (once per robot and game: no cost).
+std::mutex& ompl_mutex() {
+  static std::mutex m;
+  return m;
+}
+
 }  // namespace
 
 struct Planner::Impl {
@@ -196,6 +205,17 @@ struct Planner::Impl {
   StaticMap map;
   std::vector<Place> places;
   QueryContext query;
+  /// Unlocks ompl_mutex() (locked by ~Impl) once the OMPL members below, declared after it and so
+  /// destroyed before it, are gone.
+  struct OmplUnlock {
+    bool locked = false;
+    OmplUnlock() = default;
+    OmplUnlock(const OmplUnlock&) = delete;
+    OmplUnlock& operator=(const OmplUnlock&) = delete;
+    ~OmplUnlock() {
+      if (locked) ompl_mutex().unlock();
+    }
+  } ompl_unlock;
   ob::SpaceInformationPtr si;
   std::shared_ptr<SeededRRTConnect> rrt;
   std::shared_ptr<SeededSimplifier> simplifier;
@@ -209,6 +229,7 @@ struct Planner::Impl {
     std::call_once(quiet, [] { ompl::msg::setLogLevel(ompl::msg::LOG_WARN); });
     query.map = &map;
 
+    const std::lock_guard<std::mutex> lock(ompl_mutex());
     auto space = std::make_shared<ob::RealVectorStateSpace>(2);
     ob::RealVectorBounds bounds(2);
     bounds.setLow(0, 0.0);
@@ -228,6 +249,12 @@ struct Planner::Impl {
     rrt->setNearestNeighbors<ompl::NearestNeighborsLinear>();
     simplifier = std::make_shared<SeededSimplifier>(si);
   }
+  ~Impl() {
+    ompl_mutex().lock();  // held until ompl_unlock goes, after the OMPL members
+    ompl_unlock.locked = true;
+  }
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
 
   /// The free point nearest to `p` within `max_m` (1 cm rings, 32 directions), if any.
   /// A start free of static obstacles (inside a disc only) moves out along a statically free
