@@ -51,9 +51,16 @@
       (modify ?m (explored TRUE))))
 )
 
+; The machine types are dealt once, at the start of the game, and never change in it
+; (docs/refbox.md); the refbox repeats them in every MachineInfo (every 2 s in production). Once
+; every machine has its type, later MachineInfos are consumed without a look (as ExplorationInfo
+; is once the signals are known): reading 16 entries that change nothing was the dearest rule.
+(deftemplate machine-types-known)
+
 (defrule refbox-machine-info
   (declare (salience ?*PRIORITY-REFBOX*))
   ?pf <- (protobuf-msg (type "llsf_msgs.MachineInfo") (ptr ?p))
+  (not (machine-types-known))
   =>
   (retract ?pf)
   (foreach ?e (pb-field-list ?p "machines")
@@ -64,6 +71,16 @@
         (bind ?m (fact-by-slot machine name ?name))
         (if (and ?m (neq (fact-slot-value ?m mtype) ?type)) then
           (modify ?m (mtype ?type))))))
+  (if (not (any-factp ((?m machine)) (eq ?m:mtype UNKNOWN))) then
+    (assert (machine-types-known)))
+)
+
+(defrule refbox-machine-info-known
+  (declare (salience ?*PRIORITY-REFBOX*))
+  ?pf <- (protobuf-msg (type "llsf_msgs.MachineInfo"))
+  (machine-types-known)
+  =>
+  (retract ?pf)
 )
 
 (defrule refbox-order-info
