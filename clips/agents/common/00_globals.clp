@@ -5,6 +5,7 @@
 
 (defglobal
   ; salience bands (as in the Carologistics agents)
+  ?*PRIORITY-WM-MARK* = 1000   ; bookkeeping that only sets a global (40_worldmodel.clp)
   ?*PRIORITY-REFBOX* = 300
   ?*PRIORITY-WM* = 200
   ?*PRIORITY-TASK* = 100

@@ -10,6 +10,19 @@
 
 (deffunction puck-kind (?p) (return ?p))   ; our symbols are the PuckKind names
 
+; The message is built again only when a machine fact changed since the last broadcast (a new
+; machine fact, i.e. an assert or modify, marks it); otherwise the last one goes out again with
+; the next seq. Both give the same bytes: a machine's entry lists what its fact holds, in the
+; order of the facts.
+(defglobal ?*WM-MSG* = FALSE ?*WM-CHANGED* = TRUE)
+
+(defrule wm-machine-changed
+  (declare (salience ?*PRIORITY-WM-MARK*))
+  (machine)
+  =>
+  (bind ?*WM-CHANGED* TRUE)
+)
+
 (defrule wm-broadcast
   (declare (salience ?*PRIORITY-WM*))
   (game (phase EXPLORATION|PRODUCTION))
@@ -17,20 +30,22 @@
   (time $?now&:(timeout ?now ?last 1.0))
   =>
   (modify ?t (time ?now) (seq (+ ?seq 1)))
-  (bind ?wm (pb-create "llsf_agent_msgs.Worldmodel"))
-  (pb-set-field ?wm "sender" ?*ROBOT-NAME*)   ; (a symbol or string fills a string field)
-  (pb-set-field ?wm "seq" (+ ?seq 1))
-  (do-for-all-facts ((?m machine)) (> ?m:updated-at 0.0)
-    (bind ?ms (pb-create "llsf_agent_msgs.MachineState"))
-    (pb-set-field ?ms "name" ?m:name)
-    (foreach ?l ?m:loaded-with (pb-add-list ?ms "loaded_with" ?l))
-    (pb-set-field ?ms "junk" ?m:consumed)
-    (pb-set-field ?ms "out_of_order_until" ?m:down-until)
-    (pb-set-field ?ms "updated_at" ?m:updated-at)
-    (pb-add-list ?wm "machines" ?ms)
-    (pb-destroy ?ms))
-  (pb-broadcast ?wm)
-  (pb-destroy ?wm)
+  (if ?*WM-CHANGED* then
+    (if ?*WM-MSG* then (pb-destroy ?*WM-MSG*))
+    (bind ?*WM-MSG* (pb-create "llsf_agent_msgs.Worldmodel"))
+    (pb-set-field ?*WM-MSG* "sender" ?*ROBOT-NAME*)   ; (a symbol or string fills a string field)
+    (do-for-all-facts ((?m machine)) (> ?m:updated-at 0.0)
+      (bind ?ms (pb-create "llsf_agent_msgs.MachineState"))
+      (pb-set-field ?ms "name" ?m:name)
+      (foreach ?l ?m:loaded-with (pb-add-list ?ms "loaded_with" ?l))
+      (pb-set-field ?ms "junk" ?m:consumed)
+      (pb-set-field ?ms "out_of_order_until" ?m:down-until)
+      (pb-set-field ?ms "updated_at" ?m:updated-at)
+      (pb-add-list ?*WM-MSG* "machines" ?ms)
+      (pb-destroy ?ms))
+    (bind ?*WM-CHANGED* FALSE))
+  (pb-set-field ?*WM-MSG* "seq" (+ ?seq 1))
+  (pb-broadcast ?*WM-MSG*)
 )
 
 (defrule wm-receive
