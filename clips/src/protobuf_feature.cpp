@@ -92,6 +92,7 @@ class ProtobufFeature final : public Feature {
       Entry* e = lookup(a, 0);
       return e == nullptr ? Value::boolean(false) : Value::string(e->message->ShortDebugString());
     });
+    env.define_function("pb-unchanged", "2**", [this](Args& a) { return unchanged(a); });
     env.define_function("pb-broadcast", "11a", [this](Args& a) {
       Entry* e = lookup(a, 0);
       if (e == nullptr) return Value{};
@@ -120,6 +121,7 @@ class ProtobufFeature final : public Feature {
   void after_reset(Environment& env) override {
     for (auto& h : facts_) env.release(h);
     facts_.clear();
+    last_.clear();  // the facts a skipped message would have made are gone too
   }
 
   void before_run(Environment& env) override {
@@ -246,6 +248,69 @@ class ProtobufFeature final : public Feature {
     const FieldDescriptor* f = d->FindFieldByName(std::string(name));
     if (f != nullptr) c = {d, name.data(), f};
     return f;
+  }
+
+  // (pb-unchanged ?m ?key [FIELD...]): TRUE when ?m, apart from the named fields, has the same
+  // type and content (the same serialised bytes) as the message last given with ?key; remembers
+  // ?m for ?key either way. For periodic status messages: a rule can skip one that repeats the
+  // last from the same sender.
+  Value unchanged(Args& a) {
+    Entry* e = lookup(a, 0);
+    if (e == nullptr) return Value::boolean(false);
+    const ArgView key = a.view(1);
+    std::string& k = key_scratch_;
+    switch (key.type) {
+      case Value::Type::kSymbol:
+      case Value::Type::kString:
+        k.assign(key.text);
+        break;
+      case Value::Type::kInteger:
+        k = std::to_string(key.integer);
+        break;
+      default:
+        a.env().error(a.function(), "the key (argument 2) must be a symbol, string or integer");
+        return Value::boolean(false);
+    }
+    const Message* m = e->message;
+    const Descriptor* d = m->GetDescriptor();
+    if (a.count() > 2) {
+      std::unique_ptr<Message>& copy = scratch_[d];
+      if (!copy) copy.reset(m->New());
+      copy->CopyFrom(*m);
+      for (int i = 2; i < a.count(); ++i) {
+        std::string_view name;
+        if (!a.text(i, name)) {
+          a.env().error(a.function(), "argument " + std::to_string(i + 1) +
+                                          " must be a field name (a string or symbol)");
+          return Value::boolean(false);
+        }
+        const FieldDescriptor* f = find_field(d, name);
+        if (f == nullptr) {
+          a.env().error(a.function(), m->GetTypeName() + " has no field " + std::string(name));
+          return Value::boolean(false);
+        }
+        copy->GetReflection()->ClearField(copy.get(), f);
+      }
+      m = copy.get();
+    }
+    bytes_scratch_.clear();
+    m->SerializePartialToString(&bytes_scratch_);
+    auto it = last_.find(k);
+    if (it == last_.end()) {
+      if (last_.size() >= kMaxUnchangedKeys) {
+        a.env().error(a.function(), "more than " + std::to_string(kMaxUnchangedKeys) +
+                                        " keys: use one per sender and message type");
+        return Value::boolean(false);
+      }
+      last_.emplace(k, Last{d, bytes_scratch_});
+      return Value::boolean(false);
+    }
+    const bool same = it->second.type == d && it->second.bytes == bytes_scratch_;
+    if (!same) {
+      it->second.type = d;
+      it->second.bytes.swap(bytes_scratch_);
+    }
+    return Value::boolean(same);
   }
 
   Value create(Args& a) {
@@ -478,6 +543,15 @@ class ProtobufFeature final : public Feature {
   static constexpr std::size_t kFieldCacheSize = 64;
   std::array<FieldCacheEntry, kFieldCacheSize> field_cache_{};
   int nested_types_ = 0;  // entries of by_name_ that are not registry types
+  // pb-unchanged: the last message per key, as serialised bytes.
+  struct Last {
+    const Descriptor* type = nullptr;
+    std::string bytes;
+  };
+  static constexpr std::size_t kMaxUnchangedKeys = 1024;
+  std::unordered_map<std::string, Last> last_;
+  std::unordered_map<const Descriptor*, std::unique_ptr<Message>> scratch_;
+  std::string key_scratch_, bytes_scratch_;
 };
 
 }  // namespace

@@ -159,3 +159,56 @@ TEST_CASE("an unset nested message reads as its defaults and cannot be written")
   CHECK(a.runtime_errors() == errors + 1);
   CHECK(llsf_agent_msgs::Incoming::default_instance().action().empty());
 }
+
+TEST_CASE("pb-unchanged tells a message that repeats the last one with the same key") {
+  const auto reg = agent_registry();
+  AgentFixture f({}, &reg);
+  f.step();
+  auto& a = f.agent();
+  f.load(
+      "(defglobal ?*a* = (pb-create \"llsf_agent_msgs.Worldmodel\")"
+      "           ?*b* = (pb-create \"llsf_agent_msgs.Worldmodel\")"
+      "           ?*l* = (pb-create \"llsf_agent_msgs.LockMessage\")"
+      "           ?*ms* = (pb-create \"llsf_agent_msgs.MachineState\"))");
+  a.eval("(pb-set-field ?*a* sender robot2)");
+  a.eval("(pb-set-field ?*a* seq 1)");
+  a.eval("(pb-set-field ?*b* sender robot2)");
+  a.eval("(pb-set-field ?*b* seq 2)");
+  const int errors = a.runtime_errors();
+  CHECK(a.eval("(pb-unchanged ?*a* robot2)").is_symbol("FALSE"));  // the first with this key
+  CHECK(a.eval("(pb-unchanged ?*a* robot2)").is_symbol("TRUE"));
+  CHECK(a.eval("(pb-unchanged ?*a* \"robot2\")").is_symbol("TRUE"));   // a string key: the same
+  CHECK(a.eval("(pb-unchanged ?*b* robot2)").is_symbol("FALSE"));      // seq differs
+  CHECK(a.eval("(pb-unchanged ?*a* robot2 seq)").is_symbol("FALSE"));  // (b was kept whole)
+  CHECK(a.eval("(pb-unchanged ?*b* robot2 seq)").is_symbol("TRUE"));   // but for seq: the same
+  CHECK(a.eval("(pb-unchanged ?*a* robot3 seq)").is_symbol("FALSE"));  // keys are separate
+  CHECK(a.eval("(pb-unchanged ?*b* 7 \"seq\")").is_symbol("FALSE"));
+  CHECK(a.eval("(pb-unchanged ?*a* 7 \"seq\")").is_symbol("TRUE"));  // an integer key
+  // a change in a nested message counts
+  a.eval("(pb-set-field ?*ms* name M1)");
+  a.eval("(pb-add-list ?*a* machines ?*ms*)");
+  CHECK(a.eval("(pb-unchanged ?*a* robot2 seq)").is_symbol("FALSE"));
+  CHECK(a.eval("(pb-unchanged ?*a* robot2 seq)").is_symbol("TRUE"));
+  // the same key with an empty message of another type is not the same
+  CHECK(a.eval("(pb-unchanged ?*l* robot4)").is_symbol("FALSE"));
+  CHECK(a.eval("(pb-unchanged (pb-create \"llsf_agent_msgs.Worldmodel\") robot4)")
+            .is_symbol("FALSE"));
+  CHECK(a.runtime_errors() == errors);
+  // the message given is not changed by the fields left out of the comparison
+  CHECK(a.eval("(pb-field-value ?*b* seq)") == Value::integer_value(2));
+
+  a.eval("(pb-unchanged ?*a* robot2 nope)");
+  CHECK(f.logged("has no field nope"));
+  a.eval("(pb-unchanged ?*a* (create$ x))");
+  CHECK(f.logged("the key (argument 2) must be a symbol, string or integer"));
+  CHECK(a.runtime_errors() == errors + 2);
+
+  // (reset) forgets: the facts a skipped message would have made are gone too
+  a.start(f.now());
+  f.load("(defglobal ?*c* = (pb-create \"llsf_agent_msgs.Worldmodel\"))");
+  CHECK(a.eval("(pb-unchanged ?*c* robot5)").is_symbol("FALSE"));
+  CHECK(a.eval("(pb-unchanged ?*c* robot5)").is_symbol("TRUE"));
+  a.start(f.now());
+  f.load("(defglobal ?*d* = (pb-create \"llsf_agent_msgs.Worldmodel\"))");
+  CHECK(a.eval("(pb-unchanged ?*d* robot5)").is_symbol("FALSE"));
+}

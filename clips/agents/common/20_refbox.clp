@@ -45,10 +45,12 @@
   ?pf <- (protobuf-msg (type "llsf_msgs.MachineReportInfo") (ptr ?p))
   =>
   (retract ?pf)
-  (foreach ?n (pb-field-list ?p "reported_machines")
-    (bind ?m (fact-by-slot machine name (sym-cat ?n)))
-    (if (and ?m (eq (fact-slot-value ?m explored) FALSE)) then
-      (modify ?m (explored TRUE))))
+  ; (a repeat of the last report changes nothing: explored only ever becomes TRUE)
+  (if (not (pb-unchanged ?p machine-report-info)) then
+    (foreach ?n (pb-field-list ?p "reported_machines")
+      (bind ?m (fact-by-slot machine name (sym-cat ?n)))
+      (if (and ?m (eq (fact-slot-value ?m explored) FALSE)) then
+        (modify ?m (explored TRUE)))))
 )
 
 ; The machine types are dealt once, at the start of the game, and never change in it
@@ -88,19 +90,21 @@
   ?pf <- (protobuf-msg (type "llsf_msgs.OrderInfo") (ptr ?p))
   =>
   (retract ?pf)
-  (foreach ?o (pb-field-list ?p "orders")
-    (bind ?id (pb-field-value ?o "id"))
-    (bind ?product (pb-field-value ?o "product"))
-    (bind ?req (pb-field-value ?o "quantity_requested"))
-    (bind ?del (pb-field-value ?o "quantity_delivered"))
-    (bind ?b (pb-field-value ?o "delivery_period_begin"))
-    (bind ?e (pb-field-value ?o "delivery_period_end"))
-    (bind ?x (fact-by-slot order id ?id))
-    (if ?x
-     then
-      (if (neq (fact-slot-value ?x delivered) ?del) then
-        (modify ?x (delivered ?del)))
-     else
-      (assert (order (id ?id) (product ?product) (requested ?req) (delivered ?del)
-                     (begin ?b) (end ?e)))))
+  ; (only this rule changes order facts: a repeat of the last OrderInfo changes nothing)
+  (if (not (pb-unchanged ?p order-info)) then
+    (foreach ?o (pb-field-list ?p "orders")
+      (bind ?id (pb-field-value ?o "id"))
+      (bind ?product (pb-field-value ?o "product"))
+      (bind ?req (pb-field-value ?o "quantity_requested"))
+      (bind ?del (pb-field-value ?o "quantity_delivered"))
+      (bind ?b (pb-field-value ?o "delivery_period_begin"))
+      (bind ?e (pb-field-value ?o "delivery_period_end"))
+      (bind ?x (fact-by-slot order id ?id))
+      (if ?x
+       then
+        (if (neq (fact-slot-value ?x delivered) ?del) then
+          (modify ?x (delivered ?del)))
+       else
+        (assert (order (id ?id) (product ?product) (requested ?req) (delivered ?del)
+                       (begin ?b) (end ?e))))))
 )

@@ -48,20 +48,25 @@
   (pb-broadcast ?*WM-MSG*)
 )
 
+; A robot sends its whole view every second, mostly the same as a second before. An entry is
+; taken only when newer than this robot's (and a machine's updated-at only grows), so an entry
+; seen before changes nothing: a message equal, but for its seq, to the last one from the same
+; robot is skipped without reading its entries (pb-unchanged).
 (defrule wm-receive
   (declare (salience ?*PRIORITY-WM*))
-  ?pf <- (protobuf-msg (type "llsf_agent_msgs.Worldmodel") (ptr ?p))
+  ?pf <- (protobuf-msg (type "llsf_agent_msgs.Worldmodel") (ptr ?p) (rcvd-from ?from $?))
   =>
   (retract ?pf)
-  (foreach ?ms (pb-field-list ?p "machines")
-    ; (fact-by-slot: the machine fact by its name, without a do-for-fact over all machines)
-    (bind ?m (fact-by-slot machine name (sym-cat (pb-field-value ?ms "name"))))
-    (bind ?at (pb-field-value ?ms "updated_at"))
-    (if (and ?m (> ?at (fact-slot-value ?m updated-at))) then
-      (modify ?m (loaded-with (pb-field-list ?ms "loaded_with"))
-                 (consumed (pb-field-value ?ms "junk"))
-                 (down-until (pb-field-value ?ms "out_of_order_until"))
-                 (updated-at ?at))))
+  (if (not (pb-unchanged ?p ?from "seq")) then
+    (foreach ?ms (pb-field-list ?p "machines")
+      ; (fact-by-slot: the machine fact by its name, without a do-for-fact over all machines)
+      (bind ?m (fact-by-slot machine name (sym-cat (pb-field-value ?ms "name"))))
+      (bind ?at (pb-field-value ?ms "updated_at"))
+      (if (and ?m (> ?at (fact-slot-value ?m updated-at))) then
+        (modify ?m (loaded-with (pb-field-list ?ms "loaded_with"))
+                   (consumed (pb-field-value ?ms "junk"))
+                   (down-until (pb-field-value ?ms "out_of_order_until"))
+                   (updated-at ?at)))))
 )
 
 ; Messages of the team this agent does not use.
