@@ -218,7 +218,7 @@
 (defrule au-close
   (declare (salience ?*PRIORITY-DECIDE*))
   ?a <- (au-auction (id ?id) (key ?key) (state BIDDING) (deadline ?d))
-  (time $?)
+  (time ? ?)
   (test (> (now) ?d))
   =>
   (bind ?best NONE) (bind ?bc 0.0)
@@ -247,7 +247,7 @@
 (defrule au-award-resend
   (declare (salience ?*PRIORITY-DECIDE*))
   ?a <- (au-auction (id ?id) (key ?key) (state AWARDED) (since ?since) (sent ?s) (sends ?n))
-  (time $?)
+  (time ? ?)
   (test (> (now) (+ ?s (au-award-resend))))
   =>
   (if (> (now) (+ ?since (au-award-timeout)))
@@ -321,7 +321,7 @@
 (defrule au-silent-winner
   (declare (salience ?*PRIORITY-DECIDE*))
   ?a <- (au-auction (id ?id) (key ?key) (state RUNNING) (winner ?w) (seen ?s))
-  (time $?)
+  (time ? ?)
   (test (> (now) (+ ?s (au-silence-timeout))))
   =>
   (log-warn "auction " ?id ": " ?w " is silent, auctioning " ?key " again")
@@ -332,7 +332,7 @@
 (defrule au-cooldown-expired
   (declare (salience ?*PRIORITY-LOW*))
   ?c <- (au-cooldown (until ?u))
-  (time $?)
+  (time ? ?)
   (test (> (now) ?u))
   =>
   (retract ?c)

@@ -110,7 +110,7 @@
   ?j <- (au-job (state RUNNING) (kind ?k) (machine ?m) (input ?i) (steps ?n))
   (holding (puck ?h))
   (not (task))
-  (time $?)
+  (time ? ?)
   (test (not (au-cooling-down)))
   =>
   (bind ?step (au-step ?k ?m ?i ?h ?n))
@@ -136,7 +136,7 @@
   (not (au-job))
   (not (task))
   (holding (puck ?h&~NONE&~S0&~S1))
-  (time $?)
+  (time ? ?)
   (test (not (au-cooling-down)))
   =>
   (bind ?step (au-step LOCAL NONE NONE ?h 1))
@@ -150,7 +150,7 @@
   (not (au-job))
   (not (task))
   (holding (puck S1))
-  (time $?)
+  (time ? ?)
   =>
   (bind ?hs (find-fact ((?x au-hold)) TRUE))
   (if (= (length$ ?hs) 0)
@@ -174,7 +174,7 @@
 (defrule au-step-watchdog
   (declare (salience ?*PRIORITY-DECIDE*))
   (task (state RUNNING) (kind ?k&~WAIT&~EXPLORE) (since ?s))
-  (time $?)
+  (time ? ?)
   (test (> (now) (+ ?s ?*AU-STEP-TIMEOUT*)))
   (skill (status RUNNING|IDLE))
   =>
@@ -184,7 +184,7 @@
 
 (defrule au-task-cooldown-expired
   (declare (salience ?*PRIORITY-LOW*))
-  (time $?)
+  (time ? ?)
   ?c <- (task-cooldown (until ?u))
   (test (> (now) ?u))
   =>

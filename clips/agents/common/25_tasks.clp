@@ -57,7 +57,7 @@
 (defrule task-lock-retry
   (declare (salience ?*PRIORITY-TASK*))
   ?t <- (task (state LOCK_WAIT) (lock ?r) (since ?s))
-  (time $?)                     ; after the task: a new (time) fact meets only waiting tasks
+  (time ? ?)                    ; after the task: a new (time) fact meets only waiting tasks
   (test (> (- (now) ?s) 1.0))   ; a test CE: evaluated again with every new (time) fact
   =>
   (assert (resource-request (resource ?r)))
@@ -94,7 +94,7 @@
 (defrule task-wait-over
   (declare (salience ?*PRIORITY-TASK*))
   ?t <- (task (state RUNNING) (kind WAIT) (since ?s))
-  (time $?)
+  (time ? ?)
   (test (> (- (now) ?s) 3.0))
   =>
   (modify ?t (state DONE))

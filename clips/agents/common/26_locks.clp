@@ -52,7 +52,7 @@
 (defrule locks-on-answer
   (declare (salience ?*PRIORITY-TASK*))
   ?p <- (resource-pending (resource ?res))
-  (time $?)
+  (time ? ?)
   =>
   (bind ?st (lock-state ?res))
   (if (eq ?st ACCEPTED) then

@@ -47,7 +47,7 @@
   (explore-pos (machine ?pos))
   (not (task))
   (not (explore-idle))
-  (time $?)
+  (time ? ?)
   =>
   (bind ?m (explore-next ?pos))
   (if (neq ?m NONE)
@@ -58,7 +58,7 @@
 (defrule explore-idle-over
   (declare (salience ?*PRIORITY-DECIDE*))
   ?f <- (explore-idle (until ?u))
-  (time $?)
+  (time ? ?)
   (test (>= (now) ?u))
   =>
   (retract ?f)

@@ -213,7 +213,7 @@
   (role (name ?role) (target ?target))
   (holding (puck ?h))
   (not (task))
-  (time $?)
+  (time ? ?)
   =>
   (bind ?step (prod-next-step ?role ?target ?h))
   (assert (task (kind (nth$ 1 ?step)) (place (nth$ 2 ?step)) (lock (nth$ 3 ?step))))
@@ -338,7 +338,7 @@
   (declare (salience (+ ?*PRIORITY-DECIDE* 1)))
   ?c <- (task-cooldown (until ?until))
   (not (task))
-  (time $?)
+  (time ? ?)
   =>
   (if (> ?until (now))
    then (assert (task (kind WAIT)))
