@@ -10,6 +10,7 @@
 #include <google/protobuf/descriptor.h>
 #include <google/protobuf/message.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <unordered_map>
@@ -271,30 +272,39 @@ class ProtobufFeature final : public Feature {
         a.env().error(a.function(), "the key (argument 2) must be a symbol, string or integer");
         return Value::boolean(false);
     }
-    const Message* m = e->message;
+    Message* m = e->message;
     const Descriptor* d = m->GetDescriptor();
-    if (a.count() > 2) {
-      std::unique_ptr<Message>& copy = scratch_[d];
-      if (!copy) copy.reset(m->New());
-      copy->CopyFrom(*m);
-      for (int i = 2; i < a.count(); ++i) {
-        std::string_view name;
-        if (!a.text(i, name)) {
-          a.env().error(a.function(), "argument " + std::to_string(i + 1) +
-                                          " must be a field name (a string or symbol)");
-          return Value::boolean(false);
-        }
-        const FieldDescriptor* f = find_field(d, name);
-        if (f == nullptr) {
-          a.env().error(a.function(), m->GetTypeName() + " has no field " + std::string(name));
-          return Value::boolean(false);
-        }
-        copy->GetReflection()->ClearField(copy.get(), f);
+    std::vector<const FieldDescriptor*>& left_out = fields_scratch_;
+    left_out.clear();
+    for (int i = 2; i < a.count(); ++i) {
+      std::string_view name;
+      if (!a.text(i, name)) {
+        a.env().error(a.function(), "argument " + std::to_string(i + 1) +
+                                        " must be a field name (a string or symbol)");
+        return Value::boolean(false);
       }
-      m = copy.get();
+      const FieldDescriptor* f = find_field(d, name);
+      if (f == nullptr) {
+        a.env().error(a.function(), m->GetTypeName() + " has no field " + std::string(name));
+        return Value::boolean(false);
+      }
+      if (std::find(left_out.begin(), left_out.end(), f) == left_out.end()) left_out.push_back(f);
+    }
+    // The left-out fields are swapped into an empty message of the type while ?m is serialised
+    // and swapped back (a swap moves nested and repeated fields without copying them); a default
+    // instance (read-only) has none of them set.
+    std::unique_ptr<Message>& aside = scratch_[d];
+    const bool swap = !left_out.empty() && !e->read_only;
+    if (swap) {
+      if (!aside) aside.reset(m->New());
+      m->GetReflection()->SwapFields(m, aside.get(), left_out);
     }
     bytes_scratch_.clear();
     m->SerializePartialToString(&bytes_scratch_);
+    if (swap) {
+      m->GetReflection()->SwapFields(m, aside.get(), left_out);
+      aside->Clear();
+    }
     auto it = last_.find(k);
     if (it == last_.end()) {
       if (last_.size() >= kMaxUnchangedKeys) {
@@ -551,6 +561,7 @@ class ProtobufFeature final : public Feature {
   static constexpr std::size_t kMaxUnchangedKeys = 1024;
   std::unordered_map<std::string, Last> last_;
   std::unordered_map<const Descriptor*, std::unique_ptr<Message>> scratch_;
+  std::vector<const FieldDescriptor*> fields_scratch_;
   std::string key_scratch_, bytes_scratch_;
 };
 

@@ -196,6 +196,10 @@ TEST_CASE("pb-unchanged tells a message that repeats the last one with the same 
   CHECK(a.runtime_errors() == errors);
   // the message given is not changed by the fields left out of the comparison
   CHECK(a.eval("(pb-field-value ?*b* seq)") == Value::integer_value(2));
+  CHECK(a.eval("(pb-unchanged ?*a* robot6 machines seq machines)").is_symbol("FALSE"));
+  CHECK(a.eval("(pb-unchanged ?*b* robot6 seq machines)").is_symbol("TRUE"));
+  CHECK(a.eval("(length$ (pb-field-list ?*a* machines))") == Value::integer_value(1));
+  CHECK(a.eval("(pb-field-value ?*a* seq)") == Value::integer_value(1));
 
   a.eval("(pb-unchanged ?*a* robot2 nope)");
   CHECK(f.logged("has no field nope"));
