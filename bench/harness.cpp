@@ -43,6 +43,11 @@ void report(const std::string& bench, const std::string& metric, double value,
   std::fflush(stdout);
 }
 
+std::string tree() {
+  const char* t = std::getenv("LLSF_BENCH_TREE");
+  return t != nullptr && *t != '\0' ? std::string(t) : std::string(LLSF_SOURCE_DIR);
+}
+
 double cpu_seconds() {
   timespec ts{};
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);

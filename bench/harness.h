@@ -16,6 +16,11 @@ void report(const std::string& bench, const std::string& metric, double value,
 /// CPU seconds used by this process so far (CLOCK_PROCESS_CPUTIME_ID).
 double cpu_seconds();
 
+/// The tree whose agents and scenarios the game benchmarks play: $LLSF_BENCH_TREE if set (e.g. a
+/// `git worktree` of an older commit, to measure the agents' code before and after a change with
+/// the same binary, in one run), else the source tree this was built from.
+std::string tree();
+
 /// Runs `body` `repeats` times and returns the median of the values it returns.
 double median_of(int repeats, const std::function<double()>& body);
 

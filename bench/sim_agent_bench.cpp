@@ -75,8 +75,8 @@ GameResult play(std::uint64_t seed, double loss, bool locks, const AgentVariant&
   sim::Game& game = driver.game();
   for (int i = 0; i < game.robot_count(); ++i) {
     sim::AgentBrainConfig c;
-    c.agent_files = {LLSF_SOURCE_DIR "/clips/agents/common",
-                     std::string(LLSF_SOURCE_DIR "/clips/agents/") + agent.dir};
+    c.agent_files = {bench::tree() + "/clips/agents/common",
+                     bench::tree() + "/clips/agents/" + agent.dir};
     c.config = agent.config;
     c.locks = locks;
     timed.push_back(std::make_unique<TimedBrain>(driver.plug_agent(i, c)));
@@ -171,7 +171,7 @@ LLSF_BENCH(
 
 LLSF_BENCH(full_game,
            "scenarios/default.yaml: a whole 3-robot game (1080 s), CPU and where the tick goes") {
-  const study::ScenarioFile f = study::load_scenario(LLSF_SOURCE_DIR "/scenarios/default.yaml");
+  const study::ScenarioFile f = study::load_scenario(bench::tree() + "/scenarios/default.yaml");
   study::RunHooks plain;
   std::vector<study::RunResult> runs;
   const double cpu = bench::median_of(5, [&] {

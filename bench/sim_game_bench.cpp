@@ -28,7 +28,7 @@ using namespace llsf;
 
 namespace {
 
-constexpr const char* kScenario = LLSF_SOURCE_DIR "/scenarios/default.yaml";
+std::string scenario() { return bench::tree() + "/scenarios/default.yaml"; }
 
 double wall_now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -52,7 +52,7 @@ ChildGame game_in_child() {
   if (pid < 0) return g;
   if (pid == 0) {
     close(fds[0]);
-    const study::ScenarioFile f = study::load_scenario(kScenario);
+    const study::ScenarioFile f = study::load_scenario(scenario());
     const double t0 = wall_now();
     const study::RunResult r = study::run_game(f.variants[0], 1);
     const double wall = wall_now() - t0;
@@ -114,7 +114,7 @@ LLSF_BENCH(batch100,
                        ("llsf_bench_batch100_" + std::to_string(static_cast<long>(getpid())));
   fs::remove_all(dir);
   fs::create_directories(dir);
-  const study::ScenarioFile f = study::load_scenario(kScenario);
+  const study::ScenarioFile f = study::load_scenario(scenario());
   double wall = 0.0;
   int played = 0;
   {
