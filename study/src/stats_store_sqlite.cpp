@@ -119,77 +119,8 @@ using sqlite::DbCloser;
 using sqlite::StmtFinalizer;
 using DbHandle = std::unique_ptr<sqlite3, DbCloser>;
 
-// A prepared statement. start() resets it and clears its bindings; a Statement that returned
-// rows is reset by the next start() or by finish().
-class Statement {
- public:
-  Statement(sqlite3* db, const std::string& path, std::string_view sql) : db_(db), path_(&path) {
-    sqlite3_stmt* s = nullptr;
-    if (sqlite3_prepare_v3(db, sql.data(), static_cast<int>(sql.size()), SQLITE_PREPARE_PERSISTENT,
-                           &s, nullptr) != SQLITE_OK) {
-      fail("prepare");
-    }
-    stmt_.reset(s);
-  }
-
-  Statement& start() {
-    sqlite3_reset(stmt_.get());
-    sqlite3_clear_bindings(stmt_.get());
-    next_ = 1;
-    return *this;
-  }
-  Statement& bind(std::int64_t v) { return check(sqlite3_bind_int64(stmt_.get(), next_++, v)); }
-  Statement& bind(int v) { return bind(static_cast<std::int64_t>(v)); }
-  Statement& bind(double v) { return check(sqlite3_bind_double(stmt_.get(), next_++, v)); }
-  Statement& bind(std::string_view v) {
-    return check(sqlite3_bind_text(stmt_.get(), next_++, v.data(), static_cast<int>(v.size()),
-                                   SQLITE_TRANSIENT));
-  }
-  Statement& bind_null() { return check(sqlite3_bind_null(stmt_.get(), next_++)); }
-
-  // One step: true if a row is ready, false when done.
-  bool step() {
-    const int rc = sqlite3_step(stmt_.get());
-    if (rc == SQLITE_ROW) return true;
-    if (rc == SQLITE_DONE) return false;
-    fail("step");
-  }
-  // Runs a statement that returns no rows.
-  void run() {
-    while (step()) {
-    }
-    finish();
-  }
-  void finish() { sqlite3_reset(stmt_.get()); }
-
-  std::int64_t int64(int col) const { return sqlite3_column_int64(stmt_.get(), col); }
-  double real(int col) const { return sqlite3_column_double(stmt_.get(), col); }
-  bool null(int col) const { return sqlite3_column_type(stmt_.get(), col) == SQLITE_NULL; }
-  std::string text(int col) const {
-    const auto* p = sqlite3_column_text(stmt_.get(), col);
-    return p ? std::string(reinterpret_cast<const char*>(p),
-                           static_cast<std::size_t>(sqlite3_column_bytes(stmt_.get(), col)))
-             : std::string();
-  }
-
- private:
-  Statement& check(int rc) {
-    if (rc != SQLITE_OK) fail("bind");
-    return *this;
-  }
-  [[noreturn]] void fail(const char* what) const {
-    // Reset so that a failed statement does not keep the database locked.
-    if (stmt_) sqlite3_reset(stmt_.get());
-    throw StatsError(*path_ + ": " + what + ": " + sqlite3_errmsg(db_));
-  }
-
-  sqlite3* db_;
-  const std::string* path_;
-  std::unique_ptr<sqlite3_stmt, StmtFinalizer> stmt_;
-  int next_ = 1;
-};
-
 using sqlite::exec;
+using sqlite::Statement;
 using sqlite::Transaction;
 
 // The store's directory is created if missing (a failure shows when SQLite opens the file).

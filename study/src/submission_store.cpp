@@ -83,62 +83,13 @@ std::string iso_now() {
 }
 
 using sqlite::DbCloser;
-using sqlite::StmtFinalizer;
 
-// A statement prepared for one call (the store's calls are few and small).
-class Stmt {
- public:
-  Stmt(sqlite3* db, const std::string& path, const char* sql) : db_(db), path_(path) {
-    sqlite3_stmt* s = nullptr;
-    if (sqlite3_prepare_v2(db, sql, -1, &s, nullptr) != SQLITE_OK) fail("prepare");
-    stmt_.reset(s);
-  }
-  Stmt& bind(std::int64_t v) { return check(sqlite3_bind_int64(stmt_.get(), next_++, v)); }
-  Stmt& bind(int v) { return bind(static_cast<std::int64_t>(v)); }
-  Stmt& bind(std::string_view v) {
-    return check(sqlite3_bind_text(stmt_.get(), next_++, v.data(), static_cast<int>(v.size()),
-                                   SQLITE_TRANSIENT));
-  }
-  Stmt& bind(std::optional<double> v) {
-    return check(v ? sqlite3_bind_double(stmt_.get(), next_++, *v)
-                   : sqlite3_bind_null(stmt_.get(), next_++));
-  }
-  bool step() {
-    const int rc = sqlite3_step(stmt_.get());
-    if (rc == SQLITE_ROW) return true;
-    if (rc == SQLITE_DONE) return false;
-    fail("step");
-  }
-  void run() {
-    while (step()) {
-    }
-  }
-  std::int64_t int64(int col) const { return sqlite3_column_int64(stmt_.get(), col); }
-  bool null(int col) const { return sqlite3_column_type(stmt_.get(), col) == SQLITE_NULL; }
-  std::string text(int col) const {
-    const auto* p = sqlite3_column_text(stmt_.get(), col);
-    return p ? std::string(reinterpret_cast<const char*>(p),
-                           static_cast<std::size_t>(sqlite3_column_bytes(stmt_.get(), col)))
-             : std::string();
-  }
-  std::optional<double> real(int col) const {
-    if (null(col)) return std::nullopt;
-    return sqlite3_column_double(stmt_.get(), col);
-  }
+using sqlite::Statement;
 
- private:
-  Stmt& check(int rc) {
-    if (rc != SQLITE_OK) fail("bind");
-    return *this;
-  }
-  [[noreturn]] void fail(const char* what) const {
-    throw StatsError(path_ + ": hackathon submissions: " + what + ": " + sqlite3_errmsg(db_));
-  }
-  sqlite3* db_;
-  const std::string& path_;
-  std::unique_ptr<sqlite3_stmt, StmtFinalizer> stmt_;
-  int next_ = 1;
-};
+// A statement prepared for one call (the store's calls are few and small); errors name the table.
+Statement stmt(sqlite3* db, const std::string& path, const char* sql) {
+  return Statement(db, path, sql, "hackathon submissions");
+}
 
 using sqlite::exec;
 using sqlite::Transaction;
@@ -148,7 +99,7 @@ constexpr const char* kColumns =
     "id, team, exercise, file_name, sha256, received, received_ms, status, seeds, started, "
     "finished, passed, total, value, verdict, better, result, error";
 
-Submission read_row(const Stmt& q) {
+Submission read_row(const Statement& q) {
   Submission s;
   s.id = q.int64(0);
   s.team = q.text(1);
@@ -163,7 +114,7 @@ Submission read_row(const Stmt& q) {
   s.finished = q.text(10);
   s.passed = static_cast<int>(q.int64(11));
   s.total = static_cast<int>(q.int64(12));
-  s.value = q.real(13);
+  s.value = q.real_or_null(13);
   s.verdict = q.text(14);
   s.better = q.text(15);
   s.result = q.text(16);
@@ -301,7 +252,8 @@ SubmissionStore::SubmissionStore(const std::string& path) : impl_(std::make_uniq
        "description TEXT NOT NULL, applied TEXT)");
   int version = 0;
   {
-    Stmt q(db, impl_->path, "SELECT coalesce(max(version), 0) FROM hackathon_schema_migrations");
+    Statement q =
+        stmt(db, impl_->path, "SELECT coalesce(max(version), 0) FROM hackathon_schema_migrations");
     if (q.step()) version = static_cast<int>(q.int64(0));
   }
   if (version > kSchemaVersion) {
@@ -311,7 +263,7 @@ SubmissionStore::SubmissionStore(const std::string& path) : impl_(std::make_uniq
   }
   for (int v = version + 1; v <= kSchemaVersion; ++v) {
     exec(db, impl_->path, kSql.at(static_cast<std::size_t>(v - 1)));
-    Stmt(db, impl_->path,
+    stmt(db, impl_->path,
          "INSERT INTO hackathon_schema_migrations (version, description, applied) VALUES (?, ?, "
          "strftime('%Y-%m-%dT%H:%M:%SZ', 'now'))")
         .bind(v)
@@ -328,7 +280,7 @@ std::int64_t SubmissionStore::add(const std::string& team, const std::string& ex
                                   const std::string& seeds, std::int64_t received_ms) {
   const std::lock_guard lock(mutex_);
   sqlite3* db = impl_->db.get();
-  Stmt(db, impl_->path,
+  stmt(db, impl_->path,
        "INSERT INTO hackathon_submissions (team, exercise, file_name, content, sha256, received, "
        "received_ms, status, seeds) VALUES (?, ?, ?, ?, ?, ?, ?, 'queued', ?)")
       .bind(std::string_view(team))
@@ -345,8 +297,9 @@ std::int64_t SubmissionStore::add(const std::string& team, const std::string& ex
 
 int SubmissionStore::count_since(const std::string& team, std::int64_t since_ms) {
   const std::lock_guard lock(mutex_);
-  Stmt q(impl_->db.get(), impl_->path,
-         "SELECT count(*) FROM hackathon_submissions WHERE team = ? AND received_ms >= ?");
+  Statement q =
+      stmt(impl_->db.get(), impl_->path,
+           "SELECT count(*) FROM hackathon_submissions WHERE team = ? AND received_ms >= ?");
   q.bind(std::string_view(team)).bind(since_ms);
   return q.step() ? static_cast<int>(q.int64(0)) : 0;
 }
@@ -357,17 +310,18 @@ std::optional<Submission> SubmissionStore::claim_next() {
   Transaction t(db, impl_->path);
   std::optional<Submission> s;
   {
-    Stmt q(db, impl_->path,
-           (std::string("SELECT ") + kColumns +
-            ", content FROM hackathon_submissions WHERE status = 'queued' ORDER BY id LIMIT 1")
-               .c_str());
+    Statement q =
+        stmt(db, impl_->path,
+             (std::string("SELECT ") + kColumns +
+              ", content FROM hackathon_submissions WHERE status = 'queued' ORDER BY id LIMIT 1")
+                 .c_str());
     if (!q.step()) return std::nullopt;
     s = read_row(q);
     s->content = q.text(18);
   }
   s->status = SubmissionStatus::kRunning;
   s->started = iso_now();
-  Stmt(db, impl_->path,
+  stmt(db, impl_->path,
        "UPDATE hackathon_submissions SET status = 'running', started = ? WHERE id = ?")
       .bind(std::string_view(s->started))
       .bind(s->id)
@@ -378,7 +332,7 @@ std::optional<Submission> SubmissionStore::claim_next() {
 
 void SubmissionStore::finish(std::int64_t id, const SubmissionOutcome& o) {
   const std::lock_guard lock(mutex_);
-  Stmt(impl_->db.get(), impl_->path,
+  stmt(impl_->db.get(), impl_->path,
        "UPDATE hackathon_submissions SET status = ?, finished = ?, passed = ?, total = ?, value = "
        "?, verdict = ?, better = ?, result = ?, error = ? WHERE id = ?")
       .bind(to_string(o.status))
@@ -396,7 +350,7 @@ void SubmissionStore::finish(std::int64_t id, const SubmissionOutcome& o) {
 
 int SubmissionStore::requeue_running() {
   const std::lock_guard lock(mutex_);
-  Stmt(impl_->db.get(), impl_->path,
+  stmt(impl_->db.get(), impl_->path,
        "UPDATE hackathon_submissions SET status = 'queued', started = NULL WHERE status = "
        "'running'")
       .run();
@@ -405,9 +359,10 @@ int SubmissionStore::requeue_running() {
 
 std::optional<Submission> SubmissionStore::get(std::int64_t id) {
   const std::lock_guard lock(mutex_);
-  Stmt q(impl_->db.get(), impl_->path,
-         (std::string("SELECT ") + kColumns + ", content FROM hackathon_submissions WHERE id = ?")
-             .c_str());
+  Statement q =
+      stmt(impl_->db.get(), impl_->path,
+           (std::string("SELECT ") + kColumns + ", content FROM hackathon_submissions WHERE id = ?")
+               .c_str());
   q.bind(id);
   if (!q.step()) return std::nullopt;
   Submission s = read_row(q);
@@ -417,10 +372,11 @@ std::optional<Submission> SubmissionStore::get(std::int64_t id) {
 
 std::vector<Submission> SubmissionStore::list(const std::string& exercise, int limit) {
   const std::lock_guard lock(mutex_);
-  Stmt q(impl_->db.get(), impl_->path,
-         (std::string("SELECT ") + kColumns +
-          " FROM hackathon_submissions WHERE ? = '' OR exercise = ? ORDER BY id DESC LIMIT ?")
-             .c_str());
+  Statement q =
+      stmt(impl_->db.get(), impl_->path,
+           (std::string("SELECT ") + kColumns +
+            " FROM hackathon_submissions WHERE ? = '' OR exercise = ? ORDER BY id DESC LIMIT ?")
+               .c_str());
   q.bind(std::string_view(exercise)).bind(std::string_view(exercise)).bind(limit);
   std::vector<Submission> out;
   while (q.step()) out.push_back(read_row(q));
@@ -429,10 +385,11 @@ std::vector<Submission> SubmissionStore::list(const std::string& exercise, int l
 
 std::vector<Submission> SubmissionStore::done(const std::string& exercise) {
   const std::lock_guard lock(mutex_);
-  Stmt q(impl_->db.get(), impl_->path,
-         (std::string("SELECT ") + kColumns +
-          " FROM hackathon_submissions WHERE exercise = ? AND status = 'done' ORDER BY id")
-             .c_str());
+  Statement q =
+      stmt(impl_->db.get(), impl_->path,
+           (std::string("SELECT ") + kColumns +
+            " FROM hackathon_submissions WHERE exercise = ? AND status = 'done' ORDER BY id")
+               .c_str());
   q.bind(std::string_view(exercise));
   std::vector<Submission> out;
   while (q.step()) out.push_back(read_row(q));
@@ -441,8 +398,9 @@ std::vector<Submission> SubmissionStore::done(const std::string& exercise) {
 
 std::vector<std::pair<std::string, int>> SubmissionStore::counts() {
   const std::lock_guard lock(mutex_);
-  Stmt q(impl_->db.get(), impl_->path,
-         "SELECT status, count(*) FROM hackathon_submissions GROUP BY status ORDER BY status");
+  Statement q =
+      stmt(impl_->db.get(), impl_->path,
+           "SELECT status, count(*) FROM hackathon_submissions GROUP BY status ORDER BY status");
   std::vector<std::pair<std::string, int>> out;
   while (q.step()) out.emplace_back(q.text(0), static_cast<int>(q.int64(1)));
   return out;
