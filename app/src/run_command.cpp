@@ -112,7 +112,9 @@ void print_issues(const study::RunResult& r, std::ostream& out) {
       const std::string skill = i.text.substr(0, i.text.find('{'));
       const std::size_t colon = i.text.find("}: ");
       const std::string error = colon == std::string::npos ? i.text : i.text.substr(colon + 3);
-      auto& f = failures[i.robot + " " + skill + ": " + error];
+      // (the engine's error starts with the skill's name already: named once)
+      const bool named = error.compare(0, skill.size() + 2, skill + ": ") == 0;
+      auto& f = failures[i.robot + " " + (named ? error : skill + ": " + error)];
       if (f.first++ == 0) f.second = i.time_s;
       continue;
     }

@@ -994,7 +994,9 @@ function E.run_cycle(chunk)
     if h.status == S_FAILED then
       status = S_FAILED
       errors = errors or {}
-      errors[#errors + 1] = h.name .. ": " .. tostring(h.error)
+      -- (named once: the library's skills start their own messages with their name)
+      local e, prefix = tostring(h.error), h.name .. ": "
+      errors[#errors + 1] = e:sub(1, #prefix) == prefix and e or prefix .. e
     elseif h.status == S_RUNNING and status ~= S_FAILED then
       status = S_RUNNING
     end
