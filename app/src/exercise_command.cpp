@@ -715,13 +715,15 @@ Action add_exercise_command(CLI::App& app) {
                  "Your skill file (start from a copy of the exercise's skill.lua); it is loaded "
                  "as the exercise's skill, next to the skill library");
   auto* seed = app.add_option("--seed", o->seed, "Seed to play (default: the exercise's first)");
-  app.add_option("--seeds", o->seeds,
-                 "Play these seeds and print a table and the verdict over them (PASS only when "
-                 "every seed passes): a list of seeds and ranges, e.g. 1-20 or 3,5,9-12")
-      ->excludes(seed);
+  auto* seeds =
+      app.add_option("--seeds", o->seeds,
+                     "Play these seeds and print a table and the verdict over them (PASS only when "
+                     "every seed passes): a list of seeds and ranges, e.g. 1-20 or 3,5,9-12")
+          ->excludes(seed);
   app.add_option("--jobs,-j", o->jobs,
                  "Games played at once by --seeds (default: the number of cores)")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::PositiveNumber)
+      ->needs(seeds);
   app.add_flag("--json", o->json,
                "Print only one JSON object on stdout: the exercise, each seed's result, value, "
                "score, error and hint, and the verdict (docs/exercises.md)");

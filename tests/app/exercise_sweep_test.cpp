@@ -187,6 +187,7 @@ TEST_CASE("exercise --seeds: bad input names the token, exit 2") {
       {{"--seeds", "5-3"}, "'5-3' is an empty range"},
       {{"--seeds", "1-3,2"}, "seed 2 is given twice"},
       {{"--seeds", "1-3", "--jobs", "0"}, "--jobs"},
+      {{"--jobs", "2"}, "--jobs requires --seeds"},  // (a single game has one job)
       {{"--seeds", "1-3", "--seed", "2"}, "--seed"},
       {{"--seeds", "1-3", "--serve"}, "give --seed N instead of --seeds"},
       {{"--seeds", "1-3", "--record", "x.gz"}, "give --seed N instead of --seeds"},
