@@ -283,6 +283,7 @@ struct ServerImpl {
   bool accept_failing = false;  ///< since the last successful accept (logged once)
   asio::io_context ioc{1};
   tcp::acceptor acceptor{ioc};
+  int port = 0;  // the port listened on (also after stop())
   asio::steady_timer accept_retry{ioc};
   std::vector<std::weak_ptr<WsSession>> ws_sessions;
   std::atomic<bool> fan_out_pending{false};
@@ -751,6 +752,7 @@ Server::Server(ServerOptions options, LiveFeed* feed) : impl_(std::make_unique<S
   if (m.acceptor.bind(endpoint, ec)) fail("listen on");
   if (m.acceptor.listen(asio::socket_base::max_listen_connections, ec)) fail("listen on");
   m.host = address.is_v6() ? "[" + bind + "]" : bind;
+  m.port = m.acceptor.local_endpoint().port();
   if (feed != nullptr) {
     feed->set_listener([&m] {
       if (!m.fan_out_pending.exchange(true)) asio::post(m.ioc, [&m] { m.fan_out(); });
@@ -764,7 +766,7 @@ Server::~Server() {
   stop();
 }
 
-int Server::port() const { return impl_->acceptor.local_endpoint().port(); }
+int Server::port() const { return impl_->port; }
 
 std::string Server::url() const { return fmt::format("http://{}:{}/", impl_->host, port()); }
 
@@ -793,6 +795,9 @@ void Server::start() {
 void Server::stop() {
   impl_->ioc.stop();
   if (impl_->thread.joinable()) impl_->thread.join();
+  // The port is free again once stopped (not only when the server is destroyed).
+  beast::error_code ec;
+  impl_->acceptor.close(ec);
 }
 
 int wait_for_stop_signal() {

@@ -119,7 +119,8 @@ class Server {
   std::string url() const;
   /// Serves on a background thread (which blocks SIGINT and SIGTERM).
   void start();
-  /// Stops serving and joins the thread; open connections are dropped. Idempotent.
+  /// Stops serving, joins the thread and closes the listening socket (the port is free again);
+  /// open connections are dropped. Idempotent.
   void stop();
 
  private:

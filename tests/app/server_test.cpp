@@ -297,6 +297,22 @@ TEST_CASE("server: bad requests get JSON errors and the server keeps serving") {
   CHECK(json::parse(r.body).size() == 1);
 }
 
+TEST_CASE("server: stop() frees the port") {
+  Fixture f;
+  llsf::app::Server server(f.options());
+  server.start();
+  const int port = server.port();
+  CHECK(request(port, "/api/nothing").status == 404);
+  server.stop();
+  CHECK(server.port() == port);
+  boost::asio::io_context ioc;
+  boost::asio::ip::tcp::socket s(ioc);
+  boost::system::error_code ec;
+  s.connect({boost::asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(port)}, ec);
+  CHECK(ec == boost::asio::error::connection_refused);
+  server.stop();  // (idempotent)
+}
+
 TEST_CASE("server: the live feed over WebSocket, catch-up first, several clients") {
   Fixture f;
   llsf::app::LiveFeed feed;
