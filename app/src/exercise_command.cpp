@@ -124,6 +124,9 @@ const char* outcome_name(Outcome r) {
 
 /// What one seed's game came to: the verdict's parts (a row of the table, a `runs` entry of
 /// `--json`).
+/// Warnings kept per seed (SeedRun::warnings).
+constexpr std::size_t kMaxWarnings = 5;
+
 struct SeedRun {
   std::uint64_t seed = 0;
   Outcome result = Outcome::kNotRun;
@@ -132,6 +135,9 @@ struct SeedRun {
   std::string why;              ///< the `why` line's text (when not passed)
   std::string error;            ///< the skill's error as `file:line: message`
   std::string hint;             ///< the hint for `error`
+  /// The skill's warnings (lines logged at warn level: the engine's hints such as a state
+  /// machine that keeps switching, and print_warn), distinct, the first kMaxWarnings of them.
+  std::vector<std::string> warnings;
   double game_time_s = 0.0;
   int code = kExitBadInput;  ///< the exit code of this seed alone
 };
@@ -251,6 +257,9 @@ SeedRun play_seed(const Exercise& ex, const ExerciseOptions& o, std::uint64_t se
     const std::string name(game.robot(static_cast<int>(i)).name());
     b.engine().set_log_sink([&, name](lua::LogLevel level, std::string_view text) {
       if (recorder) recorder->log(game.time(), name, level, text);
+      if (level == lua::LogLevel::kWarn && run.warnings.size() < kMaxWarnings &&
+          std::find(run.warnings.begin(), run.warnings.end(), text) == run.warnings.end())
+        run.warnings.emplace_back(text);
       if (o.quiet && level < lua::LogLevel::kWarn) return;
       static const char* const names[] = {"debug", "info", "warn", "error"};
       out << stamp(game.time()) << " " << name << " " << names[static_cast<int>(level)] << ": "
@@ -589,6 +598,26 @@ void print_sweep(const Exercise& ex, const ExerciseOptions& o, const std::vector
         fmt::format("{:.2f} s", r.game_time_s), first_line(r.error.empty() ? r.why : r.error));
     if (r.result != Outcome::kPass) failed.push_back(r.seed);
   }
+  // Each warning once, with the seeds that gave it (in seed order).
+  std::vector<std::pair<std::string, std::vector<std::uint64_t>>> warnings;
+  for (const SeedRun& r : runs) {
+    for (const std::string& w : r.warnings) {
+      auto it = std::find_if(warnings.begin(), warnings.end(),
+                             [&](const auto& x) { return x.first == w; });
+      if (it == warnings.end()) {
+        warnings.emplace_back(w, std::vector<std::uint64_t>{});
+        it = std::prev(warnings.end());
+      }
+      it->second.push_back(r.seed);
+    }
+  }
+  for (std::size_t i = 0; i < warnings.size() && i < kMaxWarnings; ++i) {
+    out << fmt::format("warning  {} (seed(s) {})\n", first_line(warnings[i].first),
+                       fmt::join(warnings[i].second, ", "));
+  }
+  if (warnings.size() > kMaxWarnings)
+    out << fmt::format("warning  ... and {} more (--json lists each seed's)\n",
+                       warnings.size() - kMaxWarnings);
   const std::size_t passed = runs.size() - failed.size();
   if (failed.empty()) {
     out << fmt::format("verdict  PASS {}/{}\n", passed, runs.size());
@@ -628,6 +657,7 @@ void print_json(const Exercise& ex, const ExerciseOptions& o, const std::vector<
     e["why"] = r.why;
     e["error"] = r.error;
     e["hint"] = r.hint;
+    e["warnings"] = r.warnings;
     e["game_time_s"] = std::round(r.game_time_s * 1000.0) / 1000.0;
     list.push_back(std::move(e));
     if (r.result == Outcome::kPass) ++passed;

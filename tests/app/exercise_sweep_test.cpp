@@ -117,7 +117,7 @@ TEST_CASE("exercise --json: one object with the contract's fields") {
   REQUIRE(runs.size() == 2);
   for (const Json& run : runs) {
     for (const char* key :
-         {"seed", "result", "value", "score", "why", "error", "hint", "game_time_s"}) {
+         {"seed", "result", "value", "score", "why", "error", "hint", "warnings", "game_time_s"}) {
       CHECK_MESSAGE(run.contains(key), key);
     }
     CHECK(run.at("value").is_number());
@@ -132,6 +132,7 @@ TEST_CASE("exercise --json: one object with the contract's fields") {
   CHECK(runs[1].at("result") == "FAIL");
   CHECK(runs[1].at("error") == path + ":24: too far east");
   CHECK_FALSE(runs[1].at("hint").get<std::string>().empty());
+  CHECK(runs[0].at("warnings") == Json::array());
 
   // --seed N --json: one run, the same as that seed's run in the sweep.
   const Run single = llsfsim({"exercise", kExercise, "--skill", path, "--seed", "5", "--json"});
@@ -140,6 +141,24 @@ TEST_CASE("exercise --json: one object with the contract's fields") {
   CHECK(s.at("verdict") == "PASS");
   REQUIRE(s.at("runs").size() == 1);
   CHECK(s.at("runs")[0] == runs[0]);
+}
+
+TEST_CASE("exercise --seeds/--json: the skill's warnings, once each with their seeds") {
+  // Two states bouncing with cond=true: the engine warns (exercise_hints_test.cpp).
+  const std::string bounce = LLSF_SOURCE_DIR "/tests/app/exercises/mistakes/bounce.lua";
+  const Run r = llsfsim({"exercise", kExercise, "--skill", bounce, "--seeds", "1-2", "-q"});
+  INFO(r.out, r.err);
+  CHECK(r.code == llsf::app::kExitFailed);
+  CHECK(has(r.out, "warning  " + bounce +
+                       ":14: drive_to_point: states PLAN -> CHECK -> PLAN keep "
+                       "switching without waiting"));
+  CHECK(has(r.out, "(seed(s) 1, 2)\nverdict  FAIL"));
+  const Run j = llsfsim({"exercise", kExercise, "--skill", bounce, "--seeds", "1-2", "--json"});
+  const Json o = Json::parse(j.out);
+  for (const Json& run : o.at("runs")) {
+    REQUIRE(run.at("warnings").size() == 1);
+    CHECK(has(run.at("warnings")[0].get<std::string>(), "keep switching without waiting"));
+  }
 }
 
 TEST_CASE("exercise --json: a long path (Lua shortens those over 59 characters) is shown whole") {
