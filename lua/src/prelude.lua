@@ -962,6 +962,12 @@ function E.skill_info(name)
          h.documentation or "", concat(h.depends, ",")
 end
 
+-- Only the state (SkillBrain asks it in every cycle while a state listener is set).
+function E.skill_state(name)
+  local h = handles[name]
+  return h and h.fsm and h.fsm.current and h.fsm.current.name or ""
+end
+
 local string_env = setmetatable({}, {
   __index = function(t, k)
     local v = proxies[k] or base[k]

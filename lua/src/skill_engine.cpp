@@ -712,10 +712,14 @@ std::string SkillEngine::skill_error(std::string_view skill) const {
 }
 
 std::string SkillEngine::skill_state(std::string_view skill) const {
+  Impl& e = *impl_;
+  lua_pushlstring(e.L, skill.data(), skill.size());
   std::string out;
-  with_skill_info(
-      *impl_, skill,
-      [&](SkillStatus, const std::string&, std::string state, auto&&...) { out = state; });
+  if (e.call_entry("skill_state", 1, 1) == LUA_OK) {
+    const char* s = lua_tostring(e.L, -1);
+    if (s != nullptr) out = s;
+  }
+  lua_settop(e.L, 0);
   return out;
 }
 

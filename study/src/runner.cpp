@@ -457,6 +457,16 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
       // A jammed robot's failures are the jam's (robot profiles), not a livelock's.
       if (!game.robot(i).jammed()) streaks.on(ch);
     });
+    // With the agents recorded, also their skills' states and log lines (the viewer's skill
+    // panel and timeline markers, as in an exercise's recording).
+    if (record_agent) {
+      brain.skills().set_state_listener(
+          [&recorder](const sim::SkillStateChange& change) { recorder->skill_state(change); });
+      brain.skills().engine().set_log_sink(
+          [&recorder, &game, name](lua::LogLevel level, std::string_view text) {
+            recorder->log(game.time(), name, level, text);
+          });
+    }
   }
   double lock_hold_max_s = 0.0;  // set at the end, before the test cases without a deadline
   // Test cases with a deadline are judged when the game passes it.
