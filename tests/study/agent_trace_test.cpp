@@ -173,6 +173,8 @@ TEST_CASE("recordings with the agents stay byte-identical for one seed") {
   CHECK(runs[0].find("\"e\":\"rules\"") != std::string::npos);
   // A delta of another robot, with assertions.
   CHECK(runs[0].find("\"e\":\"fact\",\"robot\":\"robot2\",\"a\":[[") != std::string::npos);
+  // The skills' states too (the viewer's skill panel).
+  CHECK(runs[0].find("\"e\":\"skill_state\",\"robot\":\"robot1\"") != std::string::npos);
 }
 
 TEST_CASE("--trace requests: kinds and robots are checked") {
