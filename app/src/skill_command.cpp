@@ -17,6 +17,7 @@
 #include "llsf/sim/driver.h"
 #include "llsf/sim/game.h"
 #include "llsf/sim/skill_brain.h"
+#include "llsf/study/recording.h"
 
 namespace llsf::app {
 
@@ -38,6 +39,7 @@ struct SkillOptions {
   std::string library_dir;
   double timeout_s = 300.0;
   double after_s = 0.0;
+  std::string record;  ///< --record FILE: the game's recording
   bool trace = false;
   bool quiet = false;
   bool list = false;
@@ -116,14 +118,34 @@ int run_skill(const SkillOptions& o, std::ostream& out, std::ostream& err) {
     return kExitBadInput;
   }
 
+  // --record: the game as the viewer replays it, with the skill's states and log lines.
+  std::unique_ptr<study::Recorder> recorder;
+  if (!o.record.empty()) {
+    try {
+      recorder = std::make_unique<study::Recorder>(
+          o.record, game, study::RecordingInfo{"skill", "", o.seed, std::string(core::kVersion)},
+          10.0, study::LineSink{});
+    } catch (const core::UserError& e) {  // the recording cannot be written
+      err << "llsfsim skill: " << e.what() << "\n";
+      return kExitBadInput;
+    }
+    brain.set_state_listener(
+        [&recorder](const sim::SkillStateChange& c) { recorder->skill_state(c); });
+  }
+  const auto frame = [&recorder, &game] {
+    if (recorder) recorder->frame(game);
+  };
+
   const std::string robot_name(game.robot(index).name());
   brain.engine().set_log_sink([&](lua::LogLevel level, std::string_view text) {
+    if (recorder) recorder->log(game.time(), robot_name, level, text);
     if (o.quiet && level < lua::LogLevel::kWarn) return;
     static const char* const names[] = {"debug", "info", "warn", "error"};
     out << stamp(game.time()) << " " << robot_name << " " << names[static_cast<int>(level)] << ": "
         << text << "\n";
   });
   brain.set_listener([&](const sim::SkillStatusChange& c) {
+    if (recorder) recorder->skill(c);
     out << stamp(c.time) << " " << c.robot << " " << status_name(c.status) << "  "
         << c.skill_string;
     if (!c.result.empty()) out << "  -> " << c.result;
@@ -133,7 +155,10 @@ int run_skill(const SkillOptions& o, std::ostream& out, std::ostream& err) {
 
   // The refbox: the chosen phase, running.
   if (o.phase != "pre_game") driver.start(phase_of(o.phase));
-  driver.run_until(game.time() + SimTime::from_seconds(o.after_s));
+  driver.run_until(game.time() + SimTime::from_seconds(o.after_s), [&](const sim::Game&) {
+    frame();
+    return false;
+  });
   if (!o.quiet) {
     out << stamp(game.time()) << " game: seed " << o.seed << ", " << o.robots << " robot(s), "
         << o.phase << ", skills " << o.level << ", robot " << robot_name << "\n";
@@ -154,6 +179,7 @@ int run_skill(const SkillOptions& o, std::ostream& out, std::ostream& err) {
     const SimTime end = game.time() + SimTime::from_seconds(o.timeout_s);
     if (brain.engine().status() == lua::SkillStatus::kRunning) {
       driver.run_until(end, [&](const sim::Game&) {
+        frame();
         if (o.trace) {
           for (const std::string& n : names) {
             const std::string st = brain.engine().skill_state(n);
@@ -179,6 +205,7 @@ int run_skill(const SkillOptions& o, std::ostream& out, std::ostream& err) {
       break;
     }
   }
+  if (recorder) recorder->close();  // throws if the file could not be finished
   const sim::GameSummary sum = game.summary();
   if (!o.quiet) {
     const auto held = game.puck_in_pocket(index);
@@ -254,6 +281,9 @@ Action add_skill_command(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   app.add_flag("--trace", o->trace, "Also print every state change of every skill's FSM");
+  app.add_option("--record", o->record,
+                 "Also write the game's recording to FILE (gzip JSON lines; replay it with "
+                 "llsfsim view FILE): poses, events, the skill's states and log lines");
   app.add_flag("-q,--quiet", o->quiet, "Only status changes, warnings and errors");
   app.add_flag("--list", o->list, "List the skills with their documentation and exit");
   return [o](std::ostream& out, std::ostream& err) {

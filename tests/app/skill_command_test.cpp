@@ -134,6 +134,25 @@ TEST_CASE("llsfsim run --record writes a readable recording; an unwritable path 
   CHECK(has(r.err, "cannot create the recording"));
 }
 
+TEST_CASE("llsfsim skill --record writes the game with the skill's states; bad path exits 2") {
+  const std::string rec = std::filesystem::temp_directory_path() / "llsf_app_test_skill.jsonl.gz";
+  Run r = llsfsim({"skill", "--seed", "7", "get_s0{}", "--record", rec, "-q"});
+  INFO(r.out, r.err);
+  CHECK(r.code == llsf::app::kExitOk);
+  const auto lines = llsf::study::read_recording(rec);
+  CHECK(lines.size() > 50);  // the header and about 80 frames of 8 s at 10 Hz
+  std::string all;
+  for (const auto& l : lines) all += l.json + "\n";
+  CHECK(has(all, "\"scenario\":\"skill\""));
+  CHECK(has(all, "\"e\":\"skill_state\",\"robot\":\"robot1\",\"skill\":\"get_s0\""));
+  CHECK(has(all, "\"e\":\"skill\""));
+  // The game is the same with and without the recording.
+  CHECK(llsfsim({"skill", "--seed", "7", "get_s0{}", "-q"}).out == r.out);
+  r = llsfsim({"skill", "get_s0{}", "--record", "/no/such/dir/x.jsonl.gz", "-q"});
+  CHECK(r.code == llsf::app::kExitBadInput);
+  CHECK(has(r.err, "cannot create the recording"));
+}
+
 TEST_CASE("llsfsim run --speed paces the game and gives the same result as unpaced") {
   const std::string scenario = std::filesystem::temp_directory_path() / "llsf_app_test_speed.yaml";
   {
