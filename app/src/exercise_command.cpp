@@ -463,7 +463,12 @@ SeedRun play_seed(const Exercise& ex, const ExerciseOptions& o, std::uint64_t se
 /// `seeds`. Progress on `err` as seeds end: a bar when `err` is std::cerr on a terminal, else one
 /// line per seed; nothing with -q or --json.
 std::vector<SeedRun> play_seeds(const Exercise& ex, const ExerciseOptions& o,
-                                const std::vector<std::uint64_t>& seeds, std::ostream& err) {
+                                const std::vector<std::uint64_t>& seeds, std::ostream& err,
+                                bool& interrupted) {
+  // The first Ctrl-C: no new game starts, the running ones end (a game is short) and their
+  // temporary skill directories go; the runs played so far are returned.
+  const SigintGuard sigint;
+  std::vector<char> ended_ok(seeds.size(), 0);  // the seeds whose run is in `runs`
   ExerciseOptions quiet = o;  // the games' own output is not shown, only the table
   quiet.quiet = true;
   std::vector<SeedRun> runs(seeds.size());
@@ -486,12 +491,13 @@ std::vector<SeedRun> play_seeds(const Exercise& ex, const ExerciseOptions& o,
       pool.emplace_back([&] {
         for (;;) {
           const std::size_t i = next++;
-          if (stop || i >= seeds.size()) break;
+          if (stop || SigintGuard::interrupted() || i >= seeds.size()) break;
           try {
             std::ostringstream game_out;
             std::ostringstream game_err;
             runs[i] = play_seed(ex, quiet, seeds[i], game_out, game_err);
             const std::lock_guard lock(mutex);
+            ended_ok[i] = 1;
             done.push_back(i);
           } catch (...) {
             const std::lock_guard lock(mutex);
@@ -535,6 +541,14 @@ std::vector<SeedRun> play_seeds(const Exercise& ex, const ExerciseOptions& o,
     }
   }
   if (error) std::rethrow_exception(error);
+  interrupted = SigintGuard::interrupted();
+  if (interrupted) {
+    std::vector<SeedRun> ran;
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+      if (ended_ok[i] != 0) ran.push_back(std::move(runs[i]));
+    }
+    return ran;
+  }
   return runs;
 }
 
@@ -565,12 +579,12 @@ std::string first_line(const std::string& text) { return text.substr(0, text.fin
 /// The sweep as a table in seed order, then the verdict: "PASS 20/20", or FAIL with the
 /// counts and the seeds not passed, or NOT RUN with the load error.
 void print_sweep(const Exercise& ex, const ExerciseOptions& o, const std::vector<SeedRun>& runs,
-                 std::ostream& out) {
+                 bool interrupted, std::size_t asked, std::ostream& out) {
   out << fmt::format("exercise {}: {}  ({} seed(s))\n", ex.name, ex.title, runs.size());
   out << fmt::format("goal     {}\n", describe_goal(ex));
   out << fmt::format("skill    {} as {}\n", o.skill_file, ex.skill);
   const Outcome verdict = sweep_verdict(runs);
-  if (verdict == Outcome::kNotRun) {  // the same file on every seed: say it once
+  if (verdict == Outcome::kNotRun && !runs.empty()) {  // the same file on every seed: once
     const SeedRun& r = runs.front();
     out << o.skill_file << " does not load\n";
     if (!r.error.empty()) out << "error    " << r.error << "\n";
@@ -619,6 +633,11 @@ void print_sweep(const Exercise& ex, const ExerciseOptions& o, const std::vector
     out << fmt::format("warning  ... and {} more (--json lists each seed's)\n",
                        warnings.size() - kMaxWarnings);
   const std::size_t passed = runs.size() - failed.size();
+  if (interrupted) {
+    out << fmt::format("verdict  INTERRUPTED (Ctrl-C): {} of {} seed(s) played, {} passed\n",
+                       runs.size(), asked, passed);
+    return;
+  }
   if (failed.empty()) {
     out << fmt::format("verdict  PASS {}/{}\n", passed, runs.size());
     return;
@@ -631,7 +650,7 @@ void print_sweep(const Exercise& ex, const ExerciseOptions& o, const std::vector
 
 /// The sweep as one JSON object (the `--json` contract of docs/exercises.md).
 void print_json(const Exercise& ex, const ExerciseOptions& o, const std::vector<SeedRun>& runs,
-                std::ostream& out) {
+                bool interrupted, std::ostream& out) {
   using Json = nlohmann::ordered_json;
   const bool points = ex.goal.kind == Goal::Kind::kPoints;
   Json j;
@@ -665,7 +684,7 @@ void print_json(const Exercise& ex, const ExerciseOptions& o, const std::vector<
   j["runs"] = std::move(list);
   j["passed"] = passed;
   j["total"] = runs.size();
-  j["verdict"] = outcome_name(sweep_verdict(runs));
+  j["verdict"] = interrupted ? "INTERRUPTED" : outcome_name(sweep_verdict(runs));
   // A participant's file may hold any bytes; invalid UTF-8 in a message becomes U+FFFD.
   out << j.dump(-1, ' ', false, Json::error_handler_t::replace) << "\n";
 }
@@ -725,13 +744,17 @@ int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err)
 
   // One game as it is played, or a sweep's table, or JSON.
   if (!sweep && !o.json) return play_seed(ex, o, seeds.front(), out, err).code;
-  const std::vector<SeedRun> runs = play_seeds(ex, o, seeds, err);
+  bool interrupted = false;
+  const std::vector<SeedRun> runs = play_seeds(ex, o, seeds, err, interrupted);
+  if (interrupted)
+    err << fmt::format("llsfsim exercise: interrupted (Ctrl-C) after {} of {} seed(s)\n",
+                       runs.size(), seeds.size());
   if (o.json) {
-    print_json(ex, o, runs, out);
+    print_json(ex, o, runs, interrupted, out);
   } else {
-    print_sweep(ex, o, runs, out);
+    print_sweep(ex, o, runs, interrupted, seeds.size(), out);
   }
-  return verdict_code(sweep_verdict(runs));
+  return interrupted ? kExitInterrupted : verdict_code(sweep_verdict(runs));
 }
 
 }  // namespace

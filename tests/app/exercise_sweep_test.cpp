@@ -4,15 +4,22 @@
 // (docs/exercises.md) and parses, and a bad --seeds names the token. In the batch tests' binary
 // (label `batch`): the games run on threads, so the tsan preset runs these too.
 #include <doctest/doctest.h>
+#include <unistd.h>
 
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "app/cli_fixture.h"
+#include "batch_progress.h"
 #include "llsf/app/cli.h"
 
 namespace {
@@ -193,6 +200,50 @@ TEST_CASE("exercise --seeds/--json: a file that does not load is NOT RUN, exit 2
   CHECK(o.at("runs")[0].at("result") == "NOT RUN");
   CHECK(o.at("runs")[0].at("value").is_null());
   CHECK(has(o.at("runs")[0].at("error").get<std::string>(), path + ":3:"));
+}
+
+extern "C" void sweep_ignore_sigint(int) {}
+
+TEST_CASE("exercise --seeds: Ctrl-C ends the sweep after the running games, exit 130") {
+  // A private temporary directory: the skill directories (llsfex-*) must all be gone after.
+  const std::filesystem::path tmp =
+      std::filesystem::temp_directory_path() / ("llsf_sweep_sigint_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(tmp);
+  const char* old_tmpdir = std::getenv("TMPDIR");
+  const std::string saved = old_tmpdir != nullptr ? old_tmpdir : "";
+  ::setenv("TMPDIR", tmp.c_str(), 1);
+  // Should the signal come after the command restored the handler, it must not end the tests.
+  const auto old = std::signal(SIGINT, sweep_ignore_sigint);
+  std::atomic<bool> done{false};
+  std::thread ctrl_c([&] {
+    while (!done) {  // as soon as a game has its skill directory, Ctrl-C
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      std::error_code ec;
+      if (std::filesystem::directory_iterator(tmp, ec) == std::filesystem::directory_iterator())
+        continue;
+      std::raise(SIGINT);  // to this thread; the handler sets the command's flag
+      return;
+    }
+  });
+  const Run r = llsfsim({"exercise", LLSF_SOURCE_DIR "/exercises/04-rescue-5-minutes", "--skill",
+                         LLSF_SOURCE_DIR "/tests/app/exercises/rescue.lua", "--seeds", "1-200",
+                         "--jobs", "1", "-q"});
+  done = true;
+  ctrl_c.join();
+  std::signal(SIGINT, old);
+  if (old_tmpdir != nullptr) {
+    ::setenv("TMPDIR", saved.c_str(), 1);
+  } else {
+    ::unsetenv("TMPDIR");
+  }
+  INFO(r.out, r.err);
+  CHECK(r.code == llsf::app::kExitInterrupted);
+  CHECK(has(r.err, "llsfsim exercise: interrupted (Ctrl-C) after "));
+  CHECK(has(r.out, "verdict  INTERRUPTED (Ctrl-C): "));
+  CHECK(has(r.out, " of 200 seed(s) played"));
+  std::error_code ec;
+  CHECK(std::filesystem::is_empty(tmp, ec));
+  std::filesystem::remove_all(tmp, ec);
 }
 
 TEST_CASE("exercise --seeds: bad input names the token, exit 2") {
