@@ -8,7 +8,8 @@
 
 namespace llsf::app {
 
-/// Exit codes of every llsfsim command (and 130: a batch interrupted by Ctrl-C).
+/// Exit codes of every llsfsim command (and 130: a batch, experiment or exercise sweep
+/// interrupted by Ctrl-C).
 inline constexpr int kExitOk = 0;             ///< everything held
 inline constexpr int kExitFailed = 1;         ///< a skill failed / a test case failed
 inline constexpr int kExitBadInput = 2;       ///< the user's error (core::UserError, CLI11)
