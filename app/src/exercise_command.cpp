@@ -122,11 +122,11 @@ const char* outcome_name(Outcome r) {
   return "";
 }
 
-/// What one seed's game came to: the verdict's parts (a row of the table, a `runs` entry of
-/// `--json`).
 /// Warnings kept per seed (SeedRun::warnings).
 constexpr std::size_t kMaxWarnings = 5;
 
+/// What one seed's game came to: the verdict's parts (a row of the table, a `runs` entry of
+/// `--json`).
 struct SeedRun {
   std::uint64_t seed = 0;
   Outcome result = Outcome::kNotRun;
@@ -779,7 +779,7 @@ Action add_exercise_command(CLI::App& app) {
       ->needs(seeds);
   app.add_flag("--json", o->json,
                "Print only one JSON object on stdout: the exercise, each seed's result, value, "
-               "score, error and hint, and the verdict (docs/exercises.md)");
+               "score, error, hint and warnings, and the verdict (docs/exercises.md)");
   app.add_option("--exercises", o->root,
                  "Where the exercises are (default: $LLSF_EXERCISES_DIR, else exercises/ of the "
                  "data directory)");

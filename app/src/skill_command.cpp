@@ -282,8 +282,9 @@ Action add_skill_command(CLI::App& app) {
       ->check(CLI::NonNegativeNumber);
   app.add_flag("--trace", o->trace, "Also print every state change of every skill's FSM");
   app.add_option("--record", o->record,
-                 "Also write the game's recording to FILE (gzip JSON lines; replay it with "
-                 "llsfsim view FILE): poses, events, the skill's states and log lines");
+                 "Also write the game's recording to FILE (gzip JSON lines: poses, events, the "
+                 "skill's states and log lines); replay it with llsfsim serve --recordings DIR "
+                 "at http://127.0.0.1:8080/#/file/FILE");
   app.add_flag("-q,--quiet", o->quiet, "Only status changes, warnings and errors");
   app.add_flag("--list", o->list, "List the skills with their documentation and exit");
   return [o](std::ostream& out, std::ostream& err) {
