@@ -225,9 +225,10 @@ TEST_CASE("exercise --seeds: Ctrl-C ends the sweep after the running games, exit
       return;
     }
   });
-  const Run r = llsfsim({"exercise", LLSF_SOURCE_DIR "/exercises/04-rescue-5-minutes", "--skill",
-                         LLSF_SOURCE_DIR "/tests/app/exercises/rescue.lua", "--seeds", "1-200",
-                         "--jobs", "1", "-q"});
+  const std::string exercise = LLSF_SOURCE_DIR "/exercises/04-rescue-5-minutes";
+  const std::string skill = LLSF_SOURCE_DIR "/tests/app/exercises/rescue.lua";
+  const Run r =
+      llsfsim({"exercise", exercise, "--skill", skill, "--seeds", "1-200", "--jobs", "1", "-q"});
   done = true;
   ctrl_c.join();
   std::signal(SIGINT, old);
