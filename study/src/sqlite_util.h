@@ -131,7 +131,7 @@ class Statement {
 
   sqlite3* db_;
   const std::string* path_;
-  std::string_view context_;
+  std::string context_;
   std::unique_ptr<sqlite3_stmt, StmtFinalizer> stmt_;
   int next_ = 1;
 };
