@@ -541,7 +541,9 @@ std::vector<SeedRun> play_seeds(const Exercise& ex, const ExerciseOptions& o,
     }
   }
   if (error) std::rethrow_exception(error);
-  interrupted = SigintGuard::interrupted();
+  // (a Ctrl-C while the last games ran, with every seed played, leaves a whole sweep)
+  interrupted = SigintGuard::interrupted() &&
+                std::count(ended_ok.begin(), ended_ok.end(), 1) < static_cast<long>(seeds.size());
   if (interrupted) {
     std::vector<SeedRun> ran;
     for (std::size_t i = 0; i < runs.size(); ++i) {
