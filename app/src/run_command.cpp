@@ -449,7 +449,8 @@ std::vector<std::string> agent_warnings(const study::RobotSpec& spec,
       read_paths.push_back((*it)[1].str());
     }
     if (src.code.find("resource-request") != std::string::npos ||
-        src.code.find("(lock ") != std::string::npos) {
+        src.code.find("(lock ") != std::string::npos ||
+        src.code.find("(lock-assert ") != std::string::npos) {
       uses_locks = true;
     }
   }

@@ -1117,6 +1117,7 @@ std::string compress_error(std::string_view raw) {
 }  // namespace
 
 std::vector<LoadError> Environment::load(const std::string& text) {
+  ++code_version_;
   loading_ = true;
   load_errors_.clear();
   error_starts_.clear();
@@ -1261,9 +1262,50 @@ void Environment::set_global(const std::string& name, const Value& v) {
 }
 
 Value Environment::eval(const std::string& expression) {
+  ++code_version_;
   DATA_OBJECT d;
   if (!EnvEval(env_, expression.c_str(), &d)) return {};
   return to_value(env_, d);
+}
+
+bool Environment::construct_texts(std::vector<std::string>& out) const {
+  out.clear();
+  bool complete = true;
+  // Rules, functions and methods without a text could match or query anything; the others
+  // without one are the system's (initial-fact, initial-object, the system classes' handlers).
+  auto take = [&](const char* text, bool needed) {
+    if (text != nullptr) {
+      out.emplace_back(text);
+    } else if (needed) {
+      complete = false;
+    }
+  };
+  void* const current = EnvGetCurrentModule(env_);
+  for (void* m = EnvGetNextDefmodule(env_, nullptr); m != nullptr;
+       m = EnvGetNextDefmodule(env_, m)) {
+    EnvSetCurrentModule(env_, m);
+    for (void* r = EnvGetNextDefrule(env_, nullptr); r; r = EnvGetNextDefrule(env_, r))
+      take(EnvGetDefrulePPForm(env_, r), true);
+    for (void* f = EnvGetNextDeffunction(env_, nullptr); f; f = EnvGetNextDeffunction(env_, f))
+      take(EnvGetDeffunctionPPForm(env_, f), true);
+    for (void* g = EnvGetNextDefgeneric(env_, nullptr); g; g = EnvGetNextDefgeneric(env_, g)) {
+      for (long i = EnvGetNextDefmethod(env_, g, 0); i != 0; i = EnvGetNextDefmethod(env_, g, i))
+        take(EnvGetDefmethodPPForm(env_, g, i), true);
+    }
+    for (void* d = EnvGetNextDeffacts(env_, nullptr); d; d = EnvGetNextDeffacts(env_, d))
+      take(EnvGetDeffactsPPForm(env_, d), false);
+    for (void* g = EnvGetNextDefglobal(env_, nullptr); g; g = EnvGetNextDefglobal(env_, g))
+      take(EnvGetDefglobalPPForm(env_, g), false);
+    for (void* c = EnvGetNextDefclass(env_, nullptr); c; c = EnvGetNextDefclass(env_, c)) {
+      for (int i = EnvGetNextDefmessageHandler(env_, c, 0); i != 0;
+           i = EnvGetNextDefmessageHandler(env_, c, i))
+        take(EnvGetDefmessageHandlerPPForm(env_, c, i), false);
+    }
+    for (void* d = EnvGetNextDefinstances(env_, nullptr); d; d = EnvGetNextDefinstances(env_, d))
+      take(EnvGetDefinstancesPPForm(env_, d), false);
+  }
+  EnvSetCurrentModule(env_, current);
+  return complete;
 }
 
 std::vector<FactCopy> Environment::facts(std::string_view template_name) const {

@@ -169,6 +169,9 @@ class Environment {
 
   /// Loads constructs from `text`; returns the errors (empty on success). Lines count from 1.
   std::vector<LoadError> load(const std::string& text);
+  /// Counts the calls that may have added constructs: load(), build() and eval() (a rule's
+  /// own (build) is not counted).
+  std::uint64_t code_version() const { return code_version_; }
   /// Builds one construct (for built-in code that needs no line numbers); throws on error.
   void build(const std::string& construct);
 
@@ -243,6 +246,10 @@ class Environment {
   void set_global(const std::string& name, const Value& v);
   /// Evaluates an expression (slow path, tests and tools).
   Value eval(const std::string& expression);
+  /// The pretty-print forms of every rule, function, generic function method, deffacts,
+  /// defglobal, message-handler and definstances (in no particular order), into `out`; false
+  /// if one has none (a construct whose text CLIPS did not keep).
+  bool construct_texts(std::vector<std::string>& out) const;
   /// All facts of `template_name` (all facts if empty), in fact-list order.
   std::vector<FactCopy> facts(std::string_view template_name) const;
 
@@ -278,6 +285,7 @@ class Environment {
   struct SizeGuard;
 
   void* env_ = nullptr;
+  std::uint64_t code_version_ = 0;
   OutputHandler output_;
   std::deque<FunctionEntry> functions_;  // stable addresses: CLIPS holds pointers to them
   std::map<std::string, std::string, std::less<>> forbidden_;  // forbid_function: name -> why

@@ -51,6 +51,27 @@ class LocksFeature final : public Feature {
       if (sh.state == LockState::kNone) assert_lock(env, "RELEASE_RVCD", r, false);
       return Value{};
     });
+    // (lock-assert GET|RELEASE R): asserts this robot's (lock (type ...) (agent ...) (resource R))
+    // for agent code that must also load without the lock template (locks off), without
+    // parsing the fact from a string in every call as assert-string does.
+    env.define_function("lock-assert", "22k", [this, &env](Args& a) {
+      std::string_view type;
+      std::string_view r;
+      if (!a.text(0, type) || (type != "GET" && type != "RELEASE")) {
+        env.error(a.function(), "the type must be GET or RELEASE");
+        return Value::boolean(false);
+      }
+      if (!a.text(1, r) || r.empty()) {
+        env.error(a.function(), "the resource must be a symbol or string");
+        return Value::boolean(false);
+      }
+      if (!mgr_) {
+        env.error(a.function(), "locks are off (AgentConfig::locks)");
+        return Value::boolean(false);
+      }
+      assert_lock(env, type == "GET" ? "GET" : "RELEASE", r, false);
+      return Value::boolean(true);
+    });
     // (lock-state R): NONE, REQUESTED, ACCEPTED, REFUSED or RELEASING.
     env.define_function("lock-state", "11k", [this, &env](Args& a) {
       std::string_view r;

@@ -13,10 +13,12 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <unordered_map>
 
 #include "feature.h"
 #include "llsf/comm/registry.h"
+#include "message_use.h"
 
 namespace llsf::clips::detail {
 namespace {
@@ -126,10 +128,17 @@ class ProtobufFeature final : public Feature {
   }
 
   void before_run(Environment& env) override {
+    // Which types can match a rule (again after code was loaded): the others make no fact.
+    if (env.code_version() != code_version_) {
+      code_version_ = env.code_version();
+      std::vector<std::string> texts;
+      matched_ = env.construct_texts(texts) ? matched_message_types(texts) : std::nullopt;
+    }
     // The slot values are rewritten in place (their strings and lists keep their capacity): no
     // allocation per message once the longest type name and peer name have been seen.
     for (auto& r : s_.inbox) {
       Message* m = r.message.get();
+      if (matched_ && !matched_->contains(m->GetDescriptor()->full_name())) continue;
       add(std::move(r.message), Kind::kReceived, m);
       set_text(slot_type_, Value::Type::kString, m->GetDescriptor()->full_name());
       std::optional<comm::MessageKey> key;
@@ -543,6 +552,10 @@ class ProtobufFeature final : public Feature {
       slot_client_id_ = 0, slot_ptr_ = 0;
   std::vector<Value> values_;
   std::vector<FactHandle> facts_;
+  // The message types some rule can match (std::nullopt: any), for Environment::code_version()
+  // code_version_ (0: not yet).
+  std::optional<TypeNames> matched_;
+  std::uint64_t code_version_ = 0;
   std::unordered_map<const void*, Entry> entries_;
   std::unordered_map<std::string, const Message*> by_name_;
   struct FieldCacheEntry {

@@ -175,27 +175,94 @@ void RayCaster::add_segment(const Vec2& a, const Vec2& b, HitKind kind, int inde
   segments_.push_back({a.x(), a.y(), e.x(), e.y(), 1.0 / len2, kind, index});
 }
 
-RayHit RayCaster::cast(const Vec2& origin, double angle_rad, double max_range_m,
-                       std::span<const Circle> robots, std::span<const Circle> pucks) const {
-  const double dx = std::cos(angle_rad), dy = std::sin(angle_rad);
+namespace {
+
+/// The nearest hit of one ray so far: faces and circles offered in a fixed order, the first of
+/// equally near ones kept.
+struct RayProbe {
+  Vec2 origin;
+  double dx, dy;  ///< the ray's direction (unit)
   double best = kInf;
   HitKind kind = HitKind::kNone;
   int index = -1;
 
-  // Faces seen from their visible side.
-  auto check_face = [&](const Segment& s) {
-    const double wx = s.ax - origin.x(), wy = s.ay - origin.y();
-    const double num = wx * s.ey - wy * s.ex;
-    const double denom = dx * s.ey - dy * s.ex;
+  // A face a -> a + e, seen from its visible side.
+  void face(double ax, double ay, double ex, double ey, HitKind face_kind, int face_index) {
+    const double wx = ax - origin.x(), wy = ay - origin.y();
+    const double num = wx * ey - wy * ex;
+    const double denom = dx * ey - dy * ex;
     if (!(num < 0.0) || !(denom < 0.0)) return;
     const double t = num / denom;
     const double u = (wx * dy - wy * dx) / denom;
     if (u >= -kEdgeSlack && u <= 1.0 + kEdgeSlack && t < best) {
       best = t;
-      kind = s.kind;
-      index = s.index;
+      kind = face_kind;
+      index = face_index;
     }
-  };
+  }
+  // Circles not containing the origin.
+  void circles(std::span<const Circle> cs, HitKind circle_kind) {
+    for (const Circle& c : cs) {
+      const double mx = c.center.x() - origin.x(), my = c.center.y() - origin.y();
+      const double cc = mx * mx + my * my - c.radius * c.radius;
+      if (!(c.radius > 0.0) || !(cc > 0.0)) continue;
+      const double p = mx * dx + my * dy;
+      const double disc = p * p - cc;
+      if (disc < 0.0) continue;
+      const double t = p - std::sqrt(disc);
+      if (t >= 0.0 && t < best) {
+        best = t;
+        kind = circle_kind;
+        index = c.index;
+      }
+    }
+  }
+  RayHit result(double max_range_m) const {
+    if (!(best <= max_range_m)) return {max_range_m, HitKind::kNone, -1};
+    return {best, kind, index};
+  }
+};
+
+}  // namespace
+
+void RayCaster::faces_near(const Vec2& center, double reach_m, std::vector<int>& faces) const {
+  faces.clear();
+  const double reach = reach_m + kCullSlack;
+  for (int k = 0; k < wall_count_; ++k) {
+    const Segment& s = segments_[k];
+    // The wall's point nearest to the centre.
+    const double wx = center.x() - s.ax, wy = center.y() - s.ay;
+    const double u = std::clamp((wx * s.ex + wy * s.ey) * s.inv_len2, 0.0, 1.0);
+    const double qx = wx - u * s.ex, qy = wy - u * s.ey;
+    if (qx * qx + qy * qy <= reach * reach) faces.push_back(k);
+  }
+  // A box's faces when its bounding circle comes within reach (groups_ are in segment order).
+  for (const DeviceGroup& g : groups_) {
+    const double gx = g.cx - center.x(), gy = g.cy - center.y();
+    const double r = reach + g.radius;
+    if (gx * gx + gy * gy > r * r) continue;
+    for (int k = g.first; k < g.first + g.count; ++k) faces.push_back(k);
+  }
+}
+
+RayHit RayCaster::cast_among(const Vec2& origin, double dir_x, double dir_y, double max_range_m,
+                             std::span<const int> faces, std::span<const Circle> robots,
+                             std::span<const Circle> pucks) const {
+  RayProbe ray{origin, dir_x, dir_y};
+  for (const int k : faces) {
+    const Segment& s = segments_[static_cast<std::size_t>(k)];
+    ray.face(s.ax, s.ay, s.ex, s.ey, s.kind, s.index);
+  }
+  ray.circles(robots, HitKind::kRobot);
+  ray.circles(pucks, HitKind::kPuck);
+  return ray.result(max_range_m);
+}
+
+RayHit RayCaster::cast(const Vec2& origin, double angle_rad, double max_range_m,
+                       std::span<const Circle> robots, std::span<const Circle> pucks) const {
+  const double dx = std::cos(angle_rad), dy = std::sin(angle_rad);
+  RayProbe ray{origin, dx, dy};
+  auto check_face = [&](const Segment& s) { ray.face(s.ax, s.ay, s.ex, s.ey, s.kind, s.index); };
   for (int k = 0; k < wall_count_; ++k) check_face(segments_[k]);
   // A box's faces only when the ray, up to max_range_m, passes within its bounding circle
   // (widened by kCullSlack, far more than the faces' kEdgeSlack can reach past a corner): the
@@ -210,29 +277,9 @@ RayHit RayCaster::cast(const Vec2& origin, double angle_rad, double max_range_m,
     if (along < -r || along > max_range_m + r) continue;  // behind the origin, or out of range
     for (int k = g.first; k < g.first + g.count; ++k) check_face(segments_[k]);
   }
-
-  // Circles not containing the origin.
-  auto check_circles = [&](std::span<const Circle> circles, HitKind circle_kind) {
-    for (const Circle& c : circles) {
-      const double mx = c.center.x() - origin.x(), my = c.center.y() - origin.y();
-      const double cc = mx * mx + my * my - c.radius * c.radius;
-      if (!(c.radius > 0.0) || !(cc > 0.0)) continue;
-      const double p = mx * dx + my * dy;
-      const double disc = p * p - cc;
-      if (disc < 0.0) continue;
-      const double t = p - std::sqrt(disc);
-      if (t >= 0.0 && t < best) {
-        best = t;
-        kind = circle_kind;
-        index = c.index;
-      }
-    }
-  };
-  check_circles(robots, HitKind::kRobot);
-  check_circles(pucks, HitKind::kPuck);
-
-  if (!(best <= max_range_m)) return {max_range_m, HitKind::kNone, -1};
-  return {best, kind, index};
+  ray.circles(robots, HitKind::kRobot);
+  ray.circles(pucks, HitKind::kPuck);
+  return ray.result(max_range_m);
 }
 
 void RayCaster::scan(const Vec2& origin, double angle0_rad, double increment_rad, int n,

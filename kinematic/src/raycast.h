@@ -61,6 +61,18 @@ class RayCaster {
   RayHit cast(const Vec2& origin, double angle_rad, double max_range_m,
               std::span<const Circle> robots, std::span<const Circle> pucks) const;
 
+  /// The faces (indices of walls and device faces) that a ray starting within reach_m - r of
+  /// `center` may hit within a range r: the walls within reach_m, and every face of a box whose
+  /// bounding circle comes within reach_m. Written to `faces` in index order, so that
+  /// cast_among() against them gives the same result, ties included, as cast() against all.
+  void faces_near(const Vec2& center, double reach_m, std::vector<int>& faces) const;
+  /// cast() against the listed faces only (from faces_near()), in direction (dir_x, dir_y) =
+  /// (cos, sin) of the ray's angle: several rays from about one place share the selection and
+  /// the trigonometry.
+  RayHit cast_among(const Vec2& origin, double dir_x, double dir_y, double max_range_m,
+                    std::span<const int> faces, std::span<const Circle> robots,
+                    std::span<const Circle> pucks) const;
+
   /// A whole scan: `n` beams at field-frame angles angle0_rad + i * increment_rad (i in [0, n)),
   /// each the distance to the nearest wall, device face or circle, +infinity where nothing lies
   /// within max_range_m. Writes n floats to ranges_out. The increment must be positive (unless

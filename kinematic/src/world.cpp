@@ -150,6 +150,9 @@ struct World::Impl : public b2ContactListener {
   std::vector<Circle> robot_circles;  // scratch, no per-step allocation
   std::vector<Circle> puck_circles;
   std::vector<Circle> other_circles;
+  std::vector<Circle> near_robots;  // the optical sensors' candidates (update_sensors)
+  std::vector<Circle> near_pucks;
+  std::vector<int> near_faces;
   std::vector<int> pending_zone_check;  // pucks added/teleported/removed since the last step
 
   Impl(const WorldConfig& c, const core::Rng& rng) : cfg(c), raycaster(c) {
@@ -163,6 +166,9 @@ struct World::Impl : public b2ContactListener {
     events.collisions.reserve(64);
     robot_circles.reserve(cfg.robots.size());
     other_circles.reserve(cfg.robots.size());
+    near_robots.reserve(cfg.robots.size());
+    near_pucks.reserve(cfg.pucks.size() + 16);
+    near_faces.reserve(static_cast<std::size_t>(raycaster.segment_count()));
     puck_circles.reserve(cfg.pucks.size() + 16);
     pending_zone_check.reserve(16);
     for (int d = 0; d < kDeviceCount; ++d) {
@@ -516,6 +522,34 @@ struct World::Impl : public b2ContactListener {
     return other_circles;
   }
 
+  // The other robots and the pucks that a ray starting within `reach_m` - range of the robot's
+  // centre could hit within its range: the rest lie beyond every such ray's range, where a hit
+  // counts as none, so a cast against these alone gives the same result (in the same order,
+  // for the same ties) as one against all.
+  void near_circles(const Robot& self, double reach_m) {
+    const b2Vec2 c = self.body->GetPosition();
+    const double cx = c.x, cy = c.y;
+    const auto within = [cx, cy](const b2Vec2& q, double r2) {
+      const double dx = double(q.x) - cx, dy = double(q.y) - cy;
+      return dx * dx + dy * dy <= r2;
+    };
+    const double rr = reach_m + cfg.robot.radius_m + 1e-6, rp = reach_m + cfg.puck.radius_m + 1e-6;
+    const double robot_r2 = rr * rr, puck_r2 = rp * rp;
+    near_robots.clear();
+    for (int i = 0; i < static_cast<int>(robots.size()); ++i) {
+      if (&robots[i] == &self) continue;
+      const b2Vec2& q = robots[i].body->GetPosition();
+      if (within(q, robot_r2)) near_robots.push_back({from_b2(q), cfg.robot.radius_m, i});
+    }
+    near_pucks.clear();
+    for (int i = 0; i < static_cast<int>(pucks.size()); ++i) {
+      const Puck& p = pucks[i];
+      if (p.removed) continue;
+      const b2Vec2& q = p.body->GetPosition();
+      if (within(q, puck_r2)) near_pucks.push_back({from_b2(q), cfg.puck.radius_m, i});
+    }
+  }
+
   void update_sensors(Robot& r) {
     const SensorsConfig& sc = cfg.sensors;
     RobotSensors& s = r.sensors;
@@ -579,14 +613,19 @@ struct World::Impl : public b2ContactListener {
       s.ir.puck_detected = d < ic.threshold_m;
     }
     if (r.optical_s.due(now)) {
-      need_circles();
       const OpticalConfig& oc = sc.optical;
       const HolderConfig& hc = cfg.robot.holder;
       const double tip = cfg.robot.radius_m + hc.arm_length_m;
       const double yc = 0.5 * hc.inner_width_m + 0.5 * hc.arm_thickness_m;
+      // Both rays start within `reach` - range of the robot's centre and share its heading.
+      const double reach = Vec2(tip + 1e-4, yc).norm() + oc.range_m;
+      near_circles(r, reach);
+      raycaster.faces_near(pose.position(), reach, near_faces);
+      const double dx = std::cos(pose.theta), dy = std::sin(pose.theta);
       auto fire = [&](double side) {
         const Vec2 o = pose.to_parent({tip + 1e-4, side * yc});
-        const RayHit hit = raycaster.cast(o, pose.theta, oc.range_m, others(r), puck_circles);
+        const RayHit hit =
+            raycaster.cast_among(o, dx, dy, oc.range_m, near_faces, near_robots, near_pucks);
         if (hit.kind == HitKind::kNone) return false;
         return !r.optical_rng.bernoulli(oc.miss_probability);
       };

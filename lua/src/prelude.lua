@@ -607,15 +607,12 @@ local function holds(c, st, fsm)
   return c(st, fsm.vars, fsm)
 end
 
-local function check(tr, st, fsm, now)
-  if tr.timeout_ns and now - st.entered_ns >= tr.timeout_ns then return true end
-  return tr.cond ~= nil and holds(tr.cond, st, fsm) and true or false
-end
-
 -- Sub-skills of a SkillJumpState: next state and error text once they are done.
 local function run_subskills(fsm, st)
   local all_final = true
-  for _, sk in ipairs(st.skills) do
+  local skills = st.skills
+  for i = 1, #skills do
+    local sk = skills[i]
     local h = sk.handle
     local status = call_skill(h, st.args[h.name] or sk.static or fsm.vars)
     if status == S_FAILED then
@@ -703,8 +700,10 @@ local function watch_spin(fsm, now, path, trs, progress)
              tr.from or "*", tr.to.name, tr.cond == true and "cond=true" or tr.label))
 end
 
+local cycle_now_ns  -- the game time of the running cycle (E.run_cycle)
+
 local function fsm_step(fsm)
-  local now = now_ns()
+  local now = cycle_now_ns
   fsm.step_id = fsm.step_id + 1
   local st = fsm.current or enter(fsm, fsm.states[fsm.start], now)
   -- The states passed and the transitions taken (for watch_spin), made on the first
@@ -721,15 +720,20 @@ local function fsm_step(fsm)
         progress = true
         to, err = run_subskills(fsm, st)
       end
-      if not to then
-        for _, t in ipairs(st.transitions) do
-          if check(t, st, fsm, now) then to, tr = t.to, t; break end
+      -- The state's transitions, then the defaults: the first whose timeout passed or whose
+      -- condition holds (written out, no call per transition: this runs in every step).
+      local list = not to and st.transitions or nil
+      while list do
+        for i = 1, #list do
+          local t = list[i]
+          local c = t.cond
+          if (t.timeout_ns and now - st.entered_ns >= t.timeout_ns) or c == true or
+             (c ~= nil and c(st, fsm.vars, fsm)) then
+            to, tr = t.to, t
+            break
+          end
         end
-      end
-      if not to then
-        for _, t in ipairs(fsm.defaults) do
-          if check(t, st, fsm, now) then to, tr = t.to, t; break end
-        end
+        list = not to and list ~= fsm.defaults and fsm.defaults or nil
       end
     else
       to = fsm.failed  -- the skill set fsm.error: failure
@@ -805,8 +809,11 @@ call_skill = function(h, args)
     error(fmt("skill '%s' is not available: %s", h.name, h.load_error), 0)
   end
   if h.in_call then error(fmt("recursive call of skill '%s'", h.name), 0) end
-  if args ~= nil and type(args) ~= "table" then
-    error(fmt("skill '%s': arguments must be a table, e.g. %s{key=value}", h.name, h.name), 0)
+  if args ~= nil and args ~= h.args_seen then  -- (a sub-skill gets the same table each step)
+    if type(args) ~= "table" then
+      error(fmt("skill '%s': arguments must be a table, e.g. %s{key=value}", h.name, h.name), 0)
+    end
+    h.args_seen = args
   end
   if not h.active then
     local vars = {}
@@ -823,7 +830,13 @@ call_skill = function(h, args)
   end
   local outer = caller
   caller, h.in_call, depth = h, true, depth + 1
-  local ok, status, err = raw_pcall(step, h)
+  local fsm, ok, status, err = h.fsm, nil, nil, nil
+  if fsm then  -- step(h), one call less
+    ok, status = raw_pcall(fsm_step, fsm)
+    if ok then err = fsm.error end
+  else
+    ok, status, err = raw_pcall(step, h)
+  end
   caller, h.in_call, depth = outer, false, depth - 1
   if ok then
     h.status = status
@@ -983,11 +996,13 @@ end
 
 function E.run_cycle(chunk)
   cycle_id = cycle_id + 1
+  cycle_now_ns = now_ns()
   for i = #called, 1, -1 do called[i] = nil end
   depth, caller = 0, nil
   chunk()
   local status, errors, results = S_FINAL, nil, nil
-  for _, h in ipairs(called) do
+  for i = 1, #called do
+    local h = called[i]
     local r = h.fsm and h.fsm.result
     if r ~= nil and type(r) ~= "string" and type(r) ~= "number" then  -- only by rawset
       h.status = S_FAILED

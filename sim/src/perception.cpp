@@ -125,7 +125,11 @@ void LightDetection::update(SimTime now, const core::Pose2D& truth,
   }
 }
 
-int LightDetection::device_in_front(const core::Pose2D& pose, bool vision) const {
+int LightDetection::device_in_front(const core::Pose2D& pose, bool vision) {
+  if (front_.device != -2 && front_.vision == vision && front_.pose.x == pose.x &&
+      front_.pose.y == pose.y && front_.pose.theta == pose.theta) {
+    return front_.device;
+  }
   int best = -1;
   double best_d = 0.0;
   const double range2_margin = c_.range_m * c_.range_m * (1.0 + 1e-9) + 1e-12;
@@ -153,6 +157,7 @@ int LightDetection::device_in_front(const core::Pose2D& pose, bool vision) const
       best_d = dist;
     }
   }
+  front_ = {pose, vision, best};
   return best;
 }
 
@@ -273,11 +278,17 @@ PuckVision::PuckVision(const PuckDetectionConfig& config) : c_(config) {
 }
 
 void PuckVision::update(SimTime now, const core::Pose2D& truth, std::span<const core::Vec2> pucks) {
-  // Field -> robot frame with one sine and cosine per robot (this runs every tick).
-  const double cs = std::cos(truth.theta);
-  const double sn = std::sin(truth.theta);
+  // Field -> robot frame with one sine and cosine per robot, once a puck is near enough (this
+  // runs every tick; mostly no puck is).
+  double cs = 0.0, sn = 0.0;
+  bool turned = false;
   const core::Vec2 me = truth.position();
   auto local = [&](const core::Vec2& d) {
+    if (!turned) {
+      cs = std::cos(truth.theta);
+      sn = std::sin(truth.theta);
+      turned = true;
+    }
     return core::Vec2(cs * d.x() + sn * d.y(), -sn * d.x() + cs * d.y());
   };
   if (c_.level == DetectionLevel::kGroundTruth) {

@@ -246,6 +246,43 @@ TEST_CASE("raycast: cast matches the brute-force reference, also with short rang
   CHECK(mismatches == 0);
 }
 
+TEST_CASE("raycast: cast_among the faces near a centre is cast, ties and misses included") {
+  // The optical sensors cast two short rays from about one place: faces_near() keeps the faces
+  // within reach of the robot's centre, and cast_among() must give exactly what cast() gives.
+  const WorldConfig config = field_2013();
+  const RayCaster caster(config);
+  llsf::core::RandomStream rng(20261126);
+  const double w = config.field.width_m, h = config.field.height_m;
+  std::vector<int> faces;
+  int hits = 0, culled = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const DeviceConfig& d = config.devices[static_cast<std::size_t>(
+        rng.uniform_int(0, static_cast<std::int64_t>(config.devices.size()) - 1))];
+    const Vec2 centre =
+        trial % 3 == 0 ? Vec2(rng.uniform(0.05, w - 0.05), rng.uniform(0.05, h - 0.05))
+                       : Vec2(d.pose.x + rng.uniform(-0.8, 0.8), d.pose.y + rng.uniform(-0.8, 0.8));
+    const double start = rng.uniform(0.0, 0.3), range = rng.uniform(0.01, 0.6);
+    const Vec2 origin = centre + llsf::core::unit(rng.uniform(-kPi, kPi)) * start;
+    const double angle = rng.uniform(-kPi, kPi);
+    const std::vector<Circle> robots = {
+        {centre + Vec2(rng.uniform(-1, 1), rng.uniform(-1, 1)), 0.185, 4}};
+    const std::vector<Circle> pucks = {
+        {origin + llsf::core::unit(angle) * rng.uniform(0.0, 0.7), 0.0375, 7},
+        {centre + Vec2(rng.uniform(-1, 1), rng.uniform(-1, 1)), 0.0375, 9}};
+    caster.faces_near(centre, start + range, faces);
+    culled += caster.segment_count() - static_cast<int>(faces.size());
+    const RayHit all = caster.cast(origin, angle, range, robots, pucks);
+    const RayHit near =
+        caster.cast_among(origin, std::cos(angle), std::sin(angle), range, faces, robots, pucks);
+    if (all.kind != HitKind::kNone) ++hits;
+    REQUIRE(near.kind == all.kind);
+    REQUIRE(near.index == all.index);
+    REQUIRE(near.distance_m == all.distance_m);
+  }
+  CHECK(hits > 5000);
+  CHECK(culled > 20000 * (caster.segment_count() / 2));  // most faces are left out
+}
+
 TEST_CASE("raycast: scan matches the brute-force reference from random poses") {
   const WorldConfig config = field_2013();
   const RayCaster caster(config);

@@ -29,11 +29,6 @@
   (do-for-all-facts ((?g resource-granted)) (eq ?g:resource ?res) (retract ?g))
 )
 
-; The lock facts are built as strings: the lock template exists only with the protocol on.
-(deffunction lock-fact (?type ?res)
-  (assert-string (str-cat "(lock (type " ?type ") (agent " ?*ROBOT-NAME* ") (resource " ?res "))"))
-)
-
 (defrule locks-on-request
   (declare (salience ?*PRIORITY-TASK*))
   ?r <- (resource-request (resource ?res))
@@ -46,7 +41,9 @@
     (assert (resource-denied (resource ?res)))
    else
     (assert (resource-pending (resource ?res)))
-    (lock-fact GET ?res))
+    ; (the host asserts (lock (type GET) (agent ...) (resource ?res)): the lock template exists
+    ; only with the protocol on, so these rules cannot name it)
+    (lock-assert GET ?res))
 )
 
 (defrule locks-on-answer
@@ -71,7 +68,7 @@
   (retract ?r)
   (do-for-all-facts ((?g resource-granted)) (eq ?g:resource ?res) (retract ?g))
   (do-for-all-facts ((?g resource-pending)) (eq ?g:resource ?res) (retract ?g))
-  (lock-fact RELEASE ?res)
+  (lock-assert RELEASE ?res)
 )
 
 ; Waiting for a lock next to a resource this robot is still releasing (a release goes out only

@@ -76,8 +76,9 @@ class LightDetection {
                      std::span<const kinematic::SignalLights> lights);
   /// The nearest device whose front is in front of `pose` (within the range and the heading
   /// cone, with the robot on the front's side); with `vision` the robot must also stand within
-  /// the facing cone of the device. -1 if none.
-  int device_in_front(const core::Pose2D& pose, bool vision) const;
+  /// the facing cone of the device. -1 if none. The last answer is kept: a robot standing
+  /// still (the same pose to the bit) is answered without looking at the devices again.
+  int device_in_front(const core::Pose2D& pose, bool vision);
   void set(const lua::LightReading& r, SimTime now);
 
   LightDetectionConfig c_;
@@ -94,6 +95,12 @@ class LightDetection {
   std::vector<Frame> frames_;  ///< ring buffer of vision frames awaiting their delay
   int frame_head_ = 0;         ///< index of the oldest frame
   int frame_count_ = 0;
+  struct FrontAnswer {
+    core::Pose2D pose;
+    bool vision = false;
+    int device = -2;  ///< -2: none kept yet
+  };
+  FrontAnswer front_;  ///< device_in_front()'s last answer
 };
 
 /// The puck detection (PuckDetectionConfig): every puck in range (ground truth), or the camera
