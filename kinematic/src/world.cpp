@@ -746,6 +746,12 @@ bool World::has_puck(PuckId puck) const {
 Vec2 World::puck_position(PuckId puck) const {
   return from_b2(impl_->pucks[impl_->puck_at(puck)].body->GetPosition());
 }
+void World::puck_positions(std::vector<Vec2>& out) const {
+  // `pucks` and `puck_ids` grow together; a removed puck leaves only `puck_ids`.
+  for (const auto& p : impl_->pucks) {
+    if (!p.removed) out.push_back(from_b2(p.body->GetPosition()));
+  }
+}
 bool World::any_puck_within(const Vec2& point, double distance_m) const {
   for (const auto& p : impl_->pucks) {
     if (!p.removed && (from_b2(p.body->GetPosition()) - point).norm() < distance_m) return true;
@@ -808,6 +814,7 @@ SignalLights World::lights(DeviceId device) const {
   LLSF_DEMAND(device.valid() && device.value() < kDeviceCount);
   return impl_->lights[device.value()];
 }
+std::span<const SignalLights, kDeviceCount> World::all_lights() const { return impl_->lights; }
 
 std::uint64_t World::state_hash() const {
   std::uint64_t h = core::kFnvOffset;

@@ -469,16 +469,13 @@ void Game::step() {
   mark(4);
 
   // 6. Sensors: what each robot perceives, at its abstraction levels.
-  for (int i = 0; i < kinematic::kDeviceCount; ++i) {
-    lights_[static_cast<std::size_t>(i)] = world_->lights(core::DeviceId(i));
-  }
+  const auto lights = world_->all_lights();
+  std::copy(lights.begin(), lights.end(), lights_.begin());
   puck_positions_.clear();
   puck_colours_.clear();
-  for (const core::PuckId p : world_->pucks()) {
-    // World::pucks() also lists removed pucks (see docs/sim.md, "Notes on other modules").
-    if (!world_->has_puck(p)) continue;
-    puck_positions_.push_back(world_->puck_position(p));
-    if (config_.hackathon_layout) {
+  world_->puck_positions(puck_positions_);
+  if (config_.hackathon_layout) {
+    for (const core::PuckId p : world_->pucks()) {
       const auto id = static_cast<std::size_t>(p.value());
       puck_colours_.push_back(id < puck_colour_by_id_.size() ? puck_colour_by_id_[id] : -1);
     }

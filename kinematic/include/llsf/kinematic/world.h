@@ -100,6 +100,9 @@ class World {
   std::span<const PuckId> pucks() const;
   bool has_puck(PuckId puck) const;
   Vec2 puck_position(PuckId puck) const;
+  /// Appends the positions of the pucks in the world to `out`, in pucks() order (one pass, no
+  /// look-ups).
+  void puck_positions(std::vector<Vec2>& out) const;
   /// True if the centre of a puck in the world is closer than `distance_m` to `point`
   /// (|position - point| < distance_m; one pass, no look-ups).
   bool any_puck_within(const Vec2& point, double distance_m) const;
@@ -120,6 +123,8 @@ class World {
   // --- devices ------------------------------------------------------------------------------
   void set_lights(DeviceId device, const SignalLights& lights);
   SignalLights lights(DeviceId device) const;
+  /// Every device's lamps, in DeviceId order.
+  std::span<const SignalLights, kDeviceCount> all_lights() const;
 
   /// FNV-1a hash over time, every body's pose and velocity and every robot's odometry state:
   /// equal hashes after equal steps mean equal games.
