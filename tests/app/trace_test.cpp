@@ -25,7 +25,9 @@ void write_scenario(const TempDir& dir) {
          "(defrule go ?s <- (state IDLE) (machine (name ?m) (mtype T1)) (time ?sec ?)\n"
          "  (test (>= ?sec 1))\n"
          "  => (retract ?s) (assert (state GOTO ?m)) (printout t \"going to \" ?m crlf)\n"
-         "  (skill-call drive_to place ?m))\n";
+         "  (skill-call drive_to place ?m))\n"
+         "(defrule game-state ?pf <- (protobuf-msg (type \"llsf_msgs.GameState\")) =>\n"
+         "  (retract ?pf))\n";
   std::ofstream(dir.file("s.yaml")) << "name: trace\nduration_s: 2\nstart: production\n"
                                        "robots: {count: 2, agent: [agent]}\n";
 }
@@ -51,6 +53,11 @@ TEST_CASE("run --trace prints firings with matched facts, fact changes, skills a
   // same game gives the same trace.
   CHECK(has(r.err, "(ptr <Pointer-C>)"));
   CHECK_FALSE(has(r.err, "<Pointer-C-"));
+  // Only the types a rule can match become facts (docs/clips.md, "Protobuf"); the message trace
+  // shows every message.
+  CHECK(has(r.err, "(protobuf-msg (type \"llsf_msgs.GameState\")"));
+  CHECK(has(r.err, "] robot1 msg <- robot2 BeaconSignal"));
+  CHECK_FALSE(has(r.err, "(protobuf-msg (type \"llsf_msgs.BeaconSignal\")"));
   const auto again =
       llsfsim({"run", dir.file("s.yaml"), "--no-db", "--no-record", "--trace", "robot1"});
   CHECK(again.err == r.err);
