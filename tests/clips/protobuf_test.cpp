@@ -6,6 +6,7 @@
 #include <llsf_agent_msgs/Worldmodel.pb.h>
 
 #include "llsf/clips/testing.h"
+#include "llsf/clips/trace.h"
 #include "llsf/comm/registry.h"
 
 using namespace llsf;
@@ -215,4 +216,61 @@ TEST_CASE("pb-unchanged tells a message that repeats the last one with the same 
   a.start(f.now());
   f.load("(defglobal ?*d* = (pb-create \"llsf_agent_msgs.Worldmodel\"))");
   CHECK(a.eval("(pb-unchanged ?*d* robot5)").is_symbol("FALSE"));
+}
+
+// Messages of a type no rule can match make no fact (docs/clips.md, "Protobuf"; the analysis of
+// the rules' texts: message_use_test.cpp).
+namespace {
+
+std::unique_ptr<llsf_agent_msgs::Worldmodel> worldmodel() {
+  auto m = std::make_unique<llsf_agent_msgs::Worldmodel>();
+  m->set_sender("robot2");
+  m->set_seq(7);
+  return m;
+}
+
+/// The protobuf-msg facts asserted while `f` steps once with both messages received.
+std::vector<std::string> message_facts(AgentFixture& f) {
+  std::vector<std::string> seen;
+  f.agent().set_trace({.facts = true}, [&seen](const TraceEvent& e) {
+    if (e.kind == TraceEvent::Kind::kCycleEnd) return;
+    const std::string line = trace_line(e);
+    if (line.find("==> ") != std::string::npos && line.find("(protobuf-msg") != std::string::npos)
+      seen.push_back(line.find("LockMessage") != std::string::npos ? "LockMessage" : "Worldmodel");
+  });
+  f.agent().receive(lock("robot2", "M1"), "robot2", 2, f.now());
+  f.agent().receive(worldmodel(), "robot2", 2, f.now());
+  f.step();
+  f.agent().set_trace({}, {});
+  return seen;
+}
+
+}  // namespace
+
+TEST_CASE("message use: a message no rule can match makes no fact, the others do") {
+  const auto reg = agent_registry();
+  AgentFixture f({}, &reg);
+  f.load(
+      "(defrule wm ?pf <- (protobuf-msg (type \"llsf_agent_msgs.Worldmodel\") (ptr ?p)) =>\n"
+      "  (retract ?pf) (assert (wm-seq (pb-field-value ?p \"seq\"))))\n");
+  f.step();
+  CHECK(message_facts(f) == std::vector<std::string>{"Worldmodel"});
+  CHECK(f.has("(wm-seq 7)"));
+  CHECK(f.agent().live_messages() == 0);  // the skipped message is freed as well
+
+  // A rule loaded later that reads lock messages gets them from the next cycle on.
+  f.load(
+      "(defrule lk ?pf <- (protobuf-msg (type \"llsf_agent_msgs.LockMessage\")) =>\n"
+      "  (retract ?pf) (assert (got-lock)))\n");
+  CHECK(message_facts(f) == std::vector<std::string>{"LockMessage", "Worldmodel"});
+  CHECK(f.has("(got-lock)"));
+
+  // A fact query over all messages: every message is a fact again.
+  AgentFixture g({}, &reg);
+  g.load(
+      "(defrule count (protobuf-msg (type \"llsf_agent_msgs.LockMessage\")) =>\n"
+      "  (assert (n (length$ (find-all-facts ((?m protobuf-msg)) TRUE)))))\n");
+  g.step();
+  CHECK(message_facts(g) == std::vector<std::string>{"LockMessage", "Worldmodel"});
+  CHECK(g.has("(n 2)"));
 }
