@@ -220,6 +220,34 @@ TEST_CASE("a one-robot team locks for itself") {
   CHECK(f.agent().runtime_errors() == 0);
 }
 
+TEST_CASE("lock-assert asserts the robot's own GET and RELEASE facts") {
+  AgentConfig c;
+  c.robot_name = "robot1";
+  c.locks = true;
+  c.lock_config.team_size = 1;
+  const auto reg = agent_registry();
+  AgentFixture f(c, &reg);
+  f.load(kProbeRvcd, "probe-rvcd.clp");
+  f.steps(100);
+  REQUIRE(f.has("(lock-role MASTER)"));
+  CHECK(f.agent().eval("(lock-assert GET M5)").is_symbol("TRUE"));
+  CHECK(f.find("lock", {{"type", Value::symbol("GET")},
+                        {"agent", Value::symbol("robot1")},
+                        {"resource", Value::symbol("M5")}})
+            .size() == 1);
+  f.step();
+  CHECK(f.find("lock", {{"type", Value::symbol("ACCEPT")}}).size() == 1);
+  CHECK(f.agent().eval("(lock-assert RELEASE M5)").is_symbol("TRUE"));
+  f.step();
+  f.step();
+  CHECK(f.has("(released M5)"));
+  CHECK(f.agent().runtime_errors() == 0);
+  // Only the robot's own requests: another type is an error naming the allowed ones.
+  f.agent().eval("(lock-assert ACCEPT M5)");
+  CHECK(f.agent().runtime_errors() == 1);
+  CHECK(f.logged("the type must be GET or RELEASE"));
+}
+
 TEST_CASE("locks are off by default") {
   const auto reg = agent_registry();
   AgentFixture f({}, &reg);
@@ -240,6 +268,8 @@ TEST_CASE("locks are off by default") {
   f.agent().eval("(lock-request M1)");
   CHECK(f.agent().runtime_errors() == 1);
   CHECK(f.logged("locks are off"));
+  f.agent().eval("(lock-assert GET M1)");
+  CHECK(f.agent().runtime_errors() == 2);
 }
 
 // The lock trap (issue #15): CLIPS ignores the assert of a fact identical to an existing one, so
