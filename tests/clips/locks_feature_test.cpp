@@ -5,6 +5,7 @@
 #include <doctest/doctest.h>
 #include <llsf_agent_msgs/LockMessage.pb.h>
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -209,40 +210,33 @@ TEST_CASE("a one-robot team locks for itself") {
   f.load(kProbeRvcd, "probe-rvcd.clp");
   f.steps(100);  // master after the timeout and back-off, then the quiet period
   CHECK(f.has("(lock-role MASTER)"));
-  f.assert_fact("(lock (type GET) (agent robot1) (resource M5))");
-  f.step();
-  CHECK(f.find("lock", {{"type", Value::symbol("ACCEPT")}}).size() == 1);
-  f.assert_fact("(lock (type RELEASE) (agent robot1) (resource M5))");  // no pose: at once
-  f.step();
-  f.step();
-  CHECK(f.has("(released M5)"));
-  CHECK(f.facts("lock").empty());
-  CHECK(f.agent().runtime_errors() == 0);
-}
-
-TEST_CASE("lock-assert asserts the robot's own GET and RELEASE facts") {
-  AgentConfig c;
-  c.robot_name = "robot1";
-  c.locks = true;
-  c.lock_config.team_size = 1;
-  const auto reg = agent_registry();
-  AgentFixture f(c, &reg);
-  f.load(kProbeRvcd, "probe-rvcd.clp");
-  f.steps(100);
-  REQUIRE(f.has("(lock-role MASTER)"));
-  CHECK(f.agent().eval("(lock-assert GET M5)").is_symbol("TRUE"));
+  // The agent's GET and RELEASE: facts asserted as such, or by (lock-assert) for code that must
+  // also load without the lock template.
+  std::function<void(const char*)> request;
+  SUBCASE("asserted facts") {
+    request = [&f](const char* type) {
+      f.assert_fact(std::string("(lock (type ") + type + ") (agent robot1) (resource M5))");
+    };
+  }
+  SUBCASE("lock-assert") {
+    request = [&f](const char* type) {
+      CHECK(f.agent().eval(std::string("(lock-assert ") + type + " M5)").is_symbol("TRUE"));
+    };
+  }
+  request("GET");
   CHECK(f.find("lock", {{"type", Value::symbol("GET")},
                         {"agent", Value::symbol("robot1")},
                         {"resource", Value::symbol("M5")}})
             .size() == 1);
   f.step();
   CHECK(f.find("lock", {{"type", Value::symbol("ACCEPT")}}).size() == 1);
-  CHECK(f.agent().eval("(lock-assert RELEASE M5)").is_symbol("TRUE"));
+  request("RELEASE");  // no pose: at once
   f.step();
   f.step();
   CHECK(f.has("(released M5)"));
+  CHECK(f.facts("lock").empty());
   CHECK(f.agent().runtime_errors() == 0);
-  // Only the robot's own requests: another type is an error naming the allowed ones.
+  // lock-assert makes only the robot's own requests: another type is an error naming them.
   f.agent().eval("(lock-assert ACCEPT M5)");
   CHECK(f.agent().runtime_errors() == 1);
   CHECK(f.logged("the type must be GET or RELEASE"));
