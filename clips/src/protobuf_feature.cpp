@@ -133,12 +133,13 @@ class ProtobufFeature final : public Feature {
       code_version_ = env.code_version();
       std::vector<std::string> texts;
       matched_ = env.construct_texts(texts) ? matched_message_types(texts) : std::nullopt;
+      wanted_.clear();
     }
     // The slot values are rewritten in place (their strings and lists keep their capacity): no
     // allocation per message once the longest type name and peer name have been seen.
     for (auto& r : s_.inbox) {
       Message* m = r.message.get();
-      if (matched_ && !matched_->contains(m->GetDescriptor()->full_name())) continue;
+      if (matched_ && !wanted(m->GetDescriptor())) continue;
       add(std::move(r.message), Kind::kReceived, m);
       set_text(slot_type_, Value::Type::kString, m->GetDescriptor()->full_name());
       std::optional<comm::MessageKey> key;
@@ -182,6 +183,16 @@ class ProtobufFeature final : public Feature {
   }
 
  private:
+  // Whether a message type can match a rule (matched_ set): decided once per type by name, then
+  // found by its descriptor (a handful of types: a linear scan of pointers).
+  bool wanted(const Descriptor* d) {
+    for (const auto& [type, yes] : wanted_)
+      if (type == d) return yes;
+    const bool yes = matched_->contains(d->full_name());
+    wanted_.emplace_back(d, yes);
+    return yes;
+  }
+
   // A text slot value, reusing the string's capacity.
   void set_text(int slot, Value::Type type, const std::string& text) {
     Value& v = values_[static_cast<std::size_t>(slot)];
@@ -555,6 +566,7 @@ class ProtobufFeature final : public Feature {
   // The message types some rule can match (std::nullopt: any), for Environment::code_version()
   // code_version_ (0: not yet).
   std::optional<TypeNames> matched_;
+  std::vector<std::pair<const Descriptor*, bool>> wanted_;  // wanted()'s answers so far
   std::uint64_t code_version_ = 0;
   std::unordered_map<const void*, Entry> entries_;
   std::unordered_map<std::string, const Message*> by_name_;
