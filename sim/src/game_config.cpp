@@ -39,6 +39,10 @@ const char* to_string(SkillLevel level) {
   return level == SkillLevel::kPhysical ? "physical" : "symbolic";
 }
 
+const char* to_string(NavigationLevel level) {
+  return level == NavigationLevel::kIdeal ? "ideal" : "move_base-2013";
+}
+
 void GameConfig::validate() const {
   // Localization.
   const LocalizationConfig& l = levels.localization;
@@ -47,6 +51,14 @@ void GameConfig::validate() const {
   require_game("levels.localization.correction_gain", l.correction_gain, core::fraction());
   require_game("levels.localization.position_noise_m", l.position_noise_m, core::non_negative());
   require_game("levels.localization.heading_noise_rad", l.heading_noise_rad, core::non_negative());
+  if (levels.navigation == NavigationLevel::kMoveBase2013) {
+    levels.move_base.validate();
+    if (!world.sensors.laser.enabled) {
+      fail("levels.navigation",
+           "move_base-2013 sees obstacles only with the laser: enable "
+           "world.sensors.laser");
+    }
+  }
   // Symbolic skill level.
   if (!(levels.symbolic.cruise_speed_mps > 0.0)) {
     fail("levels.symbolic.cruise_speed_mps", "must be > 0");

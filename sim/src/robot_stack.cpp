@@ -61,6 +61,10 @@ RobotStack::RobotStack(std::string name, int index, const core::Pose2D& start,
       light_(config.levels.light, devices_, rng.stream("sim/" + name_ + "/light")),
       puck_vision_(config.levels.puck) {
   nav_.set_obstacle_names(robot_names_);  // "held back by robot2"
+  if (config.levels.navigation == NavigationLevel::kMoveBase2013) {
+    move_base_.emplace(planner, config.levels.move_base);
+    laser_mount_ = {config.world.sensors.laser.mount_x_m, config.world.sensors.laser.mount_y_m};
+  }
   if (config.hackathon) {
     const HackathonConfig& h = *config.hackathon;
     std::vector<std::string> colour_names;
@@ -85,6 +89,16 @@ kinematic::MotorCommand RobotStack::actuate(SimTime now,
                                             std::span<const planner::DiscObstacle> others) {
   switch (drive_) {
     case Drive::kNavigator: {
+      if (move_base_) {
+        const bool was_running = move_base_->status().outcome == planner::NavOutcome::kRunning;
+        planner::MoveBaseNavigator::Scan scan{scan_origin_, scan_hits_};
+        const planner::VelocityCommand c = move_base_->update(
+            now, localization_.estimate().pose, odom_velocity_, scan_new_ ? &scan : nullptr);
+        scan_new_ = false;
+        if (was_running) note_nav_end(now);
+        // move_base's own goal approach stands for the alignment (align_s is not added).
+        return handle({c.vx_mps, c.vy_mps, c.omega_rps}, false);
+      }
       const bool was_running = nav_.status().outcome == planner::NavOutcome::kRunning;
       const planner::VelocityCommand c = nav_.update(now, localization_.estimate().pose, others);
       if (was_running) note_nav_end(now);
@@ -158,7 +172,11 @@ void RobotStack::goto_place(std::string_view place, bool forward_only) {
   goal_from_ = true_pose_.position();
   goal_place_.assign(place);
   goal_known_ = planner_->place(place) != nullptr;
-  nav_.go_to_place(place, forward_only);
+  if (move_base_) {
+    move_base_->go_to_place(place, forward_only);
+  } else {
+    nav_.go_to_place(place, forward_only);
+  }
   drive_ = Drive::kNavigator;
   ++goal_id_;
   note_nav_end(now_);  // an unknown place is refused at once
@@ -169,13 +187,17 @@ void RobotStack::goto_pose(const core::Pose2D& pose, bool forward_only) {
   goal_from_ = true_pose_.position();
   goal_place_.clear();
   goal_known_ = true;
-  nav_.go_to(pose, forward_only);
+  if (move_base_) {
+    move_base_->go_to(pose, forward_only);
+  } else {
+    nav_.go_to(pose, forward_only);
+  }
   drive_ = Drive::kNavigator;
   ++goal_id_;
 }
 
 void RobotStack::note_nav_end(SimTime now) {
-  const planner::NavStatus& s = nav_.status();
+  const planner::NavStatus& s = nav_status();
   switch (s.outcome) {
     case planner::NavOutcome::kNoPath:
     case planner::NavOutcome::kInvalidGoal:
@@ -190,7 +212,7 @@ void RobotStack::note_nav_end(SimTime now) {
   f.time = now;
   f.outcome = s.outcome;
   f.message = s.message;
-  f.goal = nav_.goal();
+  f.goal = move_base_ ? move_base_->goal() : nav_.goal();
   f.place = goal_place_;
   f.goal_known = goal_known_;
   ++nav_failure_count_;
@@ -203,7 +225,7 @@ const NavFailure* RobotStack::nav_failure(std::int64_t n) const {
 }
 
 lua::NavState RobotStack::navigator() const {
-  const planner::NavStatus& s = nav_.status();
+  const planner::NavStatus& s = nav_status();
   lua::NavState out;
   out.status = to_api(s.outcome);
   // The fine alignment after an arrival (robot profiles): still running until it is done.
@@ -219,14 +241,22 @@ lua::NavState RobotStack::navigator() const {
   return out;
 }
 
+void RobotStack::nav_abort() {
+  if (move_base_) {
+    move_base_->abort();
+  } else if (nav_.status().outcome == planner::NavOutcome::kRunning) {
+    nav_.abort();
+  }
+}
+
 void RobotStack::stop() {
-  if (nav_.status().outcome == planner::NavOutcome::kRunning) nav_.abort();
+  nav_abort();
   drive_ = Drive::kIdle;
   velocity_ = {};
 }
 
 void RobotStack::set_velocity(double vx_mps, double vy_mps, double omega_rps) {
-  if (nav_.status().outcome == planner::NavOutcome::kRunning) nav_.abort();
+  nav_abort();
   if (drive_ != Drive::kMotor) motor_started_ = true;
   drive_ = Drive::kMotor;
   velocity_ = {vx_mps, vy_mps, omega_rps};
@@ -323,6 +353,26 @@ void RobotStack::sense(const RobotPercept& p) {
   optical_ = {s.optical.left, s.optical.right};
   laser_ = {s.laser.angle_min_rad, s.laser.angle_increment_rad, s.laser.ranges};
   localization_.update(p.now, p.true_pose, s.odometry);
+  if (move_base_) {
+    odom_velocity_ = {s.odometry.vx_mps, s.odometry.vy_mps, s.odometry.omega_rps};
+    if (s.laser.seq != laser_seq_) {
+      // A new scan: its hits in field coordinates at the pose the robot believes it has.
+      laser_seq_ = s.laser.seq;
+      const core::Pose2D est = localization_.estimate().pose;
+      scan_origin_ = est.to_parent(laser_mount_);
+      scan_hits_.clear();
+      const std::size_t n = s.laser.ranges.size();
+      for (std::size_t i = 0; i < n; ++i) {
+        const float r = s.laser.ranges[i];
+        if (!std::isfinite(r)) continue;
+        const double a = est.theta + s.laser.angle_min_rad +
+                         static_cast<double>(i) * s.laser.angle_increment_rad;
+        scan_hits_.emplace_back(scan_origin_.x() + r * std::cos(a),
+                                scan_origin_.y() + r * std::sin(a));
+      }
+      scan_new_ = true;
+    }
+  }
   light_.update(p.now, p.true_pose, p.lights);
   puck_vision_.update(p.now, p.true_pose, p.pucks);
   if (colour_camera_) colour_camera_->update(p.now, p.true_pose, p.pucks, p.puck_colours);

@@ -596,10 +596,11 @@ void Recorder::frame(const sim::Game& game) {
 
   // Planned paths that changed since the last frame (empty while not navigating).
   for (int i = 0; i < game.robot_count(); ++i) {
-    const planner::Navigator& nav = game.robot(i).nav();
+    const sim::RobotStack& robot = game.robot(i);
     static const std::vector<core::Vec2> kNone;
-    const std::vector<core::Vec2>& now =
-        nav.status().outcome == planner::NavOutcome::kRunning ? nav.path().points : kNone;
+    const std::vector<core::Vec2>& now = robot.nav_status().outcome == planner::NavOutcome::kRunning
+                                             ? robot.nav_path().points
+                                             : kNone;
     std::vector<core::Vec2>& last = m.paths[static_cast<std::size_t>(i)];
     if (now.size() == last.size() &&
         std::equal(now.begin(), now.end(), last.begin(),

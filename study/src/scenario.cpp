@@ -71,6 +71,10 @@ void read_levels(const core::ConfigNode& n, sim::RobotLevelsConfig& l) {
   n.read_enum("skill", l.skill,
               {{"physical", sim::SkillLevel::kPhysical}, {"symbolic", sim::SkillLevel::kSymbolic}},
               "skill level");
+  n.read_enum("navigation", l.navigation,
+              {{"ideal", sim::NavigationLevel::kIdeal},
+               {"move_base-2013", sim::NavigationLevel::kMoveBase2013}},
+              "navigation level");
   // Bounds: docs/security.md, "Scenario budgets".
   n.read("position_noise_m", l.localization.position_noise_m, core::in_range(0.0, 1.0));
   n.read("heading_noise_rad", l.localization.heading_noise_rad, core::in_range(0.0, core::kPi));

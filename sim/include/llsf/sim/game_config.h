@@ -12,6 +12,7 @@
 #include "llsf/core/sim_time.h"
 #include "llsf/kinematic/world_config.h"
 #include "llsf/planner/config.h"
+#include "llsf/planner/move_base.h"
 #include "llsf/refbox/config.h"
 #include "llsf/refbox/protocol.h"
 #include "llsf/sim/hackathon.h"
@@ -35,7 +36,13 @@ enum class SkillLevel : std::uint8_t {
   kPhysical,  ///< skills drive the robot through navigator and motor; pucks move by contact
   kSymbolic,  ///< skills wait an estimated duration, then the world is changed directly
 };
-/// "ground_truth", "noisy", "vision", "physical", "symbolic".
+/// Navigation level: what drives the robot to a goal (docs/planner.md).
+enum class NavigationLevel : std::uint8_t {
+  kIdeal,         ///< planner::Navigator: OMPL paths, other robots known everywhere as discs
+  kMoveBase2013,  ///< planner::MoveBaseNavigator: the 2013 team's move_base, laser-only
+};
+/// "ground_truth", "noisy", "vision", "physical", "symbolic", "ideal", "move_base-2013".
+const char* to_string(NavigationLevel level);
 const char* to_string(LocalizationLevel level);
 const char* to_string(DetectionLevel level);
 const char* to_string(SkillLevel level);
@@ -131,6 +138,9 @@ struct RobotLevelsConfig {
   PuckDetectionConfig puck;
   SkillLevel skill = SkillLevel::kPhysical;
   SymbolicConfig symbolic;
+  NavigationLevel navigation = NavigationLevel::kIdeal;
+  /// The figures of the move_base-2013 level (used only at that level).
+  planner::MoveBaseConfig move_base;
 };
 
 /// A radio peer outside the simulation (a 2013 tool on a served UDP socket, `llsfsim run

@@ -144,7 +144,17 @@ class RobotStack final : public lua::RobotApi {
   int index() const { return index_; }
   /// The radio of this robot (agent side).
   RobotRadio& radio() { return radio_; }
+  /// The ideal level's navigator (idle at the move_base-2013 level).
   const planner::Navigator& nav() const { return nav_; }
+  /// The move_base-2013 level's navigator, nullptr at the ideal level.
+  const planner::MoveBaseNavigator* move_base() const {
+    return move_base_ ? &*move_base_ : nullptr;
+  }
+  /// The status and the path of the navigator of this robot's level.
+  const planner::NavStatus& nav_status() const {
+    return move_base_ ? move_base_->status() : nav_.status();
+  }
+  const planner::Path& nav_path() const { return move_base_ ? move_base_->path() : nav_.path(); }
   /// Brain plugged into this robot (borrowed), or nullptr.
   RobotBrain* brain() const { return brain_; }
   void set_brain(RobotBrain* brain) { brain_ = brain; }
@@ -205,6 +215,16 @@ class RobotStack final : public lua::RobotApi {
   std::vector<DeviceView> devices_;
   planner::Planner* planner_;
   planner::Navigator nav_;
+  std::optional<planner::MoveBaseNavigator> move_base_;
+  // The move_base-2013 level's laser input: the newest scan's hits in field coordinates (at the
+  // pose estimate), handed to the navigator once; the odometry's velocity.
+  std::int64_t laser_seq_ = 0;
+  bool scan_new_ = false;
+  core::Vec2 scan_origin_{0.0, 0.0};
+  core::Vec2 laser_mount_{0.0, 0.0};
+  std::vector<core::Vec2> scan_hits_;
+  planner::VelocityCommand odom_velocity_;
+  void nav_abort();
   RobotRadio radio_;
   std::vector<SymbolicRequest> symbolic_requests_;
   mutable std::uint64_t travel_queries_ = 0;

@@ -1,0 +1,299 @@
+// SPDX-License-Identifier: MIT
+// The `move_base-2013` navigation level: the 2013 Carologistics Robotino's ROS move_base as its
+// team configured it (repository carologistics/fawkes-robotino, commit 6cffc15f2,
+// cfg/move_base_robotino/), written here from the behaviour ROS navigation (groovy) documents:
+// a global costmap on the static map plus laser obstacles, a local rolling costmap of laser
+// obstacles only, a navfn-style Dijkstra planner on the inflated global costmap, a
+// TrajectoryPlannerROS-style rollout controller (dwa mode, holonomic), and move_base's state
+// machine (planning, controlling, clearing) with its default recovery sequence. Other robots
+// exist for it only as laser hits. docs/planner.md ("move_base-2013") gives every figure with
+// its source.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "llsf/core/sim_time.h"
+#include "llsf/planner/navigator.h"
+#include "llsf/planner/planner.h"
+
+namespace llsf::planner {
+
+/// Every figure of the level. Defaults are the 2013 files' values where they set one, else the
+/// ROS navigation (groovy) default; docs/planner.md cites each.
+struct MoveBaseConfig {
+  // costmap_common_params.yaml
+  double robot_radius_m = 0.275;      ///< inscribed radius: closer to an obstacle is a collision
+  double inflation_radius_m = 0.30;   ///< costs fall off to this distance
+  double cost_scaling_factor = 10.0;  ///< costmap_2d default (exp(-k (d - inscribed)))
+  double obstacle_range_m = 3.0;      ///< laser hits nearer than this are marked
+  double raytrace_range_m = 3.0;      ///< free space is cleared along beams this far
+  // local_costmap_params.yaml (rolling window, laser only)
+  double local_size_m = 3.0;
+  double local_resolution_m = 0.1;
+  double local_update_hz = 5.0;
+  // global_costmap_params.yaml (static map + laser); map/map.yaml resolution
+  double global_resolution_m = 0.05;
+  double global_update_hz = 2.0;
+  // base_local_planner_params.yaml (TrajectoryPlannerROS)
+  double max_vel_x = 0.5;
+  double min_vel_x = 0.1;
+  double max_rotational_vel = 0.78;
+  double min_in_place_rotational_vel = 0.3;
+  double acc_lim_x = 2.5;
+  double acc_lim_y = 2.5;
+  double acc_lim_th = 3.2;
+  double xy_goal_tolerance_m = 0.15;
+  double yaw_goal_tolerance_rad = 0.1;
+  double path_distance_bias = 1.0;
+  double sim_time_s = 2.0;
+  // TrajectoryPlannerROS defaults (the 2013 file is silent)
+  double goal_distance_bias = 0.8;
+  double occdist_scale = 0.01;
+  double sim_granularity_m = 0.025;
+  int vx_samples = 3;
+  int vtheta_samples = 20;
+  double heading_lookahead_m = 0.325;
+  double oscillation_reset_dist_m = 0.05;
+  double escape_reset_dist_m = 0.10;
+  double escape_reset_theta_rad = 0.7853981633974483;  // pi/4
+  double escape_vel_mps = -0.1;
+  double stopped_vel = 0.01;  ///< trans/rot velocity below which the robot counts as stopped
+  // move_base.launch
+  double controller_frequency_hz = 5.0;
+  double conservative_reset_dist_m = 5.6;
+  bool recovery_behavior_enabled = true;
+  bool shutdown_costmaps = true;
+  // move_base defaults (the 2013 files leave them unset)
+  double planner_patience_s = 5.0;
+  double controller_patience_s = 15.0;
+  double circumscribed_radius_m = 0.46;  ///< aggressive reset keeps 4x this square
+  bool clearing_rotation_allowed = true;
+  // rotate_recovery defaults
+  double rotate_sim_granularity_rad = 0.017;
+  // A robot that starts inside the inscribed radius of a static obstacle (at a machine, in the
+  // insertion area) first moves straight out to the nearest free point within this distance,
+  // as the 2013 skills did before every ppgoto (leave_area: motor_move x = -0.2; leave_IS).
+  double depart_max_m = 0.6;
+  // The final approach to a goal move_base cannot take (a pose at a machine, inside the
+  // inscribed radius of its footprint): move_base drives to the nearest pose back along the
+  // goal heading that its costmap allows, then a straight relative move at this speed, as the
+  // 2013 skills did (ppgoto to a navgraph node, then move_under_rfid / motor_move).
+  double approach_speed_mps = 0.15;
+  double approach_omega_rps = 0.5;
+  double approach_tolerance_m = 0.02;
+  double approach_angle_tolerance_rad = 0.03;
+
+  /// The clearance (robot centre to the nearest static obstacle or wall) of the pose move_base
+  /// drives to instead of a goal too close to an obstacle, and of the point a departure goes
+  /// to: the smallest at which both costmaps, however their cells fall, see the robot free --
+  /// the robot radius rounded up to whole cells of the coarser map (costmap_2d's
+  /// cellDistance), plus one such cell (the robot's and the obstacle's cell centres may each be
+  /// half a cell off), plus the straight move's stop tolerance (0.30 + 0.1 + 0.02 = 0.42 m
+  /// with the 2013 figures).
+  double standoff_m() const;
+
+  /// Throws core::ConfigError naming the field ("move_base.sim_time_s: must be > 0").
+  void validate() const;
+};
+
+/// A 2D cost grid as costmap_2d keeps it: 0 free .. 252 inflated, 253 inscribed (a collision for
+/// a robot centred there), 254 lethal (an obstacle cell).
+class Costmap {
+ public:
+  static constexpr std::uint8_t kFree = 0;
+  static constexpr std::uint8_t kInscribed = 253;
+  static constexpr std::uint8_t kLethal = 254;
+
+  Costmap() = default;
+  /// A grid of `nx` x `ny` cells of `resolution_m`, its lower-left corner at `origin`.
+  Costmap(Vec2 origin, int nx, int ny, double resolution_m, const MoveBaseConfig& config);
+
+  int nx() const { return nx_; }
+  int ny() const { return ny_; }
+  double resolution() const { return res_; }
+  Vec2 origin() const { return origin_; }
+  bool to_cell(const Vec2& p, int& i, int& j) const;
+  Vec2 cell_center(int i, int j) const;
+  std::uint8_t cost(int i, int j) const { return cost_[idx(i, j)]; }
+  /// Cost at a point; outside the grid: kLethal if `outside_lethal`, else kFree.
+  std::uint8_t cost_at(const Vec2& p, bool outside_lethal = true) const;
+  bool obstacle(int i, int j) const { return obstacle_[idx(i, j)] != 0; }
+  /// The static layer's cost at a point (outside the grid: kLethal).
+  std::uint8_t static_cost_at(const Vec2& p) const;
+
+  /// The static layer: cells an obstacle of `planner`'s map (or a wall) covers are lethal for
+  /// good; the rest is inflated from them.
+  void set_static(const Planner& planner);
+  /// Moves a rolling window so that `center` is in its middle cell; cells that enter are free.
+  void recenter(const Vec2& center);
+  /// One sensor update: clear the cells along every beam from `origin` to its hit (within
+  /// raytrace range), mark the hits within obstacle range, then inflate.
+  void update(const Vec2& origin, std::span<const Vec2> hits);
+  /// ClearCostmapRecovery: laser obstacles outside the square of side `size_m` around `center`
+  /// are forgotten (the static map remains).
+  void reset_outside(const Vec2& center, double size_m);
+  /// Forgets every laser obstacle.
+  void clear_obstacles();
+  /// Laser obstacle cells now marked.
+  int obstacle_count() const;
+
+ private:
+  std::size_t idx(int i, int j) const {
+    return static_cast<std::size_t>(j) * static_cast<std::size_t>(nx_) +
+           static_cast<std::size_t>(i);
+  }
+  void inflate();
+
+  Vec2 origin_{0.0, 0.0};
+  int nx_ = 0;
+  int ny_ = 0;
+  double res_ = 0.1;
+  std::vector<std::uint8_t> static_lethal_;  // 1 = static obstacle
+  std::vector<std::uint8_t> static_cost_;    // inflated static layer
+  std::vector<std::uint8_t> obstacle_;       // 1 = laser obstacle
+  std::vector<std::uint8_t> cost_;           // combined, inflated
+  struct KernelCell {
+    int di;
+    int dj;
+    std::uint8_t cost;
+  };
+  std::vector<KernelCell> kernel_;
+  double raytrace_range_ = 3.0;
+  double obstacle_range_ = 3.0;
+};
+
+/// move_base's state (MoveBaseNavigator::state()).
+enum class MoveBaseState {
+  kIdle,
+  kPlanning,
+  kControlling,
+  kClearing,  ///< a recovery behaviour runs
+  kApproach,  ///< the straight final move after move_base reached the approach pose
+  kDepart,    ///< the straight move out of an obstacle's inscribed radius before planning
+};
+const char* to_string(MoveBaseState state);
+
+/// Counters of one navigation (reset by go_to).
+struct MoveBaseStats {
+  int plans = 0;              ///< global plans made
+  int plan_failures = 0;      ///< global planning attempts that found no path
+  int control_failures = 0;   ///< controller cycles without a valid command
+  int escapes = 0;            ///< controller cycles that backed off (escape velocity)
+  int recoveries = 0;         ///< recovery behaviours run
+  int rotate_recoveries = 0;  ///< of them, in-place rotations
+  double recovery_s = 0.0;    ///< time spent in recovery behaviours
+  double stopped_s = 0.0;     ///< time commanded to stand (no valid control, planning)
+};
+
+/// One navigation stack of one robot, stepped in simulated time. Deterministic: no randomness,
+/// no wall clock. Not thread-safe.
+class MoveBaseNavigator {
+ public:
+  MoveBaseNavigator(const Planner& planner, MoveBaseConfig config);
+
+  void go_to(const Pose2D& goal, bool forward = false);
+  void go_to_place(std::string_view name, bool forward = false);
+  void abort();
+
+  /// A laser scan in field coordinates: the sensor's position and the points it hit.
+  struct Scan {
+    Vec2 origin{0.0, 0.0};
+    std::span<const Vec2> hits;
+  };
+  /// One step at `now` for the robot at `pose` (the localization's estimate) moving at
+  /// `velocity` (robot frame, odometry); `scan` is a new laser scan or nullptr. Returns the
+  /// velocity command (robot frame): the controller's, held between controller cycles.
+  VelocityCommand update(core::SimTime now, const Pose2D& pose, const VelocityCommand& velocity,
+                         const Scan* scan);
+
+  const NavStatus& status() const { return status_; }
+  MoveBaseState state() const { return state_; }
+  const MoveBaseStats& stats() const { return stats_; }
+  const Pose2D& goal() const { return goal_; }
+  /// The global plan being followed (empty before the first plan).
+  const Path& path() const { return plan_; }
+  const Costmap& global_costmap() const { return global_; }
+  const Costmap& local_costmap() const { return local_; }
+  /// Totals over every navigation of this navigator.
+  const MoveBaseStats& totals() const { return totals_; }
+
+ private:
+  struct Traj {
+    double vx = 0.0, vy = 0.0, vth = 0.0;
+    double cost = -1.0;
+    double end_x = 0.0, end_y = 0.0, end_th = 0.0;
+  };
+  void finish(NavOutcome outcome, std::string message);
+  bool make_plan(const Pose2D& pose);
+  bool compute_velocity(const Pose2D& pose, const VelocityCommand& vel, VelocityCommand& cmd);
+  void update_grids(const Pose2D& pose);
+  Traj create_trajectories(const Pose2D& pose, const VelocityCommand& vel);
+  void generate(const Pose2D& pose, const VelocityCommand& vel, double vx_s, double vy_s,
+                double vth_s, Traj& t) const;
+  bool rotation_free(const Pose2D& pose, double angle) const;
+  void start_recovery(core::SimTime now, const Pose2D& pose);
+  VelocityCommand run_recovery(core::SimTime now, const Pose2D& pose, const VelocityCommand& vel);
+  VelocityCommand approach(const Pose2D& pose, double dt);
+  VelocityCommand straight_to(const Pose2D& pose, const Pose2D& target, bool& arrived) const;
+  void add_stats(double dt);
+
+  const Planner* planner_;
+  MoveBaseConfig config_;
+  Costmap global_;
+  Costmap local_;
+  NavStatus status_;
+  MoveBaseState state_ = MoveBaseState::kIdle;
+  MoveBaseStats stats_;
+  MoveBaseStats totals_;
+  Pose2D goal_;       // what the caller asked for
+  Pose2D base_goal_;  // what move_base drives to (the approach pose if one is needed)
+  bool needs_approach_ = false;
+  bool depart_checked_ = false;
+  bool forward_ = false;  // carrying a puck: the departure turns first, never backs off
+  Pose2D depart_to_;      // where the departure move goes
+  Path plan_;
+  // Times.
+  core::SimTime last_update_;
+  bool has_last_update_ = false;
+  core::SimTime next_control_;
+  core::SimTime next_local_;
+  core::SimTime next_global_;
+  core::SimTime last_valid_plan_;
+  core::SimTime last_valid_control_;
+  VelocityCommand command_;
+  // Latest scan, kept until the costmaps have used it.
+  std::vector<Vec2> scan_hits_;
+  Vec2 scan_origin_{0.0, 0.0};
+  bool scan_for_local_ = false;
+  bool scan_for_global_ = false;
+  // Recovery.
+  enum class Trigger { kPlanning, kControlling };
+  Trigger trigger_ = Trigger::kPlanning;
+  int recovery_index_ = 0;
+  bool rotating_ = false;
+  double rotate_start_offset_ = 0.0;
+  bool rotate_got_180_ = false;
+  // Rollout controller's grids (local costmap sized) and memory.
+  std::vector<int> path_dist_;
+  std::vector<int> goal_dist_;
+  std::vector<int> queue_;
+  int unreachable_ = 0;
+  bool rotating_to_goal_ = false;
+  bool stuck_left_ = false, stuck_right_ = false;
+  bool stuck_left_strafe_ = false, stuck_right_strafe_ = false;
+  bool rotating_left_ = false, rotating_right_ = false;
+  bool strafe_left_ = false, strafe_right_ = false;
+  bool escaping_ = false;
+  double prev_x_ = 0.0, prev_y_ = 0.0;
+  double escape_x_ = 0.0, escape_y_ = 0.0, escape_th_ = 0.0;
+  std::size_t prune_from_ = 0;
+  // Navfn memory.
+  std::vector<float> potential_;
+  std::vector<std::uint8_t> done_;
+};
+
+}  // namespace llsf::planner

@@ -1,0 +1,214 @@
+// SPDX-License-Identifier: MIT
+// The move_base-2013 costmaps (docs/planner.md, "move_base-2013"): a static layer rasterised
+// from the planner's exact map, laser obstacles marked at their hits and cleared along their
+// beams (Bresenham), and the costmap_2d inflation written as a precomputed kernel.
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+
+#include "llsf/core/assert.h"
+#include "llsf/planner/move_base.h"
+
+namespace llsf::planner {
+
+Costmap::Costmap(Vec2 origin, int nx, int ny, double resolution_m, const MoveBaseConfig& config)
+    : origin_(origin),
+      nx_(nx),
+      ny_(ny),
+      res_(resolution_m),
+      raytrace_range_(config.raytrace_range_m),
+      obstacle_range_(config.obstacle_range_m) {
+  LLSF_DEMAND(nx > 0 && ny > 0 && resolution_m > 0.0);
+  const std::size_t n = static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny);
+  static_lethal_.assign(n, 0);
+  static_cost_.assign(n, kFree);
+  obstacle_.assign(n, 0);
+  cost_.assign(n, kFree);
+  // costmap_2d's cost of a cell at distance d (in cells, exact) from an obstacle cell: lethal on
+  // it, inscribed within ceil(robot radius / resolution) cells, then
+  // 252 * exp(-k (d res - robot radius)) out to ceil(inflation radius / resolution) cells.
+  // Both radii are rounded up to whole cells as costmap_2d's cellDistance() does: with the 2013
+  // figures (0.275 and 0.30 m) every cell within 0.30 m is inscribed, at 0.05 m and at 0.1 m.
+  const int inscribed = static_cast<int>(std::ceil(config.robot_radius_m / res_ - 1e-9));
+  const int r = static_cast<int>(std::ceil(config.inflation_radius_m / res_ - 1e-9));
+  for (int dj = -r; dj <= r; ++dj) {
+    for (int di = -r; di <= r; ++di) {
+      const double d = std::hypot(static_cast<double>(di), static_cast<double>(dj));
+      if (d > r) continue;
+      std::uint8_t c = 0;
+      if (di == 0 && dj == 0) {
+        c = kLethal;
+      } else if (d <= inscribed) {
+        c = kInscribed;
+      } else {
+        c = static_cast<std::uint8_t>(
+            (kInscribed - 1) *
+            std::exp(-config.cost_scaling_factor * (d * res_ - config.robot_radius_m)));
+      }
+      if (c > 0) kernel_.push_back({di, dj, c});
+    }
+  }
+}
+
+bool Costmap::to_cell(const Vec2& p, int& i, int& j) const {
+  const double fx = (p.x() - origin_.x()) / res_;
+  const double fy = (p.y() - origin_.y()) / res_;
+  if (!(fx >= 0.0 && fy >= 0.0)) return false;
+  i = static_cast<int>(fx);
+  j = static_cast<int>(fy);
+  return i < nx_ && j < ny_;
+}
+
+Vec2 Costmap::cell_center(int i, int j) const {
+  return {origin_.x() + (i + 0.5) * res_, origin_.y() + (j + 0.5) * res_};
+}
+
+std::uint8_t Costmap::cost_at(const Vec2& p, bool outside_lethal) const {
+  int i = 0, j = 0;
+  if (!to_cell(p, i, j)) return outside_lethal ? kLethal : kFree;
+  return cost_[idx(i, j)];
+}
+
+std::uint8_t Costmap::static_cost_at(const Vec2& p) const {
+  int i = 0, j = 0;
+  if (!to_cell(p, i, j)) return kLethal;
+  return static_cost_[idx(i, j)];
+}
+
+void Costmap::set_static(const Planner& planner) {
+  // A cell is a static obstacle when an obstacle or a wall reaches into it (its centre is
+  // within half a cell of one), as the pixels of the team's map image marked them.
+  for (int j = 0; j < ny_; ++j) {
+    for (int i = 0; i < nx_; ++i) {
+      const double d = planner.clearance(cell_center(i, j)).distance_m;
+      static_lethal_[idx(i, j)] = d <= 0.5 * res_ ? 1 : 0;
+    }
+  }
+  std::fill(static_cost_.begin(), static_cost_.end(), kFree);
+  for (int j = 0; j < ny_; ++j) {
+    for (int i = 0; i < nx_; ++i) {
+      if (static_lethal_[idx(i, j)] == 0) continue;
+      for (const KernelCell& k : kernel_) {
+        const int a = i + k.di, b = j + k.dj;
+        if (a < 0 || b < 0 || a >= nx_ || b >= ny_) continue;
+        std::uint8_t& c = static_cost_[idx(a, b)];
+        c = std::max(c, k.cost);
+      }
+    }
+  }
+  for (std::size_t n = 0; n < obstacle_.size(); ++n) {
+    if (static_lethal_[n] != 0) obstacle_[n] = 0;
+  }
+  inflate();
+}
+
+void Costmap::recenter(const Vec2& center) {
+  // As costmap_2d's rolling window: the origin moves by whole cells, what stays is kept.
+  const Vec2 wanted(center.x() - 0.5 * nx_ * res_, center.y() - 0.5 * ny_ * res_);
+  const int si = static_cast<int>(std::floor((wanted.x() - origin_.x()) / res_));
+  const int sj = static_cast<int>(std::floor((wanted.y() - origin_.y()) / res_));
+  if (si == 0 && sj == 0) return;
+  std::vector<std::uint8_t> moved(obstacle_.size(), 0);
+  for (int j = 0; j < ny_; ++j) {
+    const int oj = j + sj;
+    if (oj < 0 || oj >= ny_) continue;
+    for (int i = 0; i < nx_; ++i) {
+      const int oi = i + si;
+      if (oi < 0 || oi >= nx_) continue;
+      moved[idx(i, j)] = obstacle_[idx(oi, oj)];
+    }
+  }
+  obstacle_.swap(moved);
+  origin_ = Vec2(origin_.x() + si * res_, origin_.y() + sj * res_);
+}
+
+void Costmap::update(const Vec2& origin, std::span<const Vec2> hits) {
+  int i0 = 0, j0 = 0;
+  const bool origin_in = to_cell(origin, i0, j0);
+  const int max_cells = static_cast<int>(raytrace_range_ / res_);
+  // 1. Clear free space along every beam (not its end cell), up to the raytrace range.
+  if (origin_in) {
+    for (const Vec2& h : hits) {
+      // The end point, clipped to the grid along the beam.
+      Vec2 e = h;
+      const Vec2 d = e - origin;
+      double t = 1.0;
+      const double x_lo = origin_.x(), y_lo = origin_.y();
+      const double x_hi = origin_.x() + nx_ * res_ - 1e-9, y_hi = origin_.y() + ny_ * res_ - 1e-9;
+      if (e.x() < x_lo) t = std::min(t, (x_lo - origin.x()) / d.x());
+      if (e.x() > x_hi) t = std::min(t, (x_hi - origin.x()) / d.x());
+      if (e.y() < y_lo) t = std::min(t, (y_lo - origin.y()) / d.y());
+      if (e.y() > y_hi) t = std::min(t, (y_hi - origin.y()) / d.y());
+      e = origin + d * t;
+      int i1 = 0, j1 = 0;
+      if (!to_cell(e, i1, j1)) continue;
+      // Bresenham from (i0, j0) towards (i1, j1), the end cell excluded.
+      int x = i0, y = j0;
+      const int dx = std::abs(i1 - i0), dy = std::abs(j1 - j0);
+      const int sx = i1 >= i0 ? 1 : -1, sy = j1 >= j0 ? 1 : -1;
+      const int steps = std::min(std::max(dx, dy), max_cells);
+      int err = dx - dy;
+      for (int s = 0; s < steps; ++s) {
+        obstacle_[idx(x, y)] = 0;
+        const int e2 = 2 * err;
+        if (e2 > -dy) {
+          err -= dy;
+          x += sx;
+        }
+        if (e2 < dx) {
+          err += dx;
+          y += sy;
+        }
+      }
+    }
+  }
+  // 2. Mark the hits within the obstacle range.
+  const double r2 = obstacle_range_ * obstacle_range_;
+  for (const Vec2& h : hits) {
+    if ((h - origin).squaredNorm() >= r2) continue;
+    int i = 0, j = 0;
+    if (!to_cell(h, i, j)) continue;
+    if (static_lethal_[idx(i, j)] != 0) continue;  // already an obstacle for good
+    obstacle_[idx(i, j)] = 1;
+  }
+  inflate();
+}
+
+void Costmap::reset_outside(const Vec2& center, double size_m) {
+  const double h = 0.5 * size_m;
+  for (int j = 0; j < ny_; ++j) {
+    for (int i = 0; i < nx_; ++i) {
+      const Vec2 c = cell_center(i, j);
+      if (std::abs(c.x() - center.x()) > h || std::abs(c.y() - center.y()) > h) {
+        obstacle_[idx(i, j)] = 0;
+      }
+    }
+  }
+  inflate();
+}
+
+void Costmap::clear_obstacles() {
+  std::fill(obstacle_.begin(), obstacle_.end(), 0);
+  inflate();
+}
+
+int Costmap::obstacle_count() const {
+  return static_cast<int>(std::count(obstacle_.begin(), obstacle_.end(), 1));
+}
+
+void Costmap::inflate() {
+  cost_ = static_cost_;
+  for (int j = 0; j < ny_; ++j) {
+    for (int i = 0; i < nx_; ++i) {
+      if (obstacle_[idx(i, j)] == 0) continue;
+      for (const KernelCell& k : kernel_) {
+        const int a = i + k.di, b = j + k.dj;
+        if (a < 0 || b < 0 || a >= nx_ || b >= ny_) continue;
+        std::uint8_t& c = cost_[idx(a, b)];
+        c = std::max(c, k.cost);
+      }
+    }
+  }
+}
+
+}  // namespace llsf::planner

@@ -1,0 +1,825 @@
+// SPDX-License-Identifier: MIT
+// The move_base-2013 navigation level (docs/planner.md, "move_base-2013"): the state machine of
+// ROS move_base, a navfn-style global planner and a TrajectoryPlannerROS-style rollout
+// controller, each written from the behaviour ROS navigation (groovy, 2013) documents.
+#include "llsf/planner/move_base.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <queue>
+#include <utility>
+
+#include "llsf/core/config.h"
+#include "llsf/core/error.h"
+#include "llsf/core/geometry.h"
+
+namespace llsf::planner {
+
+using core::SimTime;
+
+namespace {
+
+double sign(double v) { return v < 0.0 ? -1.0 : 1.0; }
+
+// One velocity component ramped towards `target` within `acc` over `dt`.
+double ramp(double target, double current, double acc, double dt) {
+  if (target >= current) return std::min(target, current + acc * dt);
+  return std::max(target, current - acc * dt);
+}
+
+}  // namespace
+
+void MoveBaseConfig::validate() const {
+  const std::string p = "move_base.";
+  core::require(p + "robot_radius_m", robot_radius_m, core::positive());
+  core::require(p + "inflation_radius_m", inflation_radius_m, core::at_least(robot_radius_m));
+  core::require(p + "inflation_radius_m", inflation_radius_m, core::at_most(2.0));
+  core::require(p + "cost_scaling_factor", cost_scaling_factor, core::non_negative());
+  core::require(p + "obstacle_range_m", obstacle_range_m, core::positive());
+  core::require(p + "raytrace_range_m", raytrace_range_m, core::positive());
+  core::require(p + "local_size_m", local_size_m, core::in_range(0.5, 20.0));
+  core::require(p + "local_resolution_m", local_resolution_m, core::in_range(0.01, 0.5));
+  core::require(p + "global_resolution_m", global_resolution_m, core::in_range(0.01, 0.5));
+  core::require(p + "local_update_hz", local_update_hz, core::in_range(0.1, 100.0));
+  core::require(p + "global_update_hz", global_update_hz, core::in_range(0.1, 100.0));
+  core::require(p + "max_vel_x", max_vel_x, core::positive());
+  core::require(p + "min_vel_x", min_vel_x, core::in_range(0.0, max_vel_x));
+  core::require(p + "max_rotational_vel", max_rotational_vel, core::positive());
+  core::require(p + "min_in_place_rotational_vel", min_in_place_rotational_vel,
+                core::in_range(0.0, max_rotational_vel));
+  core::require(p + "acc_lim_x", acc_lim_x, core::positive());
+  core::require(p + "acc_lim_y", acc_lim_y, core::positive());
+  core::require(p + "acc_lim_th", acc_lim_th, core::positive());
+  core::require(p + "xy_goal_tolerance_m", xy_goal_tolerance_m, core::positive());
+  core::require(p + "yaw_goal_tolerance_rad", yaw_goal_tolerance_rad, core::positive());
+  core::require(p + "sim_time_s", sim_time_s, core::in_range(0.1, 10.0));
+  core::require(p + "sim_granularity_m", sim_granularity_m, core::in_range(0.001, 0.5));
+  core::require(p + "vx_samples", vx_samples, core::in_range(2, 50));
+  core::require(p + "vtheta_samples", vtheta_samples, core::in_range(2, 100));
+  core::require(p + "controller_frequency_hz", controller_frequency_hz, core::in_range(1.0, 100.0));
+  core::require(p + "planner_patience_s", planner_patience_s, core::non_negative());
+  core::require(p + "controller_patience_s", controller_patience_s, core::non_negative());
+  core::require(p + "approach_speed_mps", approach_speed_mps, core::positive());
+  core::require(p + "approach_omega_rps", approach_omega_rps, core::positive());
+  core::require(p + "approach_tolerance_m", approach_tolerance_m, core::positive());
+  core::require(p + "approach_angle_tolerance_rad", approach_angle_tolerance_rad, core::positive());
+}
+
+double MoveBaseConfig::standoff_m() const {
+  const double cell = std::max(local_resolution_m, global_resolution_m);
+  return std::ceil(robot_radius_m / cell - 1e-9) * cell + cell + approach_tolerance_m;
+}
+
+const char* to_string(MoveBaseState state) {
+  switch (state) {
+    case MoveBaseState::kIdle:
+      return "idle";
+    case MoveBaseState::kPlanning:
+      return "planning";
+    case MoveBaseState::kControlling:
+      return "controlling";
+    case MoveBaseState::kClearing:
+      return "clearing";
+    case MoveBaseState::kApproach:
+      return "approach";
+    case MoveBaseState::kDepart:
+      return "depart";
+  }
+  return "?";
+}
+
+MoveBaseNavigator::MoveBaseNavigator(const Planner& planner, MoveBaseConfig config)
+    : planner_(&planner), config_(config) {
+  config_.validate();
+  const FieldMap& f = planner.field();
+  const double r = config_.global_resolution_m;
+  global_ = Costmap(Vec2(0.0, 0.0), static_cast<int>(std::ceil(f.width_m / r - 1e-9)),
+                    static_cast<int>(std::ceil(f.height_m / r - 1e-9)), r, config_);
+  global_.set_static(planner);
+  const int n =
+      std::max(1, static_cast<int>(std::lround(config_.local_size_m / config_.local_resolution_m)));
+  local_ = Costmap(Vec2(0.0, 0.0), n, n, config_.local_resolution_m, config_);
+  const std::size_t cells = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
+  path_dist_.assign(cells, 0);
+  goal_dist_.assign(cells, 0);
+  unreachable_ = n * n;
+}
+
+void MoveBaseNavigator::go_to(const Pose2D& goal, bool forward) {
+  // move_base knew nothing of a held puck; `forward` only makes the departure turn and drive
+  // forwards, as leave_IS did (docs/planner.md).
+  forward_ = forward;
+  goal_ = goal;
+  status_ = {NavOutcome::kRunning, -1, {}};
+  stats_ = {};
+  plan_ = {};
+  prune_from_ = 0;
+  // A goal move_base cannot reach (inside the inscribed radius of a static obstacle, e.g. a
+  // pose at a machine's reader): drive to the nearest pose back along the goal heading that
+  // the static costmap allows, then approach in a straight line.
+  base_goal_ = goal;
+  needs_approach_ = false;
+  const Vec2 back(-std::cos(goal.theta), -std::sin(goal.theta));
+  auto clear = [&](const Vec2& p) {
+    return planner_->clearance(p).distance_m >= config_.standoff_m();
+  };
+  if (!clear(goal.position())) {
+    const double step = 0.01;
+    for (double d = step; d <= 1.5; d += step) {
+      const Vec2 p = goal.position() + back * d;
+      if (clear(p)) {
+        base_goal_ = Pose2D{p.x(), p.y(), goal.theta};
+        needs_approach_ = true;
+        break;
+      }
+    }
+  }
+  state_ = MoveBaseState::kPlanning;
+  depart_checked_ = false;
+  trigger_ = Trigger::kPlanning;
+  recovery_index_ = 0;
+  rotating_ = false;
+  rotating_to_goal_ = false;
+  escaping_ = false;
+  stuck_left_ = stuck_right_ = stuck_left_strafe_ = stuck_right_strafe_ = false;
+  rotating_left_ = rotating_right_ = strafe_left_ = strafe_right_ = false;
+  const SimTime now = has_last_update_ ? last_update_ : SimTime();
+  last_valid_plan_ = now;
+  last_valid_control_ = now;
+  next_control_ = now;
+}
+
+void MoveBaseNavigator::go_to_place(std::string_view name, bool forward) {
+  const Place* p = planner_->place(name);
+  if (p == nullptr) {
+    goal_ = {};
+    state_ = MoveBaseState::kIdle;
+    status_ = {NavOutcome::kInvalidGoal, -1, "unknown place '" + std::string(name) + "'"};
+    return;
+  }
+  go_to(p->pose, forward);
+}
+
+void MoveBaseNavigator::abort() {
+  if (status_.outcome == NavOutcome::kRunning) finish(NavOutcome::kAborted, "aborted");
+}
+
+void MoveBaseNavigator::finish(NavOutcome outcome, std::string message) {
+  status_ = {outcome, -1, std::move(message)};
+  state_ = MoveBaseState::kIdle;
+  command_ = {};
+  rotating_ = false;
+  totals_.plans += stats_.plans;
+  totals_.plan_failures += stats_.plan_failures;
+  totals_.control_failures += stats_.control_failures;
+  totals_.escapes += stats_.escapes;
+  totals_.recoveries += stats_.recoveries;
+  totals_.rotate_recoveries += stats_.rotate_recoveries;
+  totals_.recovery_s += stats_.recovery_s;
+  totals_.stopped_s += stats_.stopped_s;
+}
+
+// --- the update ----------------------------------------------------------------------------
+
+VelocityCommand MoveBaseNavigator::update(SimTime now, const Pose2D& pose,
+                                          const VelocityCommand& velocity, const Scan* scan) {
+  const double dt = has_last_update_ ? (now - last_update_).seconds() : 0.0;
+  last_update_ = now;
+  has_last_update_ = true;
+  if (scan != nullptr) {
+    scan_hits_.assign(scan->hits.begin(), scan->hits.end());
+    scan_origin_ = scan->origin;
+    scan_for_local_ = scan_for_global_ = true;
+  }
+  const bool active = state_ != MoveBaseState::kIdle;
+  // shutdown_costmaps: the costmaps are updated only while a goal is active.
+  if (active || !config_.shutdown_costmaps) {
+    if (now >= next_local_) {
+      next_local_ = now + SimTime::period_of_hz(config_.local_update_hz);
+      local_.recenter(pose.position());
+      if (scan_for_local_) local_.update(scan_origin_, scan_hits_);
+      scan_for_local_ = false;
+    }
+    if (now >= next_global_) {
+      next_global_ = now + SimTime::period_of_hz(config_.global_update_hz);
+      if (scan_for_global_) global_.update(scan_origin_, scan_hits_);
+      scan_for_global_ = false;
+    }
+  }
+  if (!active) return {};
+  add_stats(dt);
+  if (state_ == MoveBaseState::kPlanning && !depart_checked_) {
+    // Inside a static obstacle's inscribed radius: first straight out to the nearest free point
+    // (16 directions, the one behind the robot first, as leave_area backs off).
+    depart_checked_ = true;
+    auto clear = [&](const Vec2& p) {
+      return planner_->clearance(p).distance_m >= config_.standoff_m();
+    };
+    if (!clear(pose.position())) {
+      const double step = 0.01;
+      bool found = false;
+      for (double d = step; d <= config_.depart_max_m && !found; d += step) {
+        for (int k = 0; k < 16 && !found; ++k) {
+          // Straight back, then alternately 22.5 degrees more to either side.
+          const double ang =
+              pose.theta + core::kPi + ((k + 1) / 2) * (core::kPi / 8.0) * (k % 2 ? 1 : -1);
+          const Vec2 p = pose.position() + Vec2(std::cos(ang), std::sin(ang)) * d;
+          if (clear(p)) {
+            depart_to_ = Pose2D{p.x(), p.y(), forward_ ? core::normalize_angle(ang) : pose.theta};
+            found = true;
+          }
+        }
+      }
+      if (found) state_ = MoveBaseState::kDepart;
+    }
+  }
+  if (state_ == MoveBaseState::kDepart) {
+    bool arrived = false;
+    const double turn = core::angle_diff(depart_to_.theta, pose.theta);
+    if (forward_ && std::abs(turn) > config_.approach_angle_tolerance_rad) {
+      // Carrying a puck: turn towards the way out first (leave_IS: TURN, then MOTOR_MOVE).
+      command_ = {0.0, 0.0,
+                  std::clamp(1.5 * turn, -config_.approach_omega_rps, config_.approach_omega_rps)};
+      return command_;
+    }
+    command_ = straight_to(pose, depart_to_, arrived);
+    if (arrived) {
+      state_ = MoveBaseState::kPlanning;
+      last_valid_plan_ = now;
+      last_valid_control_ = now;
+      next_control_ = now;
+    }
+    return command_;
+  }
+  if (state_ == MoveBaseState::kApproach) {
+    command_ = approach(pose, dt);
+    return command_;
+  }
+  if (state_ == MoveBaseState::kClearing && rotating_) {
+    command_ = run_recovery(now, pose, velocity);
+    return command_;
+  }
+  if (now < next_control_) return command_;
+  next_control_ = now + SimTime::period_of_hz(config_.controller_frequency_hz);
+
+  switch (state_) {
+    case MoveBaseState::kPlanning: {
+      command_ = {};
+      if (make_plan(pose)) {
+        state_ = MoveBaseState::kControlling;
+        last_valid_plan_ = now;
+        if (trigger_ == Trigger::kPlanning) recovery_index_ = 0;
+      } else if (now > last_valid_plan_ + SimTime::from_seconds(config_.planner_patience_s)) {
+        state_ = MoveBaseState::kClearing;
+        trigger_ = Trigger::kPlanning;
+        start_recovery(now, pose);
+      }
+      break;
+    }
+    case MoveBaseState::kControlling: {
+      // Goal reached: within both tolerances and stopped.
+      const Vec2 to_goal = base_goal_.position() - pose.position();
+      const bool stopped = std::hypot(velocity.vx_mps, velocity.vy_mps) <= config_.stopped_vel &&
+                           std::abs(velocity.omega_rps) <= config_.stopped_vel;
+      if (to_goal.norm() <= config_.xy_goal_tolerance_m &&
+          std::abs(core::angle_diff(base_goal_.theta, pose.theta)) <=
+              config_.yaw_goal_tolerance_rad &&
+          stopped) {
+        if (needs_approach_) {
+          state_ = MoveBaseState::kApproach;
+          command_ = approach(pose, dt);
+        } else {
+          finish(NavOutcome::kArrived, {});
+        }
+        break;
+      }
+      VelocityCommand cmd;
+      if (compute_velocity(pose, velocity, cmd)) {
+        last_valid_control_ = now;
+        command_ = cmd;
+        if (trigger_ == Trigger::kControlling) recovery_index_ = 0;
+      } else {
+        ++stats_.control_failures;
+        command_ = {};
+        if (now > last_valid_control_ + SimTime::from_seconds(config_.controller_patience_s)) {
+          state_ = MoveBaseState::kClearing;
+          trigger_ = Trigger::kControlling;
+          start_recovery(now, pose);
+        } else {
+          last_valid_plan_ = now;
+          state_ = MoveBaseState::kPlanning;
+        }
+      }
+      break;
+    }
+    case MoveBaseState::kClearing:
+      start_recovery(now, pose);
+      break;
+    case MoveBaseState::kIdle:
+    case MoveBaseState::kApproach:
+    case MoveBaseState::kDepart:
+      break;
+  }
+  return command_;
+}
+
+void MoveBaseNavigator::add_stats(double dt) {
+  if (state_ == MoveBaseState::kClearing) stats_.recovery_s += dt;
+  if (command_ == VelocityCommand{}) stats_.stopped_s += dt;
+}
+
+// --- recovery behaviours -------------------------------------------------------------------
+
+void MoveBaseNavigator::start_recovery(SimTime now, const Pose2D& pose) {
+  command_ = {};
+  // The default sequence: conservative reset, rotation, aggressive reset, rotation.
+  const int count = config_.clearing_rotation_allowed ? 4 : 2;
+  if (!config_.recovery_behavior_enabled || recovery_index_ >= count) {
+    finish(trigger_ == Trigger::kPlanning ? NavOutcome::kNoPath : NavOutcome::kStuck,
+           trigger_ == Trigger::kPlanning
+               ? "move_base: failed to find a valid plan, even after executing recovery behaviors"
+               : "move_base: failed to find a valid control, even after executing recovery "
+                 "behaviors");
+    return;
+  }
+  ++stats_.recoveries;
+  const int behaviour = config_.clearing_rotation_allowed ? recovery_index_ : recovery_index_ * 2;
+  ++recovery_index_;
+  switch (behaviour) {
+    case 0:  // conservative reset
+    case 2:  // aggressive reset
+    {
+      const double size =
+          behaviour == 0 ? config_.conservative_reset_dist_m : 4.0 * config_.circumscribed_radius_m;
+      global_.reset_outside(pose.position(), size);
+      local_.reset_outside(pose.position(), size);
+      state_ = MoveBaseState::kPlanning;
+      next_control_ = now;
+      break;
+    }
+    default: {  // rotate in place, a full turn
+      ++stats_.rotate_recoveries;
+      rotating_ = true;
+      rotate_start_offset_ = -core::normalize_angle(pose.theta);
+      rotate_got_180_ = false;
+      break;
+    }
+  }
+}
+
+bool MoveBaseNavigator::rotation_free(const Pose2D& pose, double /*angle*/) const {
+  // A circular footprint: every heading at this position costs the same.
+  return local_.cost_at(pose.position(), false) < Costmap::kInscribed;
+}
+
+VelocityCommand MoveBaseNavigator::run_recovery(SimTime now, const Pose2D& pose,
+                                                const VelocityCommand& /*velocity*/) {
+  const double current =
+      core::normalize_angle(core::normalize_angle(pose.theta) + rotate_start_offset_);
+  const double left = core::kPi - current;
+  auto done = [&] {
+    rotating_ = false;
+    state_ = MoveBaseState::kPlanning;
+    next_control_ = now;
+    return VelocityCommand{};
+  };
+  if (!rotation_free(pose, left)) return done();
+  if (current < 0.0) rotate_got_180_ = true;
+  if (rotate_got_180_ && current >= -config_.yaw_goal_tolerance_rad) return done();
+  double vel = std::sqrt(2.0 * config_.acc_lim_th * left);
+  vel = std::clamp(vel, config_.min_in_place_rotational_vel, config_.max_rotational_vel);
+  return {0.0, 0.0, vel};
+}
+
+// --- the final approach --------------------------------------------------------------------
+
+VelocityCommand MoveBaseNavigator::approach(const Pose2D& pose, double /*dt*/) {
+  bool arrived = false;
+  const VelocityCommand c = straight_to(pose, goal_, arrived);
+  if (arrived) finish(NavOutcome::kArrived, {});
+  return c;
+}
+
+VelocityCommand MoveBaseNavigator::straight_to(const Pose2D& pose, const Pose2D& target,
+                                               bool& arrived) const {
+  const Vec2 d = target.position() - pose.position();
+  const double dist = d.norm();
+  const double dth = core::angle_diff(target.theta, pose.theta);
+  arrived =
+      dist <= config_.approach_tolerance_m && std::abs(dth) <= config_.approach_angle_tolerance_rad;
+  if (arrived) return {};
+  // A straight relative move (Fawkes' motor_move): proportional, capped; no obstacle check.
+  const double v = std::min(config_.approach_speed_mps, 1.5 * dist);
+  Vec2 vf = dist > 1e-9 ? Vec2(d * (v / dist)) : Vec2(0.0, 0.0);
+  const Vec2 vr = core::rotate(vf, -pose.theta);
+  const double w = std::clamp(1.5 * dth, -config_.approach_omega_rps, config_.approach_omega_rps);
+  return {vr.x(), vr.y(), w};
+}
+
+// --- the global planner (navfn) ------------------------------------------------------------
+
+bool MoveBaseNavigator::make_plan(const Pose2D& pose) {
+  // Dijkstra over the inflated global costmap from the goal, each cell costing navfn's
+  // neutral cost 50 plus 0.8 x its cost; inscribed and lethal cells are impassable, the
+  // robot's own cell is cleared. The path descends the potential from the start cell.
+  const Costmap& m = global_;
+  const int nx = m.nx(), ny = m.ny();
+  int si = 0, sj = 0, gi = 0, gj = 0;
+  plan_ = {};
+  if (!m.to_cell(pose.position(), si, sj) || !m.to_cell(base_goal_.position(), gi, gj)) {
+    ++stats_.plan_failures;
+    return false;
+  }
+  const std::size_t n = static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny);
+  const float kInf = std::numeric_limits<float>::infinity();
+  potential_.assign(n, kInf);
+  done_.assign(n, 0);
+  auto index = [nx](int i, int j) {
+    return static_cast<std::size_t>(j) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(i);
+  };
+  auto passable = [&](int i, int j) {
+    return (i == si && j == sj) || m.cost(i, j) < Costmap::kInscribed;
+  };
+  if (!passable(gi, gj)) {
+    ++stats_.plan_failures;
+    return false;
+  }
+  using Item = std::pair<float, std::size_t>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
+  potential_[index(gi, gj)] = 0.0f;
+  open.push({0.0f, index(gi, gj)});
+  const std::size_t start = index(si, sj);
+  constexpr int kDi[4] = {1, -1, 0, 0};
+  constexpr int kDj[4] = {0, 0, 1, -1};
+  while (!open.empty()) {
+    const auto [p, k] = open.top();
+    open.pop();
+    if (done_[k] != 0) continue;
+    done_[k] = 1;
+    if (k == start) break;
+    const int i = static_cast<int>(k % static_cast<std::size_t>(nx));
+    const int j = static_cast<int>(k / static_cast<std::size_t>(nx));
+    for (int e = 0; e < 4; ++e) {
+      const int a = i + kDi[e], b = j + kDj[e];
+      if (a < 0 || b < 0 || a >= nx || b >= ny || !passable(a, b)) continue;
+      const std::size_t kk = index(a, b);
+      const float c = p + 50.0f + 0.8f * static_cast<float>(m.cost(a, b));
+      if (c < potential_[kk]) {
+        potential_[kk] = c;
+        open.push({c, kk});
+      }
+    }
+  }
+  if (!std::isfinite(potential_[start])) {
+    ++stats_.plan_failures;
+    return false;
+  }
+  // Descend: from the start, always to the 8-neighbour of least potential.
+  plan_.points.push_back(pose.position());
+  int i = si, j = sj;
+  for (std::size_t guard = 0; guard < n && !(i == gi && j == gj); ++guard) {
+    int bi = i, bj = j;
+    float best = potential_[index(i, j)];
+    for (int dj = -1; dj <= 1; ++dj) {
+      for (int di = -1; di <= 1; ++di) {
+        const int a = i + di, b = j + dj;
+        if ((di == 0 && dj == 0) || a < 0 || b < 0 || a >= nx || b >= ny) continue;
+        const float q = potential_[index(a, b)];
+        if (q < best) {
+          best = q;
+          bi = a;
+          bj = b;
+        }
+      }
+    }
+    if (bi == i && bj == j) break;
+    i = bi;
+    j = bj;
+    plan_.points.push_back(m.cell_center(i, j));
+  }
+  plan_.points.push_back(base_goal_.position());
+  plan_.goal_theta = base_goal_.theta;
+  prune_from_ = 0;
+  ++stats_.plans;
+  return true;
+}
+
+// --- the local planner (TrajectoryPlannerROS) ----------------------------------------------
+
+void MoveBaseNavigator::update_grids(const Pose2D& pose) {
+  // Path and goal distances on the local costmap (cells, 4-connected), as base_local_planner's
+  // MapGrid: from every plan cell inside the window, and from the last one (the local goal).
+  const Costmap& m = local_;
+  const int nx = m.nx(), ny = m.ny();
+  const int obstacle = unreachable_;
+  const int unknown = unreachable_ + 1;
+  std::fill(path_dist_.begin(), path_dist_.end(), unknown);
+  std::fill(goal_dist_.begin(), goal_dist_.end(), unknown);
+  // Prune: plan points more than 1 m from the robot at the plan's start are passed.
+  const std::vector<Vec2>& pts = plan_.points;
+  while (prune_from_ + 1 < pts.size() && (pts[prune_from_] - pose.position()).squaredNorm() > 1.0) {
+    ++prune_from_;
+  }
+  auto index = [nx](int i, int j) {
+    return static_cast<std::size_t>(j) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(i);
+  };
+  auto bfs = [&](std::vector<int>& dist) {
+    std::size_t head = 0;
+    while (head < queue_.size()) {
+      const std::size_t k = static_cast<std::size_t>(queue_[head++]);
+      const int i = static_cast<int>(k % static_cast<std::size_t>(nx));
+      const int j = static_cast<int>(k / static_cast<std::size_t>(nx));
+      const int d = dist[k];
+      constexpr int kDi[4] = {1, -1, 0, 0};
+      constexpr int kDj[4] = {0, 0, 1, -1};
+      for (int e = 0; e < 4; ++e) {
+        const int a = i + kDi[e], b = j + kDj[e];
+        if (a < 0 || b < 0 || a >= nx || b >= ny) continue;
+        const std::size_t kk = index(a, b);
+        if (dist[kk] != unknown) continue;
+        if (m.cost(a, b) >= Costmap::kInscribed) {
+          dist[kk] = obstacle;
+          continue;
+        }
+        dist[kk] = d + 1;
+        queue_.push_back(static_cast<int>(kk));
+      }
+    }
+  };
+  // The plan at the local map's resolution: points at most one cell apart.
+  queue_.clear();
+  bool started = false;
+  int last_i = -1, last_j = -1;
+  for (std::size_t s = prune_from_; s < pts.size(); ++s) {
+    const Vec2 a = pts[s];
+    const Vec2 b = s + 1 < pts.size() ? pts[s + 1] : pts[s];
+    const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / m.resolution())));
+    bool left = false;
+    for (int t = 0; t < steps; ++t) {
+      const Vec2 p = a + (b - a) * (static_cast<double>(t) / steps);
+      int i = 0, j = 0;
+      if (!m.to_cell(p, i, j)) {
+        if (started) left = true;
+        if (left) break;
+        continue;
+      }
+      started = true;
+      const std::size_t k = index(i, j);
+      if (path_dist_[k] != 0) {
+        path_dist_[k] = 0;
+        queue_.push_back(static_cast<int>(k));
+      }
+      last_i = i;
+      last_j = j;
+    }
+    if (left) break;
+  }
+  bfs(path_dist_);
+  queue_.clear();
+  if (last_i >= 0) {
+    goal_dist_[index(last_i, last_j)] = 0;
+    queue_.push_back(static_cast<int>(index(last_i, last_j)));
+  }
+  bfs(goal_dist_);
+}
+
+void MoveBaseNavigator::generate(const Pose2D& pose, const VelocityCommand& vel, double vx_s,
+                                 double vy_s, double vth_s, Traj& t) const {
+  const MoveBaseConfig& c = config_;
+  const Costmap& m = local_;
+  const double vmag = std::hypot(vx_s, vy_s);
+  int steps = static_cast<int>(
+      std::max(vmag * c.sim_time_s / c.sim_granularity_m, std::abs(vth_s) / c.sim_granularity_m) +
+      0.5);
+  if (steps == 0) steps = 1;
+  const double dt = c.sim_time_s / steps;
+  double x = pose.x, y = pose.y, th = pose.theta;
+  double vx = vel.vx_mps, vy = vel.vy_mps, vth = vel.omega_rps;
+  t.vx = vx_s;
+  t.vy = vy_s;
+  t.vth = vth_s;
+  t.cost = -1.0;
+  double occ = 0.0;
+  int path_d = 0, goal_d = 0;
+  for (int s = 0; s < steps; ++s) {
+    int i = 0, j = 0;
+    if (!m.to_cell(Vec2(x, y), i, j)) return;  // off the known map
+    const std::uint8_t cost = m.cost(i, j);
+    if (cost >= Costmap::kInscribed) return;  // the footprint hits an obstacle
+    occ = std::max(occ, static_cast<double>(cost));
+    const std::size_t k = static_cast<std::size_t>(j) * static_cast<std::size_t>(m.nx()) +
+                          static_cast<std::size_t>(i);
+    path_d = path_dist_[k];
+    goal_d = goal_dist_[k];
+    if (path_d >= unreachable_ || goal_d >= unreachable_) {
+      t.cost = -2.0;  // no clear way to the goal from here
+      return;
+    }
+    t.end_x = x;
+    t.end_y = y;
+    t.end_th = th;
+    vx = ramp(vx_s, vx, c.acc_lim_x, dt);
+    vy = ramp(vy_s, vy, c.acc_lim_y, dt);
+    vth = ramp(vth_s, vth, c.acc_lim_th, dt);
+    x += (vx * std::cos(th) - vy * std::sin(th)) * dt;
+    y += (vx * std::sin(th) + vy * std::cos(th)) * dt;
+    th += vth * dt;
+  }
+  t.cost = c.path_distance_bias * path_d + c.goal_distance_bias * goal_d + c.occdist_scale * occ;
+}
+
+MoveBaseNavigator::Traj MoveBaseNavigator::create_trajectories(const Pose2D& pose,
+                                                               const VelocityCommand& vel) {
+  const MoveBaseConfig& c = config_;
+  const double period = 1.0 / c.controller_frequency_hz;
+  double max_vx = c.max_vel_x;
+  const double final_dist = (base_goal_.position() - pose.position()).norm();
+  max_vx = std::min(max_vx, final_dist / c.sim_time_s);
+  // The dynamic window: what the accelerations allow within one controller period.
+  max_vx = std::max(std::min(max_vx, vel.vx_mps + c.acc_lim_x * period), c.min_vel_x);
+  const double min_vx = std::max(c.min_vel_x, vel.vx_mps - c.acc_lim_x * period);
+  const double max_vth = std::min(c.max_rotational_vel, vel.omega_rps + c.acc_lim_th * period);
+  const double min_vth = std::max(-c.max_rotational_vel, vel.omega_rps - c.acc_lim_th * period);
+  const double dvx = (max_vx - min_vx) / (c.vx_samples - 1);
+  const double dvth = (max_vth - min_vth) / (c.vtheta_samples - 1);
+
+  Traj best;
+  Traj comp;
+  auto take_if_better = [&](bool or_equal) {
+    if (comp.cost >= 0 &&
+        (best.cost < 0 || comp.cost < best.cost || (or_equal && comp.cost <= best.cost))) {
+      std::swap(best, comp);
+    }
+  };
+  if (!escaping_) {
+    double vx = min_vx;
+    for (int a = 0; a < c.vx_samples; ++a) {
+      generate(pose, vel, vx, 0.0, 0.0, comp);
+      take_if_better(false);
+      double vth = min_vth;
+      for (int b = 0; b < c.vtheta_samples - 1; ++b) {
+        generate(pose, vel, vx, 0.0, vth, comp);
+        take_if_better(false);
+        vth += dvth;
+      }
+      vx += dvx;
+    }
+    // Holonomic: forward with a slight strafe either way.
+    generate(pose, vel, 0.1, 0.1, 0.0, comp);
+    take_if_better(false);
+    generate(pose, vel, 0.1, -0.1, 0.0, comp);
+    take_if_better(false);
+  }
+  // Rotations in place, towards open space (the heading that looks nearest the goal).
+  auto ahead_goal_dist = [&](const Traj& t) {
+    const Vec2 p(t.end_x + c.heading_lookahead_m * std::cos(t.end_th),
+                 t.end_y + c.heading_lookahead_m * std::sin(t.end_th));
+    int i = 0, j = 0;
+    if (!local_.to_cell(p, i, j)) return -1;
+    return goal_dist_[static_cast<std::size_t>(j) * static_cast<std::size_t>(local_.nx()) +
+                      static_cast<std::size_t>(i)];
+  };
+  double heading_dist = std::numeric_limits<double>::max();
+  double vth = min_vth;
+  for (int b = 0; b < c.vtheta_samples; ++b) {
+    const double limited = vth > 0 ? std::max(vth, c.min_in_place_rotational_vel)
+                                   : std::min(vth, -c.min_in_place_rotational_vel);
+    generate(pose, vel, 0.0, 0.0, limited, comp);
+    if (comp.cost >= 0 && (comp.cost <= best.cost || best.cost < 0 || best.vy != 0.0) &&
+        (vth > dvth || vth < -dvth)) {
+      const int g = ahead_goal_dist(comp);
+      if (g >= 0 && g < heading_dist) {
+        if ((vth < 0 && !stuck_left_) || (vth > 0 && !stuck_right_)) {
+          std::swap(best, comp);
+          heading_dist = g;
+        }
+      }
+    }
+    vth += dvth;
+  }
+  auto note_oscillation = [&] {
+    if (!(best.vx > 0)) {
+      if (best.vth < 0) {
+        if (rotating_right_) stuck_right_ = true;
+        rotating_left_ = true;
+      } else if (best.vth > 0) {
+        if (rotating_left_) stuck_left_ = true;
+        rotating_right_ = true;
+      } else if (best.vy > 0) {
+        if (strafe_right_) stuck_right_strafe_ = true;
+        strafe_left_ = true;
+      } else if (best.vy < 0) {
+        if (strafe_left_) stuck_left_strafe_ = true;
+        strafe_right_ = true;
+      }
+      prev_x_ = pose.x;
+      prev_y_ = pose.y;
+    }
+  };
+  auto reset_oscillation = [&] {
+    if (std::hypot(pose.x - prev_x_, pose.y - prev_y_) > c.oscillation_reset_dist_m) {
+      rotating_left_ = rotating_right_ = strafe_left_ = strafe_right_ = false;
+      stuck_left_ = stuck_right_ = stuck_left_strafe_ = stuck_right_strafe_ = false;
+    }
+  };
+  auto reset_escape = [&] {
+    if (std::hypot(pose.x - escape_x_, pose.y - escape_y_) > c.escape_reset_dist_m ||
+        std::abs(core::angle_diff(escape_th_, pose.theta)) > c.escape_reset_theta_rad) {
+      escaping_ = false;
+    }
+  };
+  if (best.cost >= 0) {
+    note_oscillation();
+    reset_oscillation();
+    reset_escape();
+    return best;
+  }
+  // Holonomic: sideways.
+  for (const double vy : {-0.3, -0.1, 0.1, 0.3}) {
+    generate(pose, vel, 0.0, vy, 0.0, comp);
+    if (comp.cost >= 0 && (comp.cost <= best.cost || best.cost < 0)) {
+      const int g = ahead_goal_dist(comp);
+      if (g >= 0 && g < heading_dist) {
+        if ((vy > 0 && !stuck_left_strafe_) || (vy < 0 && !stuck_right_strafe_)) {
+          std::swap(best, comp);
+          heading_dist = g;
+        }
+      }
+    }
+  }
+  if (best.cost >= 0) {
+    note_oscillation();
+    reset_oscillation();
+    reset_escape();
+    return best;
+  }
+  // Nothing else: back up slowly, even where the map shows it blocked.
+  generate(pose, vel, c.escape_vel_mps, 0.0, 0.0, comp);
+  std::swap(best, comp);
+  reset_oscillation();
+  if (!escaping_ && best.cost > -2.0) {
+    escape_x_ = pose.x;
+    escape_y_ = pose.y;
+    escape_th_ = pose.theta;
+    escaping_ = true;
+  }
+  reset_escape();
+  if (best.cost == -1.0) best.cost = 1.0;
+  if (best.cost >= 0) ++stats_.escapes;
+  return best;
+}
+
+bool MoveBaseNavigator::compute_velocity(const Pose2D& pose, const VelocityCommand& vel,
+                                         VelocityCommand& cmd) {
+  if (plan_.points.empty()) return false;
+  const MoveBaseConfig& c = config_;
+  const double period = 1.0 / c.controller_frequency_hz;
+  update_grids(pose);
+  const double dist = (base_goal_.position() - pose.position()).norm();
+  if (dist <= c.xy_goal_tolerance_m) {
+    // At the goal position: stop within the acceleration limits, then rotate to the heading.
+    const double dth = core::angle_diff(base_goal_.theta, pose.theta);
+    if (std::abs(dth) <= c.yaw_goal_tolerance_rad) {
+      cmd = {};
+      rotating_to_goal_ = false;
+      return true;
+    }
+    const bool stopped = std::hypot(vel.vx_mps, vel.vy_mps) <= c.stopped_vel &&
+                         std::abs(vel.omega_rps) <= c.stopped_vel;
+    if (!rotating_to_goal_ && !stopped) {
+      const double vx =
+          sign(vel.vx_mps) * std::max(0.0, std::abs(vel.vx_mps) - c.acc_lim_x * period);
+      const double vy =
+          sign(vel.vy_mps) * std::max(0.0, std::abs(vel.vy_mps) - c.acc_lim_y * period);
+      const double vt =
+          sign(vel.omega_rps) * std::max(0.0, std::abs(vel.omega_rps) - c.acc_lim_th * period);
+      Traj t;
+      generate(pose, vel, vx, vy, vt, t);
+      if (t.cost < 0) return false;
+      cmd = {vx, vy, vt};
+      return true;
+    }
+    rotating_to_goal_ = true;
+    double v = dth > 0.0
+                   ? std::min(c.max_rotational_vel, std::max(c.min_in_place_rotational_vel, dth))
+                   : std::max(-c.max_rotational_vel, std::min(-c.min_in_place_rotational_vel, dth));
+    const double max_acc = std::abs(vel.omega_rps) + c.acc_lim_th * period;
+    const double min_acc = std::abs(vel.omega_rps) - c.acc_lim_th * period;
+    v = sign(v) * std::min(std::max(std::abs(v), min_acc), max_acc);
+    v = sign(v) * std::min(std::sqrt(2.0 * c.acc_lim_th * std::abs(dth)), std::abs(v));
+    v = v > 0.0 ? std::min(c.max_rotational_vel, std::max(c.min_in_place_rotational_vel, v))
+                : std::max(-c.max_rotational_vel, std::min(-c.min_in_place_rotational_vel, v));
+    Traj t;
+    generate(pose, vel, 0.0, 0.0, v, t);
+    if (t.cost < 0) return false;
+    cmd = {0.0, 0.0, v};
+    return true;
+  }
+  const Traj best = create_trajectories(pose, vel);
+  if (best.cost < 0) return false;
+  cmd = {best.vx, best.vy, best.vth};
+  return true;
+}
+
+}  // namespace llsf::planner
