@@ -68,7 +68,7 @@ void MoveBaseConfig::validate() const {
 
 double MoveBaseConfig::standoff_m() const {
   const double cell = std::max(local_resolution_m, global_resolution_m);
-  return std::ceil(robot_radius_m / cell - 1e-9) * cell + cell + approach_tolerance_m;
+  return std::ceil(robot_radius_m / cell - 1e-9) * cell + 2.0 * cell;
 }
 
 const char* to_string(MoveBaseState state) {

@@ -96,18 +96,13 @@ kinematic::MotorCommand RobotStack::actuate(SimTime now,
             now, localization_.estimate().pose, odom_velocity_, scan_new_ ? &scan : nullptr);
         scan_new_ = false;
         if (was_running) note_nav_end(now);
-        // move_base's own goal approach stands for the alignment (align_s is not added).
+        note_arrival(now, move_base_->status().outcome);
         return handle({c.vx_mps, c.vy_mps, c.omega_rps}, false);
       }
       const bool was_running = nav_.status().outcome == planner::NavOutcome::kRunning;
       const planner::VelocityCommand c = nav_.update(now, localization_.estimate().pose, others);
       if (was_running) note_nav_end(now);
-      if (!arrived_at_ && nav_.status().outcome == planner::NavOutcome::kArrived) {
-        // Only the end of a real drive is aligned again (robot profiles): a short push is not.
-        const bool drove =
-            (true_pose_.position() - goal_from_).norm() >= handling_.align_min_drive_m;
-        arrived_at_ = drove ? now : now - SimTime::from_seconds(handling_.align_s);
-      }
+      note_arrival(now, nav_.status().outcome);
       return handle({c.vx_mps, c.vy_mps, c.omega_rps}, false);
     }
     case Drive::kMotor:
@@ -116,6 +111,13 @@ kinematic::MotorCommand RobotStack::actuate(SimTime now,
       break;
   }
   return {};
+}
+
+void RobotStack::note_arrival(SimTime now, planner::NavOutcome outcome) {
+  if (arrived_at_ || outcome != planner::NavOutcome::kArrived) return;
+  // Only the end of a real drive is aligned again (robot profiles): a short push is not.
+  const bool drove = (true_pose_.position() - goal_from_).norm() >= handling_.align_min_drive_m;
+  arrived_at_ = drove ? now : now - SimTime::from_seconds(handling_.align_s);
 }
 
 kinematic::MotorCommand RobotStack::handle(kinematic::MotorCommand c, bool motor) {

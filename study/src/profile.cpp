@@ -55,13 +55,39 @@ RobotProfile robotino_2013() {
   return p;
 }
 
+// The 2013 Carologistics Robotino with the team's own navigation configuration
+// (carologistics/fawkes-robotino 6cffc15f2, cfg/move_base_robotino/; docs/profiles.md). Work in
+// progress (issue #32): not yet calibrated, not yet the experiment's profile.
+RobotProfile robotino_2013_move_base() {
+  RobotProfile p = robotino_2013();
+  p.name = "robotino-2013-move_base";
+  // base_local_planner_params.yaml: max_vel_x 0.5, max_rotational_vel 0.78, acc_lim_x/y 2.5,
+  // acc_lim_th 3.2 -- for move_base and for the world's robot alike.
+  p.max_speed_mps = 0.5;
+  p.max_omega_rps = 0.78;
+  p.max_accel_mps2 = 2.5;
+  p.max_alpha_rps2 = 3.2;
+  // move_base's navigation sees other robots only with the laser (costmap_common_params.yaml:
+  // the laser is the only observation source), at the thesis' 5 Hz.
+  p.navigation = sim::NavigationLevel::kMoveBase2013;
+  p.laser = true;
+  // Jams at machines: contact and move_base, not dice (docs/profiles.md, "Failures").
+  p.jam_probability = 0.0;
+  // Not yet recalibrated: robotino-2013's figure (docs/profiles.md).
+  p.align_s = 12.0;
+  return p;
+}
+
 }  // namespace
 
-std::vector<std::string> RobotProfile::names() { return {"ideal", "robotino-2013"}; }
+std::vector<std::string> RobotProfile::names() {
+  return {"ideal", "robotino-2013", "robotino-2013-move_base"};
+}
 
 RobotProfile RobotProfile::named(std::string_view name) {
   if (name == "ideal") return RobotProfile{};
   if (name == "robotino-2013") return robotino_2013();
+  if (name == "robotino-2013-move_base") return robotino_2013_move_base();
   throw std::invalid_argument("unknown robot profile '" + std::string(name) + "'");
 }
 
@@ -115,6 +141,8 @@ void RobotProfile::apply(sim::GameConfig& game, lua::SkillEngineConfig& skills) 
   c.backoff_max_s = backoff_max_s;
   c.blocked_timeout_s = blocked_timeout_s;
   game.world.sensors.laser.rate_hz = laser_rate_hz;
+  game.world.sensors.laser.enabled = laser;
+  game.levels.navigation = navigation;
   sim::LightDetectionConfig& l = game.levels.light;
   l.level = light;
   l.frame_rate_hz = light_frame_rate_hz;
@@ -168,7 +196,8 @@ RobotProfile named_or_fail(const core::ConfigNode& n) {
   try {
     return RobotProfile::named(n.as_string());
   } catch (const std::invalid_argument&) {
-    n.fail("unknown profile '" + n.as_string() + "' (known: ideal, robotino-2013)");
+    n.fail("unknown profile '" + n.as_string() +
+           "' (known: ideal, robotino-2013, robotino-2013-move_base)");
   }
 }
 
@@ -188,6 +217,11 @@ RobotProfile load_profile(const core::ConfigNode& node) {
                  {{"ground_truth", sim::LocalizationLevel::kGroundTruth},
                   {"noisy", sim::LocalizationLevel::kNoisy}},
                  "localization level");
+  node.read_enum("navigation", p.navigation,
+                 {{"ideal", sim::NavigationLevel::kIdeal},
+                  {"move_base-2013", sim::NavigationLevel::kMoveBase2013}},
+                 "navigation level");
+  node.read("laser", p.laser);
   node.read("light_reads_states", p.light_reads_states);
   node.read("stuck_detection", p.stuck_detection);
   node.no_other_keys();

@@ -89,11 +89,11 @@ struct MoveBaseConfig {
 
   /// The clearance (robot centre to the nearest static obstacle or wall) of the pose move_base
   /// drives to instead of a goal too close to an obstacle, and of the point a departure goes
-  /// to: the smallest at which both costmaps, however their cells fall, see the robot free --
-  /// the robot radius rounded up to whole cells of the coarser map (costmap_2d's
-  /// cellDistance), plus one such cell (the robot's and the obstacle's cell centres may each be
-  /// half a cell off), plus the straight move's stop tolerance (0.30 + 0.1 + 0.02 = 0.42 m
-  /// with the 2013 figures).
+  /// to: where both costmaps see the robot free however their cells fall -- the robot radius
+  /// rounded up to whole cells of the coarser map (costmap_2d's cellDistance), plus two such
+  /// cells: the robot's and the obstacle's cell centres may each be half a cell off, and the
+  /// laser's noise, the localization's error and the stop tolerance need the second
+  /// (0.30 + 0.2 = 0.50 m with the 2013 figures).
   double standoff_m() const;
 
   /// Throws core::ConfigError naming the field ("move_base.sim_time_s: must be > 0").

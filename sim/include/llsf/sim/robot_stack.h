@@ -250,6 +250,8 @@ class RobotStack final : public lua::RobotApi {
   std::int64_t nav_failure_count_ = 0;
   std::string goal_place_;
   bool goal_known_ = true;
+  /// Starts the alignment time (HandlingConfig::align_s) at the navigation's arrival.
+  void note_arrival(SimTime now, planner::NavOutcome outcome);
   /// Remembers the navigation's end if it failed (called where the outcome can change).
   void note_nav_end(SimTime now);
   /// Applies the motor caps and the jam to a command; may start or end a jam.

@@ -3,7 +3,9 @@
 // game -- drive limits, fine motion, alignment at a goal, light and laser rates, localization,
 // navigation around other robots, jams at devices and whether skills detect being stuck.
 // `ideal` is the game loop's defaults; `robotino-2013` is the 2013 Carologistics Robotino as the
-// thesis' Gazebo games show it. docs/profiles.md gives every figure with its source.
+// thesis' Gazebo games show it; `robotino-2013-move_base` the same robot with the team's own
+// move_base configuration (work in progress). docs/profiles.md gives every figure with its
+// source.
 #pragma once
 
 #include <string>
@@ -45,7 +47,11 @@ struct RobotProfile {
   double position_noise_m = 0.01;
   double heading_noise_rad = 0.01;
 
-  // Navigation around other robots (navigation.controller).
+  // Navigation: the level (levels.navigation) and, at the ideal level, how the navigator deals
+  // with other robots (navigation.controller).
+  sim::NavigationLevel navigation = sim::NavigationLevel::kIdeal;
+  /// Whether the laser runs (world.sensors.laser.enabled); the move_base-2013 level needs it.
+  bool laser = true;
   double wait_before_replan_s = 1.0;
   double backoff_min_s = 0.5;
   double backoff_max_s = 3.0;
@@ -55,7 +61,7 @@ struct RobotProfile {
   double jam_probability = 0.0;  ///< HandlingConfig::jam_probability
   bool stuck_detection = true;   ///< HandlingConfig::stuck_detection
 
-  /// The names named() knows: "ideal", "robotino-2013".
+  /// The names named() knows: "ideal", "robotino-2013", "robotino-2013-move_base".
   static std::vector<std::string> names();
   /// A named profile; throws std::invalid_argument for an unknown name.
   static RobotProfile named(std::string_view name);
