@@ -29,6 +29,7 @@ using namespace llsf;
 namespace {
 
 std::string scenario() { return bench::tree() + "/scenarios/default.yaml"; }
+std::string move_base_scenario() { return bench::tree() + "/bench/move_base_game.yaml"; }
 
 double wall_now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -44,7 +45,7 @@ struct ChildGame {
 
 // Plays seed 1 in a child process; the child writes wall seconds, game seconds and points to a
 // pipe, the parent reads its peak resident set size from wait4().
-ChildGame game_in_child() {
+ChildGame game_in_child(const std::string& path) {
   ChildGame g;
   int fds[2];
   if (pipe(fds) != 0) return g;
@@ -52,7 +53,7 @@ ChildGame game_in_child() {
   if (pid < 0) return g;
   if (pid == 0) {
     close(fds[0]);
-    const study::ScenarioFile f = study::load_scenario(scenario());
+    const study::ScenarioFile f = study::load_scenario(path);
     const double t0 = wall_now();
     const study::RunResult r = study::run_game(f.variants[0], 1);
     const double wall = wall_now() - t0;
@@ -83,17 +84,14 @@ double median(std::vector<double> v) {
   return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-}  // namespace
-
-LLSF_BENCH(game,
-           "scenarios/default.yaml, seed 1, in a child process: real-time factor, wall seconds "
-           "and peak memory of one 1080 s 3-robot game (median of 5)") {
+// Plays `path`'s seed 1 five times, each in a child process, and reports the medians as `name`.
+void games_in_children(const char* name, const std::string& path) {
   std::vector<double> wall, rss;
   double game_s = 0.0;
   for (int i = 0; i < 5; ++i) {
-    const ChildGame g = game_in_child();
+    const ChildGame g = game_in_child(path);
     if (!g.ok) {
-      std::fprintf(stderr, "game: the child process failed\n");
+      std::fprintf(stderr, "%s: the child process failed\n", name);
       return;
     }
     wall.push_back(g.wall_s);
@@ -101,9 +99,24 @@ LLSF_BENCH(game,
     game_s = g.game_s;
   }
   const double w = median(wall);
-  bench::report("game", "rtf", game_s / w, "x");
-  bench::report("game", "wall_s", w, "s");
-  bench::report("game", "peak_rss_mb", median(rss), "MB");
+  bench::report(name, "rtf", game_s / w, "x");
+  bench::report(name, "wall_s", w, "s");
+  bench::report(name, "peak_rss_mb", median(rss), "MB");
+}
+
+}  // namespace
+
+LLSF_BENCH(game,
+           "scenarios/default.yaml, seed 1, in a child process: real-time factor, wall seconds "
+           "and peak memory of one 1080 s 3-robot game (median of 5)") {
+  games_in_children("game", scenario());
+}
+
+LLSF_BENCH(game_move_base,
+           "bench/move_base_game.yaml (the default game under robotino-2013-move_base: the "
+           "move_base-2013 navigation, the laser on), seed 1, in a child process: real-time "
+           "factor, wall seconds and peak memory (median of 5)") {
+  games_in_children("game_move_base", move_base_scenario());
 }
 
 LLSF_BENCH(batch100,

@@ -123,6 +123,48 @@ void Costmap::recenter(const Vec2& center) {
 }
 
 void Costmap::update(const Vec2& origin, std::span<const Vec2> hits) {
+  mark_and_clear(origin, hits);
+  inflate();
+}
+
+void Costmap::update(const Vec2& origin, std::span<const Vec2> hits, const Vec2& robot,
+                     double radius_m) {
+  mark_and_clear(origin, hits);
+  erase_within(robot, radius_m);
+  inflate();
+}
+
+bool Costmap::clear_footprint(const Vec2& center, double radius_m) {
+  if (!erase_within(center, radius_m)) return false;
+  inflate();
+  return true;
+}
+
+bool Costmap::erase_within(const Vec2& center, double radius_m) {
+  // The cells whose centres lie inside the circle (costmap_2d fills a 72-gon of it).
+  bool any = false;
+  int i0 = 0, j0 = 0, i1 = 0, j1 = 0;
+  const Vec2 lo = center - Vec2(radius_m, radius_m);
+  const Vec2 hi = center + Vec2(radius_m, radius_m);
+  i0 = std::max(0, static_cast<int>(std::floor((lo.x() - origin_.x()) / res_)));
+  j0 = std::max(0, static_cast<int>(std::floor((lo.y() - origin_.y()) / res_)));
+  i1 = std::min(nx_ - 1, static_cast<int>(std::floor((hi.x() - origin_.x()) / res_)));
+  j1 = std::min(ny_ - 1, static_cast<int>(std::floor((hi.y() - origin_.y()) / res_)));
+  const double r2 = radius_m * radius_m;
+  for (int j = j0; j <= j1; ++j) {
+    for (int i = i0; i <= i1; ++i) {
+      if ((cell_center(i, j) - center).squaredNorm() > r2) continue;
+      std::uint8_t& o = obstacle_[idx(i, j)];
+      if (o != 0) {
+        o = 0;
+        any = true;
+      }
+    }
+  }
+  return any;
+}
+
+void Costmap::mark_and_clear(const Vec2& origin, std::span<const Vec2> hits) {
   int i0 = 0, j0 = 0;
   const bool origin_in = to_cell(origin, i0, j0);
   const int max_cells = static_cast<int>(raytrace_range_ / res_);
@@ -171,7 +213,6 @@ void Costmap::update(const Vec2& origin, std::span<const Vec2> hits) {
     if (static_lethal_[idx(i, j)] != 0) continue;  // already an obstacle for good
     obstacle_[idx(i, j)] = 1;
   }
-  inflate();
 }
 
 void Costmap::reset_outside(const Vec2& center, double size_m) {

@@ -186,6 +186,7 @@ TEST_CASE("move_base-2013: a goal another robot stands on ends in move_base's ab
   CHECK(r.a == planner::NavOutcome::kNoPath);
   CHECK(r.sa.recoveries >= 4);
   CHECK(r.sa.rotate_recoveries >= 2);
+  CHECK(r.sa.recovery_s > 10.0);  // full turns at up to 0.78 rad/s
   CHECK(g.robot(0).nav_status().message.find("even after executing recovery behaviors") !=
         std::string::npos);
 }

@@ -133,6 +133,12 @@ class Costmap {
   /// One sensor update: clear the cells along every beam from `origin` to its hit (within
   /// raytrace range), mark the hits within obstacle range, then inflate.
   void update(const Vec2& origin, std::span<const Vec2> hits);
+  /// update() and clear_footprint() in one inflation.
+  void update(const Vec2& origin, std::span<const Vec2> hits, const Vec2& robot, double radius_m);
+  /// costmap_2d's clearRobotFootprint(), after every update and before every controller cycle:
+  /// laser obstacle cells within `radius_m` of `center` (the robot's inscribed circle) are
+  /// forgotten, then the map is inflated again. Returns whether a cell was cleared.
+  bool clear_footprint(const Vec2& center, double radius_m);
   /// ClearCostmapRecovery: laser obstacles outside the square of side `size_m` around `center`
   /// are forgotten (the static map remains).
   void reset_outside(const Vec2& center, double size_m);
@@ -147,6 +153,8 @@ class Costmap {
            static_cast<std::size_t>(i);
   }
   void inflate();
+  void mark_and_clear(const Vec2& origin, std::span<const Vec2> hits);
+  bool erase_within(const Vec2& center, double radius_m);
 
   Vec2 origin_{0.0, 0.0};
   int nx_ = 0;
