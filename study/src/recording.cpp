@@ -16,6 +16,7 @@
 #include <unordered_map>
 
 #include "llsf/core/error.h"
+#include "llsf/planner/move_base.h"
 #include "llsf/refbox/refbox.h"
 
 namespace llsf::study {
@@ -157,6 +158,7 @@ struct Recorder::Impl {
   std::int64_t dropped = 0;
   std::vector<std::string> robot_names;
   std::vector<std::vector<core::Vec2>> paths;  // per robot, as last written
+  std::vector<int> nav_states;                 // per robot: move_base's state as last written
   std::vector<int> jam_device;                 // per robot, as last written (-1: not jammed)
   std::vector<std::int64_t> robot_dropped;     // per robot: its copies dropped so far
   sim::HackathonScore score;                   // hackathon: as last written
@@ -203,6 +205,7 @@ Recorder::Recorder(const std::string& path, const sim::Game& game, const Recordi
     }
   }
   m.paths.resize(static_cast<std::size_t>(game.robot_count()));
+  m.nav_states.assign(static_cast<std::size_t>(game.robot_count()), -1);
   m.jam_device.assign(static_cast<std::size_t>(game.robot_count()), -1);
   m.robot_dropped.assign(static_cast<std::size_t>(game.robot_count()), 0);
   m.camera_frames.assign(static_cast<std::size_t>(game.robot_count()), 0);
@@ -612,6 +615,26 @@ void Recorder::frame(const sim::Game& game) {
     Json j = Impl::event(t, "path");
     j["robot"] = m.robot_names.at(static_cast<std::size_t>(i));
     j["points"] = std::move(points);
+    m.write(j);
+  }
+
+  // move_base-2013 level: its state when it changed (docs/recording.md), with the counters of
+  // the current navigation.
+  for (int i = 0; i < game.robot_count(); ++i) {
+    const planner::MoveBaseNavigator* mb = game.robot(i).move_base();
+    if (mb == nullptr) continue;
+    const int state = static_cast<int>(mb->state());
+    int& last = m.nav_states[static_cast<std::size_t>(i)];
+    if (state == last) continue;
+    last = state;
+    const planner::MoveBaseStats& st = mb->stats();
+    Json j = Impl::event(t, "move_base");
+    j["robot"] = m.robot_names.at(static_cast<std::size_t>(i));
+    j["state"] = planner::to_string(mb->state());
+    j["recoveries"] = st.recoveries;
+    j["rotations"] = st.rotate_recoveries;
+    j["escapes"] = st.escapes;
+    j["plans"] = st.plans;
     m.write(j);
   }
 
