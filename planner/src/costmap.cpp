@@ -48,6 +48,34 @@ Costmap::Costmap(Vec2 origin, int nx, int ny, double resolution_m, const MoveBas
       if (c > 0) kernel_.push_back({di, dj, c});
     }
   }
+  // The same kernel as row spans (zeros inside a span are harmless under max).
+  for (int dj = -r; dj <= r; ++dj) {
+    int lo = r + 1, hi = -r - 1;
+    for (const KernelCell& k : kernel_) {
+      if (k.dj != dj) continue;
+      lo = std::min(lo, k.di);
+      hi = std::max(hi, k.di);
+    }
+    if (lo > hi) continue;
+    KernelRow row{dj, lo, std::vector<std::uint8_t>(static_cast<std::size_t>(hi - lo + 1), 0)};
+    for (const KernelCell& k : kernel_) {
+      if (k.dj == dj) row.costs[static_cast<std::size_t>(k.di - lo)] = k.cost;
+    }
+    rows_.push_back(std::move(row));
+  }
+}
+
+void Costmap::stamp(std::vector<std::uint8_t>& grid, int i, int j) const {
+  for (const KernelRow& row : rows_) {
+    const int b = j + row.dj;
+    if (b < 0 || b >= ny_) continue;
+    const int first = i + row.di0;
+    const int a0 = std::max(0, first);
+    const int a1 = std::min(nx_ - 1, first + static_cast<int>(row.costs.size()) - 1);
+    std::uint8_t* out = grid.data() + idx(0, b);
+    const std::uint8_t* k = row.costs.data() - first;
+    for (int a = a0; a <= a1; ++a) out[a] = std::max(out[a], k[a]);
+  }
 }
 
 bool Costmap::to_cell(const Vec2& p, int& i, int& j) const {
@@ -87,13 +115,7 @@ void Costmap::set_static(const Planner& planner) {
   std::fill(static_cost_.begin(), static_cost_.end(), kFree);
   for (int j = 0; j < ny_; ++j) {
     for (int i = 0; i < nx_; ++i) {
-      if (static_lethal_[idx(i, j)] == 0) continue;
-      for (const KernelCell& k : kernel_) {
-        const int a = i + k.di, b = j + k.dj;
-        if (a < 0 || b < 0 || a >= nx_ || b >= ny_) continue;
-        std::uint8_t& c = static_cost_[idx(a, b)];
-        c = std::max(c, k.cost);
-      }
+      if (static_lethal_[idx(i, j)] != 0) stamp(static_cost_, i, j);
     }
   }
   for (std::size_t n = 0; n < obstacle_.size(); ++n) {
@@ -241,13 +263,7 @@ void Costmap::inflate() {
   cost_ = static_cost_;
   for (int j = 0; j < ny_; ++j) {
     for (int i = 0; i < nx_; ++i) {
-      if (obstacle_[idx(i, j)] == 0) continue;
-      for (const KernelCell& k : kernel_) {
-        const int a = i + k.di, b = j + k.dj;
-        if (a < 0 || b < 0 || a >= nx_ || b >= ny_) continue;
-        std::uint8_t& c = cost_[idx(a, b)];
-        c = std::max(c, k.cost);
-      }
+      if (obstacle_[idx(i, j)] != 0) stamp(cost_, i, j);
     }
   }
 }

@@ -364,13 +364,22 @@ void RobotStack::sense(const RobotPercept& p) {
       scan_origin_ = est.to_parent(laser_mount_);
       scan_hits_.clear();
       const std::size_t n = s.laser.ranges.size();
+      if (beam_dirs_.size() != n) {
+        // The beams' directions in the robot frame, once (the scan's geometry is fixed).
+        beam_dirs_.resize(n);
+        for (std::size_t i = 0; i < n; ++i) {
+          const double a =
+              s.laser.angle_min_rad + static_cast<double>(i) * s.laser.angle_increment_rad;
+          beam_dirs_[i] = {std::cos(a), std::sin(a)};
+        }
+      }
+      const double c = std::cos(est.theta), sn = std::sin(est.theta);
       for (std::size_t i = 0; i < n; ++i) {
         const float r = s.laser.ranges[i];
         if (!std::isfinite(r)) continue;
-        const double a = est.theta + s.laser.angle_min_rad +
-                         static_cast<double>(i) * s.laser.angle_increment_rad;
-        scan_hits_.emplace_back(scan_origin_.x() + r * std::cos(a),
-                                scan_origin_.y() + r * std::sin(a));
+        const core::Vec2& d = beam_dirs_[i];
+        scan_hits_.emplace_back(scan_origin_.x() + r * (c * d.x() - sn * d.y()),
+                                scan_origin_.y() + r * (sn * d.x() + c * d.y()));
       }
       scan_new_ = true;
     }

@@ -170,6 +170,13 @@ class Costmap {
     std::uint8_t cost;
   };
   std::vector<KernelCell> kernel_;
+  struct KernelRow {  // the kernel by rows: costs of cells di0, di0 + 1, ... of row dj
+    int dj;
+    int di0;
+    std::vector<std::uint8_t> costs;
+  };
+  std::vector<KernelRow> rows_;
+  void stamp(std::vector<std::uint8_t>& grid, int i, int j) const;
   double raytrace_range_ = 3.0;
   double obstacle_range_ = 3.0;
 };
