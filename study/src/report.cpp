@@ -46,44 +46,7 @@ double mean_of(const std::vector<double>& x) {
   return std::accumulate(x.begin(), x.end(), 0.0) / static_cast<double>(x.size());
 }
 
-// The estimator of one resample (sorted in place for the median).
-double estimate(std::vector<double>& x, Estimator e) {
-  if (e == Estimator::kMean) return mean_of(x);
-  std::sort(x.begin(), x.end());
-  return quantile(x, 0.5);
-}
-
 }  // namespace
-
-Interval bootstrap_interval(const std::vector<double>& a, const std::vector<double>& b,
-                            Estimator estimator, core::RandomStream& rng, int resamples) {
-  LLSF_DEMAND(!a.empty());
-  LLSF_DEMAND(resamples > 0);
-  auto resample = [&rng](const std::vector<double>& from, std::vector<double>& to) {
-    to.resize(from.size());
-    const auto last = static_cast<std::int64_t>(from.size()) - 1;
-    for (double& x : to) x = from[static_cast<std::size_t>(rng.uniform_int(0, last))];
-  };
-  std::vector<double> values;
-  values.reserve(static_cast<std::size_t>(resamples));
-  std::vector<double> ra, rb;
-  for (int k = 0; k < resamples; ++k) {
-    resample(a, ra);
-    resample(b, rb);
-    const double ea = estimate(ra, estimator);
-    values.push_back(b.empty() ? ea : ea - estimate(rb, estimator));
-  }
-  std::sort(values.begin(), values.end());
-  return {quantile(values, 0.025), quantile(values, 0.975)};
-}
-
-double quantile(const std::vector<double>& sorted, double q) {
-  if (sorted.empty()) return 0.0;
-  const double h = (static_cast<double>(sorted.size()) - 1.0) * std::clamp(q, 0.0, 1.0);
-  const auto lo = static_cast<std::size_t>(std::floor(h));
-  const std::size_t hi = std::min(lo + 1, sorted.size() - 1);
-  return sorted[lo] + (h - static_cast<double>(lo)) * (sorted[hi] - sorted[lo]);
-}
 
 const StatSummary* VariantReport::find(const std::string& name) const {
   for (const StatSummary& s : stats) {

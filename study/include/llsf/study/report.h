@@ -13,6 +13,7 @@
 
 #include "llsf/core/error.h"
 #include "llsf/core/rng.h"
+#include "llsf/study/compare.h"
 #include "llsf/study/stats_store.h"
 
 namespace llsf::study {
@@ -90,29 +91,5 @@ std::string viewer_dir();
 /// `json` (to_json's output) in `<script id="llsf-report-data" type="application/json">`; the
 /// text report in a <noscript>. Throws ViewerBundleMissing if `dir`/report.js cannot be read.
 std::string to_html(const BatchReport& r, const std::string& json, const std::string& dir);
-
-/// Resamples of the percentile bootstrap (reports, experiments).
-constexpr int kBootstrapResamples = 2000;
-
-/// What a bootstrap interval is taken of.
-enum class Estimator : std::uint8_t { kMean, kMedian };
-
-/// A percentile-bootstrap 95 % interval.
-struct Interval {
-  double low = 0.0;
-  double high = 0.0;
-};
-
-/// Percentile-bootstrap 95 % interval of estimator(a) - estimator(b), or of estimator(a) if `b`
-/// is empty: `resamples` times, a and then b are resampled with replacement (independently, each
-/// to its own size) from `rng`; the interval is the 2.5 % and 97.5 % quantiles of the resampled
-/// values. `a` must not be empty.
-Interval bootstrap_interval(const std::vector<double>& a, const std::vector<double>& b,
-                            Estimator estimator, core::RandomStream& rng,
-                            int resamples = kBootstrapResamples);
-
-/// Quantile `q` in [0, 1] of sorted values, linear interpolation between order statistics
-/// (R's type 7); 0 for an empty vector.
-double quantile(const std::vector<double>& sorted, double q);
 
 }  // namespace llsf::study
