@@ -141,7 +141,7 @@ std::optional<int> games_to_separate(double diff, double sd) {
 }
 
 Comparison compare_means(const std::vector<KeyedValue>& a, const std::vector<KeyedValue>& b,
-                         core::RandomStream& rng, int resamples) {
+                         core::RandomStream& rng, int min_games, int resamples) {
   LLSF_DEMAND(!a.empty() && !b.empty());
   Comparison c;
   c.n_a = static_cast<int>(a.size());
@@ -204,19 +204,22 @@ Comparison compare_means(const std::vector<KeyedValue>& a, const std::vector<Key
   c.ci90 = {quantile(values, t90), quantile(values, 1.0 - t90)};
   // Two-sided p: the level at which the expanded interval's end reaches 0, so that p < 5 % where
   // the 95 % interval excludes 0. The share of resampled differences beyond 0 (ties count on both
-  // sides; (k + 1) / (R + 1) keeps it above 0) is the tail Phi(-widen t) of that level.
+  // sides) is the tail Phi(-widen t) of that level; none beyond 0: p = 0, as every interval
+  // excludes 0.
   const auto below = std::upper_bound(values.begin(), values.end(), 0.0) - values.begin();
   const auto above = values.end() - std::lower_bound(values.begin(), values.end(), 0.0);
-  const double r = static_cast<double>(values.size());
-  const double tail = std::min(0.5, (static_cast<double>(std::min(below, above)) + 1.0) / (r + 1.0));
-  if (df >= 1 && std::isfinite(widen) && widen > 0.0) {
+  const double tail = std::min(
+      0.5, static_cast<double>(std::min(below, above)) / static_cast<double>(values.size()));
+  if (tail <= 0.0) {
+    c.p_value = 0.0;
+  } else if (df >= 1 && std::isfinite(widen) && widen > 0.0) {
     c.p_value = 1.0 - t_two_sided_cdf(-normal_quantile(tail) / widen, df);
   } else {
     c.p_value = 2.0 * tail;
   }
   if (c.se) c.detectable = (kZ975 + kZ80) * *c.se;
   if (std::isfinite(sd)) c.games_needed = games_to_separate(c.diff, sd);
-  c.enough = c.games() >= kMinGamesForVerdict;
+  c.enough = c.games() >= min_games;
   return c;
 }
 
@@ -236,9 +239,8 @@ bool within_margin(const Comparison& c, MarginTest test, double margin) {
 std::vector<bool> holm(const std::vector<double>& p, double alpha) {
   std::vector<std::size_t> order(p.size());
   std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) {
-    return p[x] < p[y];
-  });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t x, std::size_t y) { return p[x] < p[y]; });
   std::vector<bool> rejected(p.size(), false);
   const auto m = static_cast<double>(p.size());
   for (std::size_t k = 0; k < order.size(); ++k) {

@@ -131,3 +131,130 @@ TEST_CASE("a report does not depend on the order in which the runs were stored")
   }
   CHECK(texts[0] == texts[1]);
 }
+
+namespace {
+
+/// A store at `path` with one batch: variants "a" and "b", `seeds` seeds each, b's points
+/// `points_b(seed)`, a's `points_a(seed)`.
+template <class A, class B>
+std::int64_t make_two_variants(const std::string& path, int seeds, A points_a, B points_b) {
+  std::filesystem::remove(path);
+  StatsStore store(path);
+  BatchKey key;
+  key.scenario_file = "x.yaml";
+  key.scenario_name = "x";
+  key.scenario_hash = "h";
+  key.runs_per_variant = seeds;
+  key.variants = 2;
+  const std::int64_t b = store.open_batch(key);
+  for (int seed = 1; seed <= seeds; ++seed) {
+    for (const char* v : {"a", "b"}) {
+      RunResult r;
+      r.scenario = "x";
+      r.variant = v;
+      r.seed = static_cast<std::uint64_t>(100 + seed);
+      r.points = std::string(v) == "a" ? points_a(seed) : points_b(seed);
+      store.add_run(b, r);
+    }
+  }
+  return b;
+}
+
+const Difference& points_difference(const BatchReport& r) {
+  for (const Difference& d : r.differences) {
+    if (d.statistic == "points") return d;
+  }
+  FAIL("no points difference");
+  return r.differences.front();
+}
+
+}  // namespace
+
+TEST_CASE("one game per variant: the report prints the numbers but no star and no verdict") {
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("llsf_report_single_" + std::to_string(::getpid()) + ".db"))
+                               .string();
+  const std::int64_t id = make_two_variants(
+      path, 1, [](int) { return 41; }, [](int) { return 28; });
+  const StatsStore store(path);
+  const BatchReport r = make_report(store, id);
+  const Difference& d = points_difference(r);
+  CHECK(d.diff == doctest::Approx(-13.0));
+  CHECK(!d.separated);
+  CHECK(!d.comparison.enough);
+  const std::string text = to_text(r);
+  CHECK(text.find("-13.0") != std::string::npos);
+  CHECK(text.find("]  *") == std::string::npos);  // no star after the interval
+  CHECK(text.find("too few for a verdict, which needs 10") != std::string::npos);
+  CHECK(text.find("the spread is unknown with one game") != std::string::npos);
+  std::filesystem::remove(path);
+}
+
+TEST_CASE("the report pairs by seed: a small gain on every seed is separated") {
+  // Seeds differ by up to 60 points, b gains 3 to 5 on each: unpaired this is noise, paired
+  // it is clear.
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("llsf_report_paired_" + std::to_string(::getpid()) + ".db"))
+                               .string();
+  const std::int64_t id = make_two_variants(
+      path, 12, [](int s) { return (s * 37) % 61; },
+      [](int s) { return (s * 37) % 61 + 3 + s % 3; });
+  const StatsStore store(path);
+  const BatchReport r = make_report(store, id);
+  const Difference& d = points_difference(r);
+  CHECK(d.comparison.pairing == Pairing::kPaired);
+  CHECK(d.comparison.pairs == 12);
+  CHECK(d.ci_low >= 3.0);
+  CHECK(d.ci_high <= 5.0);
+  CHECK(d.separated);
+  CHECK(d.comparisons == 1);
+  const std::string text = to_text(r);
+  CHECK(text.find("paired by seed") != std::string::npos);
+  CHECK(text.find("(12 pairs)") != std::string::npos);
+  CHECK(text.find("]  *") != std::string::npos);
+  std::filesystem::remove(path);
+}
+
+TEST_CASE("the report's stars are corrected for many comparisons (Holm)") {
+  // Five variants against the first, each with a borderline gain: uncorrected several would
+  // be starred; Holm keeps the family-wise error at 5 % and says how many comparisons it made.
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("llsf_report_holm_" + std::to_string(::getpid()) + ".db"))
+                               .string();
+  std::filesystem::remove(path);
+  {
+    StatsStore store(path);
+    BatchKey key;
+    key.scenario_file = "x.yaml";
+    key.scenario_name = "x";
+    key.scenario_hash = "h";
+    key.runs_per_variant = 12;
+    key.variants = 6;
+    const std::int64_t b = store.open_batch(key);
+    for (int seed = 1; seed <= 12; ++seed) {
+      for (int v = 0; v < 6; ++v) {
+        RunResult r;
+        r.scenario = "x";
+        r.variant = std::string(1, static_cast<char>('a' + v));
+        r.seed = static_cast<std::uint64_t>(seed);
+        // Per variant a different noise pattern around a +2 gain (v > 0).
+        r.points = 50 + (v > 0 ? 2 : 0) + ((seed * (7 + 2 * v)) % 9) - 4;
+        store.add_run(b, r);
+      }
+    }
+  }
+  const StatsStore store(path);
+  const BatchReport r = make_report(store, store.batches().front().id);
+  int uncorrected = 0, starred = 0;
+  for (const Difference& d : r.differences) {
+    if (d.statistic != "points") continue;
+    CHECK(d.comparisons == 5);
+    uncorrected += d.comparison.p_value < 0.05 ? 1 : 0;
+    starred += d.separated ? 1 : 0;
+  }
+  // Two would be starred uncorrected (p < 5 %), one survives Holm (the family of 5).
+  CHECK(uncorrected >= 2);
+  CHECK(starred < uncorrected);
+  CHECK(to_text(r).find("after Holm's correction for 5 comparisons") != std::string::npos);
+  std::filesystem::remove(path);
+}

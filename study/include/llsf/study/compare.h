@@ -83,7 +83,7 @@ struct Comparison {
   /// times in 5 (normal approximation, at least kMinGamesForVerdict); unset if the spread is
   /// unknown (one game) or `diff` is 0.
   std::optional<int> games_needed;
-  /// Enough games for a verdict: the games used per side are at least kMinGamesForVerdict.
+  /// Enough games for a verdict: games() is at least the minimum (kMinGamesForVerdict).
   bool enough = false;
 
   /// Games per variant the verdict rests on: pairs, or the smaller side.
@@ -94,9 +94,11 @@ struct Comparison {
 
 /// Compares a with b. Paired when the sides share their seeds: no key twice on a side, and at
 /// least half of each side's values have a partner (the others are left out and counted in
-/// `unmatched`); unpaired otherwise. The bootstrap draws from `rng`. Both sides must have values.
+/// `unmatched`); unpaired otherwise. The bootstrap draws from `rng`; `enough` is games() >=
+/// `min_games`. Both sides must have values.
 Comparison compare_means(const std::vector<KeyedValue>& a, const std::vector<KeyedValue>& b,
-                         core::RandomStream& rng, int resamples = kBootstrapResamples);
+                         core::RandomStream& rng, int min_games = kMinGamesForVerdict,
+                         int resamples = kBootstrapResamples);
 
 /// Games per variant that would separate `diff` 4 times in 5 at the 5 % level, with the
 /// per-game standard deviation `sd` of the difference (paired: of the per-seed differences;

@@ -33,13 +33,19 @@ struct VariantReport {
   const StatSummary* find(const std::string& name) const;
 };
 
-/// mean(variant) - mean(baseline) of one statistic with a percentile-bootstrap 95 % interval.
+/// mean(variant) - mean(baseline) of one statistic (compare_means: paired by seed when both
+/// played the same seeds) with an expanded percentile-bootstrap 95 % interval.
 struct Difference {
   std::string variant;
   std::string baseline;
   std::string statistic;
   double diff = 0.0;
   double ci_low = 0.0, ci_high = 0.0;
+  Comparison comparison;  ///< the method, the counts, p, the smallest detectable difference
+  /// Holm's correction over this statistic's comparisons (each variant against the first):
+  /// separated at the 5 % family-wise level, and enough games for a verdict.
+  bool separated = false;
+  int comparisons = 0;  ///< the size of the Holm family
 };
 
 struct BatchReport {
@@ -50,6 +56,7 @@ struct BatchReport {
 
 /// Builds the report of batch `batch_id` (StatsError if there is no such batch). The bootstrap
 /// (2,000 resamples) draws from a stream seeded with `seed`: the same store gives the same report.
+/// Runs are paired by their seed (docs/statistics.md, "Comparing variants").
 BatchReport make_report(const StatsStore& store, std::int64_t batch_id, std::uint64_t seed = 1);
 
 /// One line per (variant, statistic): variant,statistic,n,mean,median,q1,q3,min,max,pass_rate.
