@@ -158,9 +158,10 @@ namespace {
 
 /// The games a difference rests on: "30 pairs", "30 vs 28 games", and the runs left out.
 std::string games_text(const Comparison& c) {
-  std::string s = c.pairing == Pairing::kPaired
-                      ? std::to_string(c.pairs) + (c.pairs == 1 ? " pair" : " pairs")
-                      : std::to_string(c.n_a) + " vs " + std::to_string(c.n_b) + " games";
+  std::string s =
+      c.pairing == Pairing::kPaired
+          ? "paired by seed: " + std::to_string(c.pairs) + (c.pairs == 1 ? " pair" : " pairs")
+          : "unpaired: " + std::to_string(c.n_a) + " vs " + std::to_string(c.n_b) + " games";
   if (c.unmatched > 0) s += ", " + std::to_string(c.unmatched) + " without a partner left out";
   return s;
 }
@@ -215,8 +216,8 @@ std::string to_text(const BatchReport& r) {
   for (const Difference& d : r.differences) {
     if (d.statistic != "points") continue;
     if (!header) {
-      out += "\npoints: difference of means against " + d.baseline + ", " +
-             to_string(d.comparison.pairing) + " (bootstrap 95 % interval; * separated at 5 % " +
+      out += "\npoints: difference of means against " + d.baseline +
+             " (bootstrap 95 % interval; * separated at 5 % " +
              (d.comparisons > 1
                   ? "after Holm's correction for " + std::to_string(d.comparisons) + " comparisons"
                   : std::string("(one comparison)")) +

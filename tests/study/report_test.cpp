@@ -210,7 +210,7 @@ TEST_CASE("the report pairs by seed: a small gain on every seed is separated") {
   CHECK(d.comparisons == 1);
   const std::string text = to_text(r);
   CHECK(text.find("paired by seed") != std::string::npos);
-  CHECK(text.find("(12 pairs)") != std::string::npos);
+  CHECK(text.find("(paired by seed: 12 pairs)") != std::string::npos);
   CHECK(text.find("]  *") != std::string::npos);
   std::filesystem::remove(path);
 }
