@@ -41,14 +41,31 @@ bool contains(const std::vector<std::string>& v, const std::string& x) {
   return std::find(v.begin(), v.end(), x) != v.end();
 }
 
-/// The names every stored run has (StatsStore writes numeric_statistics()).
+/// The names a stored run may have (StatsStore writes numeric_statistics()).
 const std::vector<std::string>& known_statistics() {
   static const std::vector<std::string> names = [] {
     std::vector<std::string> out;
-    for (const auto& [name, value] : numeric_statistics(RunResult{})) out.push_back(name);
+    for (const StatisticInfo& s : statistic_infos()) out.push_back(s.name);
     return out;
   }();
   return names;
+}
+
+/// Whether a game may lack `name` (then no run having it is no sign of an old store).
+bool may_be_absent(const std::string& name) {
+  for (const StatisticInfo& s : statistic_infos()) {
+    if (s.name == name) return s.may_be_absent;
+  }
+  return false;
+}
+
+/// A statistic no stored run of a batch has: an error unless games may lack it (a store written
+/// before the statistic existed, or a typo the loader could not see).
+void require_stored(const std::set<std::string>& stored, const std::string& statistic,
+                    const std::string& where, const std::string& batch) {
+  if (stored.empty() || stored.count(statistic) > 0 || may_be_absent(statistic)) return;
+  throw core::ConfigError(where + ": no stored run of batch '" + batch + "' has the statistic '" +
+                          statistic + "'");
 }
 
 /// The non-empty string under `key`; "missing key 'key'" at `map` if absent. `node`, if given,
@@ -144,7 +161,8 @@ std::string read_statistic(const core::ConfigNode& map) {
   if (!contains(known_statistics(), s)) {
     at.fail("unknown statistic '" + s +
             "' (docs/statistics.md; e.g. points, production_points, deliveries, "
-            "first_complex_s, storage_empty_s, role_changes, jams)");
+            "first_complex_production_s, storage_empty_game_s, storage_ran_empty, role_changes, "
+            "jams)");
   }
   return s;
 }
@@ -851,10 +869,7 @@ CheckResult evaluate_check(const Experiment& e, const std::vector<BatchData>& da
                            const std::string& group, core::RandomStream rng, int min_games) {
   const BatchData& d = data[static_cast<std::size_t>(c.sel.batch)];
   const ExperimentBatch& b = *d.batch;
-  if (d.statistics.size() > 0 && d.statistics.count(c.sel.statistic) == 0) {
-    throw core::ConfigError(c.where + ": no stored run of batch '" + b.name +
-                            "' has the statistic '" + c.sel.statistic + "'");
-  }
+  require_stored(d.statistics, c.sel.statistic, c.where, b.name);
   CheckResult r;
   r.description = describe(c);
   const AxisFilter fa = with_group(e, b, c.a, group);
@@ -963,10 +978,7 @@ SweepResult evaluate_sweep(const Experiment& e, const std::vector<BatchData>& da
                            const std::string& group, const EvaluateOptions& o) {
   const BatchData& d = data[static_cast<std::size_t>(s.sel.batch)];
   const ExperimentBatch& b = *d.batch;
-  if (d.statistics.size() > 0 && d.statistics.count(s.sel.statistic) == 0) {
-    throw core::ConfigError(s.where + ": no stored run of batch '" + b.name +
-                            "' has the statistic '" + s.sel.statistic + "'");
-  }
+  require_stored(d.statistics, s.sel.statistic, s.where, b.name);
   SweepResult r;
   r.sweep = &s;
   r.group = group;
@@ -1030,12 +1042,7 @@ TableResult evaluate_table(const Experiment& e, const std::vector<BatchData>& da
                            const std::string& group) {
   const BatchData& d = data[static_cast<std::size_t>(t.sel.batch)];
   const ExperimentBatch& b = *d.batch;
-  for (const std::string& st : t.statistics) {
-    if (d.statistics.size() > 0 && d.statistics.count(st) == 0) {
-      throw core::ConfigError(t.where + ": no stored run of batch '" + b.name +
-                              "' has the statistic '" + st + "'");
-    }
-  }
+  for (const std::string& st : t.statistics) require_stored(d.statistics, st, t.where, b.name);
   TableResult r;
   r.table = &t;
   r.group = group;
@@ -1179,7 +1186,9 @@ std::string batch_line(const BatchState& b) {
 
 std::string sweep_cell(const SweepRow& row, std::size_t i) {
   if (row.n[i].used == 0) return "-";
-  return num(row.means[i]) + " (n " + std::to_string(row.n[i].used) + ")";
+  const SampleCounts& n = row.n[i];
+  return num(row.means[i]) + " (n " + std::to_string(n.used) +
+         (n.used != n.stored ? " of " + std::to_string(n.stored) : "") + ")";
 }
 
 std::string top_two(const SweepRow& row) {
@@ -1215,10 +1224,12 @@ std::string findings_note(const ExperimentResult& r) {
          std::to_string(r.min_games) + " games a side.";
 }
 
-/// A table's cell: the mean, with the runs it counts if some were left out.
+/// A table's cell: the mean, with "n of N" if some runs have no value (absent, or left out).
 std::string table_cell(const TableRow& row, std::size_t i) {
   if (row.n[i] == 0) return "-";
-  return num(row.means[i]) + (row.n[i] != row.runs ? " (n " + std::to_string(row.n[i]) + ")" : "");
+  return num(row.means[i]) + (row.n[i] != row.runs ? " (n " + std::to_string(row.n[i]) + " of " +
+                                                         std::to_string(row.runs) + ")"
+                                                   : "");
 }
 
 std::string table_heading(const TableResult& t, const Experiment& e) {

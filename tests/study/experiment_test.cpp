@@ -608,7 +608,7 @@ TEST_CASE("experiment tables: means per row and group, left-out values counted")
   CHECK(has(md, "#### Why (ideal)\n\nSource: the mechanisms\n\n"));
   CHECK(has(md,
             "| config | runs | points | lock_wait_max_s |\n|---|---:|---:|---:|\n"
-            "| B | 4 | 52.5 | - |\n| A | 4 | 102.5 | 620.0 (n 3) |\n"));
+            "| B | 4 | 52.5 | - |\n| A | 4 | 102.5 | 620.0 (n 3 of 4) |\n"));
   const std::string text = to_text(r);
   CHECK(has(text,
             "  Why [real]: Mean per run by `config` of batch `conf`, values below 0 left out.\n"));
