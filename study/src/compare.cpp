@@ -141,9 +141,11 @@ std::optional<int> games_to_separate(double diff, double sd) {
 }
 
 Comparison compare_means(const std::vector<KeyedValue>& a, const std::vector<KeyedValue>& b,
-                         core::RandomStream& rng, int min_games, int resamples) {
+                         core::RandomStream& rng, int min_games, int resamples, double alpha) {
   LLSF_DEMAND(!a.empty() && !b.empty());
+  LLSF_DEMAND(alpha > 0.0 && alpha < 0.5);
   Comparison c;
+  c.alpha = alpha;
   c.n_a = static_cast<int>(a.size());
   c.n_b = static_cast<int>(b.size());
 
@@ -198,10 +200,10 @@ Comparison compare_means(const std::vector<KeyedValue>& a, const std::vector<Key
       df = std::isfinite(welch) ? std::max(1, static_cast<int>(std::floor(welch))) : 0;
     }
   }
-  const double t95 = expanded_tail(kAlpha, widen, df);
-  const double t90 = expanded_tail(2.0 * kAlpha, widen, df);
-  c.ci95 = {quantile(values, t95), quantile(values, 1.0 - t95)};
-  c.ci90 = {quantile(values, t90), quantile(values, 1.0 - t90)};
+  const double two_sided = expanded_tail(alpha, widen, df);
+  const double one_sided = expanded_tail(2.0 * alpha, widen, df);
+  c.ci = {quantile(values, two_sided), quantile(values, 1.0 - two_sided)};
+  c.ci_tost = {quantile(values, one_sided), quantile(values, 1.0 - one_sided)};
   // Two-sided p: the level at which the expanded interval's end reaches 0, so that p < 5 % where
   // the 95 % interval excludes 0. The share of resampled differences beyond 0 (ties count on both
   // sides) is the tail Phi(-widen t) of that level; none beyond 0: p = 0, as every interval
@@ -227,13 +229,67 @@ bool within_margin(const Comparison& c, MarginTest test, double margin) {
   LLSF_DEMAND(margin > 0.0);
   switch (test) {
     case MarginTest::kSame:
-      return -margin < c.ci90.low && c.ci90.high < margin;
+      return -margin < c.ci_tost.low && c.ci_tost.high < margin;
     case MarginTest::kNotAbove:
-      return c.ci90.high < margin;
+      return c.ci_tost.high < margin;
     case MarginTest::kNotBelow:
-      return c.ci90.low > -margin;
+      return c.ci_tost.low > -margin;
   }
   return false;
+}
+
+std::vector<int> SequentialPlan::look_sizes() const {
+  std::vector<int> out;
+  for (int k = 1; k <= looks; ++k) {
+    const std::int64_t n = (static_cast<std::int64_t>(k) * max_runs + looks - 1) / looks;
+    out.push_back(static_cast<int>(n));
+  }
+  return out;
+}
+
+std::string SequentialPlan::problem() const {
+  if (max_runs < kMinGamesForVerdict) {
+    return "--max-runs must be at least " + std::to_string(kMinGamesForVerdict) +
+           " (no verdict from fewer games)";
+  }
+  if (looks < 1 || looks > max_runs) return "--looks must be 1..--max-runs";
+  if (margin && !(*margin > 0.0 && std::isfinite(*margin))) return "--margin must be above 0";
+  return "";
+}
+
+std::string to_string(SequentialOutcome o) {
+  switch (o) {
+    case SequentialOutcome::kContinue:
+      return "continue";
+    case SequentialOutcome::kSeparated:
+      return "separated";
+    case SequentialOutcome::kEquivalent:
+      return "equivalent within the margin";
+    case SequentialOutcome::kUndecided:
+      return "undecided";
+  }
+  return "?";
+}
+
+SequentialLook sequential_look(const SequentialPlan& plan, int look,
+                               const std::vector<KeyedValue>& a, const std::vector<KeyedValue>& b,
+                               core::RandomStream& rng) {
+  LLSF_DEMAND(plan.problem().empty());
+  LLSF_DEMAND(look >= 1 && look <= plan.looks);
+  SequentialLook l;
+  l.look = look;
+  l.seeds = plan.look_sizes()[static_cast<std::size_t>(look - 1)];
+  l.comparison =
+      compare_means(a, b, rng, kMinGamesForVerdict, kBootstrapResamples, plan.look_alpha());
+  const Comparison& c = l.comparison;
+  if (c.enough && c.separated()) {
+    l.outcome = SequentialOutcome::kSeparated;
+  } else if (c.enough && plan.margin && within_margin(c, MarginTest::kSame, *plan.margin)) {
+    l.outcome = SequentialOutcome::kEquivalent;
+  } else {
+    l.outcome = look == plan.looks ? SequentialOutcome::kUndecided : SequentialOutcome::kContinue;
+  }
+  return l;
 }
 
 std::vector<bool> holm(const std::vector<double>& p, double alpha) {

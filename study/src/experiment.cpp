@@ -887,7 +887,7 @@ CheckResult evaluate_check(const Experiment& e, const std::vector<BatchData>& da
     r.comparison = cmp;
     r.value = cmp.diff;
     const bool margin = has_margin(c.kind);
-    const Interval ci = margin ? cmp.ci90 : cmp.ci95;
+    const Interval ci = margin ? cmp.ci_tost : cmp.ci;
     r.ci_low = ci.low;
     r.ci_high = ci.high;
     r.measured = "difference " + signed_num(r.value) + (margin ? ", 90 % CI [" : ", 95 % CI [") +
@@ -896,7 +896,7 @@ CheckResult evaluate_check(const Experiment& e, const std::vector<BatchData>& da
     bool holds = false;
     switch (c.kind) {
       case Check::Kind::kGreater:
-        holds = cmp.ci95.low > 0.0;
+        holds = cmp.ci.low > 0.0;
         break;
       case Check::Kind::kNotGreater:
         holds = within_margin(cmp, MarginTest::kNotAbove, c.margin);
@@ -1016,8 +1016,8 @@ SweepResult evaluate_sweep(const Experiment& e, const std::vector<BatchData>& da
       core::RandomStream rng = stream(o, "sweep/" + s.name + "/" + group + "/" + value);
       row.top = compare_means(samples[idx[0]], samples[idx[1]], rng, o.min_games);
       row.top_diff = row.top->diff;
-      row.top_low = row.top->ci95.low;
-      row.top_high = row.top->ci95.high;
+      row.top_low = row.top->ci.low;
+      row.top_high = row.top->ci.high;
     }
     if (value == s.baseline) baseline_order = row.order;
     r.rows.push_back(std::move(row));

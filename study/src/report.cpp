@@ -106,8 +106,8 @@ BatchReport make_report(const StatsStore& store, std::int64_t batch_id, std::uin
       d.statistic = name;
       d.comparison = compare_means(it->second, b, rng);
       d.diff = d.comparison.diff;
-      d.ci_low = d.comparison.ci95.low;
-      d.ci_high = d.comparison.ci95.high;
+      d.ci_low = d.comparison.ci.low;
+      d.ci_high = d.comparison.ci.high;
       r.differences.push_back(std::move(d));
     }
   }

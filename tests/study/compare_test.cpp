@@ -57,7 +57,7 @@ Rates paired_coverage(int n, double diff, int experiments, const char* stream) {
     const Comparison c =
         compare_means(games(shared, 50.0 + diff, 6.0, data), games(shared, 50.0, 6.0, data), boot);
     REQUIRE(c.pairing == Pairing::kPaired);
-    r.covered += c.ci95.low <= diff && diff <= c.ci95.high ? 1 : 0;
+    r.covered += c.ci.low <= diff && diff <= c.ci.high ? 1 : 0;
     ++r.experiments;
   }
   return r;
@@ -100,7 +100,7 @@ TEST_CASE("unpaired 95 % intervals cover a known difference, also for skewed out
     for (int i = 0; i < 25; ++i) b.push_back({"b" + std::to_string(i), skewed(55.0, data)});
     const Comparison c = compare_means(a, b, boot);
     REQUIRE(c.pairing == Pairing::kUnpaired);
-    r.covered += c.ci95.low <= 5.0 && 5.0 <= c.ci95.high ? 1 : 0;
+    r.covered += c.ci.low <= 5.0 && 5.0 <= c.ci.high ? 1 : 0;
     ++r.experiments;
   }
   MESSAGE("unpaired skewed, 30 vs 25 games: " << r.covered << " of " << r.experiments);
@@ -137,7 +137,7 @@ TEST_CASE("pairing: duplicate seeds or too few partners fall back to unpaired") 
   Comparison c = compare_means(a, b, boot);
   CHECK(c.pairing == Pairing::kPaired);
   CHECK(c.diff == doctest::Approx(2.0));
-  CHECK(c.ci95.low == doctest::Approx(2.0));  // every seed +2: no spread
+  CHECK(c.ci.low == doctest::Approx(2.0));  // every seed +2: no spread
   CHECK(c.enough);
   // Two runs without a partner are left out and counted.
   std::vector<KeyedValue> a2 = a;
@@ -230,7 +230,7 @@ TEST_CASE("equivalence does not hold by absence of evidence: fewer games make it
         compare_means(games(s6, 50.0, 10.0, data), games(s6, 50.0, 10.0, data), boot);
     many_accepted += within_margin(many, MarginTest::kSame, 10.0) ? 1 : 0;
     few_accepted += within_margin(few, MarginTest::kSame, 10.0) ? 1 : 0;
-    few_reach_0 += few.ci95.low <= 0.0 && few.ci95.high >= 0.0 ? 1 : 0;
+    few_reach_0 += few.ci.low <= 0.0 && few.ci.high >= 0.0 ? 1 : 0;
   }
   MESSAGE("same within 10: " << many_accepted << " of " << experiments << " with 40 seeds, "
                              << few_accepted << " with 6; 6 seeds' interval reaches 0 in "
@@ -273,4 +273,94 @@ TEST_CASE("the bootstrap p-value agrees with the interval") {
   }
   // Both come from the same expanded tails: they differ only by the quantiles' interpolation.
   CHECK(agree >= 197);
+}
+
+TEST_CASE("playing until the answer is known keeps its error rate despite the repeated looks") {
+  // 300 simulated batches of at most 40 seeds, looked at after 10, 20, 30 and 40: with two equal
+  // variants, a batch that stops "separated" is an error; with a true difference of exactly the
+  // margin, one that stops "equivalent" is. Both must stay at or below 5 % (the plan's level);
+  // looking at 5 % each time would not keep it.
+  SequentialPlan plan;
+  plan.max_runs = 40;
+  plan.looks = 4;
+  plan.margin = 5.0;
+  CHECK(plan.problem().empty());
+  CHECK(plan.look_sizes() == std::vector<int>{10, 20, 30, 40});
+  CHECK(plan.look_alpha() == doctest::Approx(0.0125));
+  core::RandomStream data = core::Rng(21).stream("sequential");
+  core::RandomStream boot = core::Rng(22).stream("sequential");
+  auto first = [](const std::vector<KeyedValue>& v, int n) {
+    return std::vector<KeyedValue>(v.begin(), v.begin() + n);
+  };
+  const int batches = 300;
+  int false_separations = 0, naive_false_separations = 0, false_equivalences = 0;
+  for (int k = 0; k < batches; ++k) {
+    const std::vector<double> shared = seed_parts(plan.max_runs, 20.0, data);
+    const std::vector<KeyedValue> b = games(shared, 50.0, 6.0, data);
+    const std::vector<KeyedValue> same = games(shared, 50.0, 6.0, data);
+    const std::vector<KeyedValue> at_margin = games(shared, 55.0, 6.0, data);
+    bool naive = false, separated = false, equivalent = false;
+    for (int look = 1; look <= plan.looks; ++look) {
+      const int n = plan.look_sizes()[static_cast<std::size_t>(look - 1)];
+      if (!separated) {
+        const SequentialLook l = sequential_look(plan, look, first(same, n), first(b, n), boot);
+        separated = l.outcome == SequentialOutcome::kSeparated;
+      }
+      naive = naive || compare_means(first(same, n), first(b, n), boot).separated();
+      if (!equivalent) {
+        const SequentialLook l =
+            sequential_look(plan, look, first(at_margin, n), first(b, n), boot);
+        equivalent = l.outcome == SequentialOutcome::kEquivalent;
+        if (l.outcome == SequentialOutcome::kSeparated) break;  // stopped: another answer
+      }
+    }
+    false_separations += separated ? 1 : 0;
+    naive_false_separations += naive ? 1 : 0;
+    false_equivalences += equivalent ? 1 : 0;
+  }
+  MESSAGE("of " << batches << " batches: false separations " << false_separations
+                << " (looking at 5 % each time: " << naive_false_separations
+                << "), false equivalences " << false_equivalences);
+  CHECK(false_separations <= 0.05 * batches);
+  CHECK(false_equivalences <= 0.05 * batches);
+  CHECK(naive_false_separations > false_separations);
+}
+
+TEST_CASE("playing until the answer is known stops early when the difference is clear") {
+  SequentialPlan plan;
+  plan.max_runs = 50;
+  plan.looks = 5;
+  core::RandomStream data = core::Rng(23).stream("sequential-power");
+  core::RandomStream boot = core::Rng(24).stream("sequential-power");
+  // +8 points with a per-seed sd of 8.5: separated at the first look (10 seeds) in most batches.
+  int separated = 0, seeds = 0;
+  const int batches = 50;
+  for (int k = 0; k < batches; ++k) {
+    const std::vector<double> shared = seed_parts(plan.max_runs, 20.0, data);
+    const std::vector<KeyedValue> a = games(shared, 58.0, 6.0, data);
+    const std::vector<KeyedValue> b = games(shared, 50.0, 6.0, data);
+    for (int look = 1; look <= plan.looks; ++look) {
+      const int n = plan.look_sizes()[static_cast<std::size_t>(look - 1)];
+      const SequentialLook l =
+          sequential_look(plan, look, std::vector<KeyedValue>(a.begin(), a.begin() + n),
+                          std::vector<KeyedValue>(b.begin(), b.begin() + n), boot);
+      if (l.outcome == SequentialOutcome::kContinue) continue;
+      separated += l.outcome == SequentialOutcome::kSeparated ? 1 : 0;
+      seeds += n;
+      break;
+    }
+  }
+  MESSAGE("separated " << separated << " of " << batches << ", " << seeds / batches
+                       << " seeds a batch on average (of at most 50)");
+  CHECK(separated >= 0.9 * batches);
+  CHECK(seeds <= 25 * batches);
+  // Bad plans are named.
+  plan.max_runs = 5;
+  CHECK(plan.problem() == "--max-runs must be at least 10 (no verdict from fewer games)");
+  plan.max_runs = 20;
+  plan.looks = 0;
+  CHECK(plan.problem() == "--looks must be 1..--max-runs");
+  plan.looks = 2;
+  plan.margin = -1.0;
+  CHECK(plan.problem() == "--margin must be above 0");
 }

@@ -749,7 +749,7 @@ TEST_CASE("experiment: equivalence within a margin, both one-sided forms, paired
   REQUIRE(real.checks[0].comparison);
   CHECK(real.checks[0].comparison->pairing == Pairing::kPaired);
   CHECK(real.checks[0].comparison->pairs == 4);
-  CHECK(real.checks[0].ci_low == real.checks[0].comparison->ci90.low);  // the 90 % interval
+  CHECK(real.checks[0].ci_low == real.checks[0].comparison->ci_tost.low);  // the 90 % interval
   CHECK(has(real.checks[0].description,
             "points: config=A = config=B within ±10 (margin: one delivery)"));
   CHECK(has(real.checks[0].measured, "difference 0, 90 % CI ["));
