@@ -94,7 +94,7 @@ Action add_report_command(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--csv", o->csv,
                  "Also write every statistic per variant (n, mean, median, quartiles, min, max, "
-                 "pass rate) as CSV");
+                 "pass rate, runs: n of runs) as CSV");
   app.add_option("--html", o->html,
                  "Also write a self-contained HTML page: box plots of the points per variant and "
                  "per phase, the tables, and every run's statistics as JSON");

@@ -142,13 +142,13 @@ std::string csv_quoted(const std::string& field) {
 }  // namespace
 
 std::string to_csv(const BatchReport& r) {
-  std::string out = "variant,statistic,n,mean,median,q1,q3,min,max,pass_rate\n";
+  std::string out = "variant,statistic,n,mean,median,q1,q3,min,max,pass_rate,runs\n";
   for (const VariantReport& v : r.variants) {
     const double rate = v.runs > 0 ? static_cast<double>(v.passed) / v.runs : 0.0;
     for (const StatSummary& s : v.stats) {
       out += csv_quoted(v.variant) + "," + s.name + "," + std::to_string(s.n) + "," + fmt(s.mean) +
              "," + fmt(s.median) + "," + fmt(s.q1) + "," + fmt(s.q3) + "," + fmt(s.min) + "," +
-             fmt(s.max) + "," + fmt(rate) + "\n";
+             fmt(s.max) + "," + fmt(rate) + "," + std::to_string(v.runs) + "\n";
     }
   }
   return out;

@@ -82,8 +82,8 @@ TEST_CASE("a report summarises each variant and bounds the difference of means")
   // Deterministic: the same store gives the same report.
   CHECK(to_text(make_report(store, r.batch.id)) == to_text(r));
   const std::string csv = to_csv(r);
-  CHECK(csv.rfind("variant,statistic,n,mean,median,q1,q3,min,max,pass_rate\n", 0) == 0);
-  CHECK(csv.find("\"a\",points,5,13,13,12,14,11,15,0.8") != std::string::npos);
+  CHECK(csv.rfind("variant,statistic,n,mean,median,q1,q3,min,max,pass_rate,runs\n", 0) == 0);
+  CHECK(csv.find("\"a\",points,5,13,13,12,14,11,15,0.8,5\n") != std::string::npos);
   // A quote in a variant name is doubled (RFC 4180), not left to end the field.
   BatchReport quoted = r;
   quoted.variants[0].variant = "config=\"P3\"";

@@ -59,7 +59,8 @@ struct BatchReport {
 /// Runs are paired by their seed (docs/statistics.md, "Comparing variants").
 BatchReport make_report(const StatsStore& store, std::int64_t batch_id, std::uint64_t seed = 1);
 
-/// One line per (variant, statistic): variant,statistic,n,mean,median,q1,q3,min,max,pass_rate.
+/// One line per (variant, statistic): variant,statistic,n,mean,median,q1,q3,min,max,pass_rate,
+/// runs -- n of runs: a statistic a game may lack counts the games that have it.
 std::string to_csv(const BatchReport& r);
 /// A readable table: per variant the pass rate and points, then the differences.
 std::string to_text(const BatchReport& r);
