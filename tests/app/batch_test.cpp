@@ -254,14 +254,15 @@ TEST_CASE("llsfsim batch --until plays in rounds until the answer is known, and 
   const std::string agents = std::string(LLSF_SOURCE_DIR) + "/clips/agents";
   dir.write("pair.yaml",
             "name: pair\nseeds: {first: 1, count: 10}\nstart: production\n"
-            "duration_s: 60\nrobots:\n  count: 1\n  agent: [" +
+            "duration_s: 30\nrobots:\n  count: 1\n  agent: [" +
                 agents + "/common, " + agents +
                 "/llsf2013]\n  config: {roles: [P3], recycle: never}\n"
                 "matrix:\n  config:\n    P3: {}\n"
                 "    P1P2: {robots.config.roles: [P1P2]}\n");
   const std::string file = dir.file("pair.yaml");
   const std::string db = dir.file("until.db");
-  // Every game lasts 60 s: equivalent within 1 s at the first look (10 seeds of at most 20).
+  // Every game lasts 30 s (short: this binary also runs under ThreadSanitizer): equivalent within
+  // 1 s at the first look (10 seeds of at most 20).
   const std::vector<std::string> args{"batch",
                                       file,
                                       "--db",
