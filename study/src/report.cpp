@@ -93,7 +93,9 @@ BatchReport make_report(const StatsStore& store, std::int64_t batch_id, std::uin
   }
   // Differences against the first variant, paired by seed where the seeds are shared.
   if (order.size() < 2) return r;
-  core::RandomStream rng(seed);
+  // Each difference draws from its own named stream: a statistic added to the store (or a
+  // variant) changes no other difference's interval.
+  const core::Rng streams(seed);
   const auto& base = values[order.front()];
   for (std::size_t i = 1; i < order.size(); ++i) {
     const auto& other = values[order[i]];
@@ -104,6 +106,7 @@ BatchReport make_report(const StatsStore& store, std::int64_t batch_id, std::uin
       d.variant = order[i];
       d.baseline = order.front();
       d.statistic = name;
+      core::RandomStream rng = streams.stream("report/" + order[i] + "/" + name);
       d.comparison = compare_means(it->second, b, rng);
       d.diff = d.comparison.diff;
       d.ci_low = d.comparison.ci.low;
@@ -180,10 +183,12 @@ std::string games_needed_text(const Comparison& c) {
 /// One line of the differences: value, interval, star, and what the runs allow.
 std::string difference_line(const Difference& d) {
   const Comparison& c = d.comparison;
-  char line[160];
-  std::snprintf(line, sizeof line, "%-28s %+8.1f  [%+.1f, %+.1f]%s  (%s", d.variant.c_str(), d.diff,
-                d.ci_low, d.ci_high, d.separated ? "  *" : "", games_text(c).c_str());
-  std::string out = line;
+  char numbers[96];
+  std::snprintf(numbers, sizeof numbers, " %+8.1f  [%+.1f, %+.1f]%s  (", d.diff, d.ci_low,
+                d.ci_high, d.separated ? "  *" : "");
+  std::string out = d.variant;
+  if (out.size() < 28) out.resize(28, ' ');
+  out += numbers + games_text(c);
   if (!c.enough) {
     out += "; too few for a verdict, which needs " + std::to_string(kMinGamesForVerdict) + "; " +
            games_needed_text(c);

@@ -55,7 +55,8 @@ struct BatchReport {
 };
 
 /// Builds the report of batch `batch_id` (StatsError if there is no such batch). The bootstrap
-/// (2,000 resamples) draws from a stream seeded with `seed`: the same store gives the same report.
+/// (2,000 resamples) of each difference draws from its own stream of `seed`, named after the
+/// variant and the statistic: the same store gives the same report.
 /// Runs are paired by their seed (docs/statistics.md, "Comparing variants").
 BatchReport make_report(const StatsStore& store, std::int64_t batch_id, std::uint64_t seed = 1);
 
