@@ -65,9 +65,7 @@ Rates paired_coverage(int n, double diff, int experiments, const char* stream) {
 
 }  // namespace
 
-TEST_CASE("Student's t quantiles behind the expanded interval") {
-  // Via the equivalence bound: a paired sample of n values with sd s has the 90 % t interval;
-  // checked through games_to_separate and directly through known t values.
+TEST_CASE("games_to_separate: ((1.96 + 0.84) sd / d)^2, at least the minimum, none for 0") {
   CHECK(games_to_separate(0.0, 5.0) == std::nullopt);
   CHECK(games_to_separate(2.0, 0.0) == kMinGamesForVerdict);
   // (1.96 + 0.84)^2 * (10 / 2)^2 = 196.2 -> 197
