@@ -28,6 +28,12 @@ struct BatchCommandOptions {
   bool no_record = false;
   bool record_agents = false;
   bool quiet = false;
+  // Playing until the answer is known (docs/llsfsim.md, "--until").
+  std::string until;  ///< "VARIANT_A>VARIANT_B" ("" = a plain batch)
+  std::string statistic = "points";
+  std::optional<double> margin;
+  std::optional<int> max_runs;
+  int looks = 5;
   // Slurm
   bool slurm = false;
   std::string partition;

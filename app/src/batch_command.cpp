@@ -15,7 +15,10 @@
 #include "llsf/app/cli.h"
 #include "llsf/clips/agent.h"
 #include "llsf/core/error.h"
+#include "llsf/core/rng.h"
 #include "llsf/study/batch.h"
+#include "llsf/study/compare.h"
+#include "llsf/study/report.h"
 #include "llsf/study/scenario.h"
 #include "llsf/study/stats_store.h"
 
@@ -54,6 +57,174 @@ void print_summary(const LoadedBatch& l, const study::BatchResult& b, const std:
   }
 }
 
+/// The two variants of `--until A>B`, checked against the file's variants.
+std::pair<std::string, std::string> until_variants(const std::string& spec,
+                                                   const study::ScenarioFile& file) {
+  const std::size_t gt = spec.find('>');
+  if (gt == std::string::npos || spec.find('>', gt + 1) != std::string::npos) {
+    throw core::ConfigError("--until: expected VARIANT_A>VARIANT_B (is A better than B?), got '" +
+                            spec + "'");
+  }
+  std::vector<std::string> names;
+  for (const study::Scenario& s : file.variants) names.push_back(s.variant);
+  auto check = [&](const std::string& v) {
+    if (std::find(names.begin(), names.end(), v) != names.end()) return v;
+    std::string list;
+    for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+    throw core::ConfigError("--until: the scenario has no variant '" + v +
+                            "' (variants: " + (list.empty() ? "none, no matrix" : list) + ")");
+  };
+  const std::string a = check(spec.substr(0, gt));
+  const std::string b = check(spec.substr(gt + 1));
+  if (a == b) throw core::ConfigError("--until: compare two different variants");
+  return {a, b};
+}
+
+/// `llsfsim batch FILE --until A>B --max-runs N`: plays the file's variants in rounds of seeds
+/// and after each round looks at A - B (study::SequentialPlan), until it is separated, shown
+/// equivalent within --margin, or N seeds are played.
+int batch_until(const BatchCommandOptions& o, std::ostream& out, std::ostream& err) {
+  const char* who = "llsfsim batch";
+  study::SequentialPlan plan;
+  std::vector<LoadedBatch> loaded;
+  std::pair<std::string, std::string> ab;
+  try {
+    if (o.scenarios.size() != 1) {
+      throw core::ConfigError("--until compares two variants of one scenario file");
+    }
+    if (!o.max_runs)
+      throw core::ConfigError("--until needs --max-runs N (seeds a variant at most)");
+    plan.max_runs = *o.max_runs;
+    plan.looks = o.looks;
+    plan.margin = o.margin;
+    if (const std::string p = plan.problem(); !p.empty()) throw core::ConfigError(p);
+    const auto& infos = study::statistic_infos();
+    if (std::none_of(infos.begin(), infos.end(),
+                     [&](const study::StatisticInfo& s) { return s.name == o.statistic; })) {
+      throw core::ConfigError("--statistic: unknown statistic '" + o.statistic +
+                              "' (docs/statistics.md)");
+    }
+    study::SeedChoice choice;
+    choice.runs = plan.max_runs;
+    loaded = load_batches(o.scenarios, choice);
+    ab = until_variants(o.until, loaded.front().file);
+  } catch (const core::UserError& e) {
+    err << who << ": " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  std::optional<study::StatsStore> store;
+  try {
+    store.emplace(o.db);
+    store->require_writable();
+  } catch (const study::StatsError& e) {
+    err << who << ": " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  const LoadedBatch& l = loaded.front();
+  const std::vector<int> sizes = plan.look_sizes();
+  std::string looks_at;
+  for (const int n : sizes) looks_at += (looks_at.empty() ? "" : ", ") + std::to_string(n);
+  if (!o.quiet) {
+    out << fmt::format(
+        "until      {} > {} on {}: at most {} seeds, looks after {} seeds, each at {:.3g} % "
+        "(5 % in all: Bonferroni){}\n",
+        ab.first, ab.second, o.statistic, plan.max_runs, looks_at, 100.0 * plan.look_alpha(),
+        plan.margin ? fmt::format("; equivalent if inside +-{:g}", *plan.margin) : "");
+  }
+  const SigintGuard sigint;
+  BatchProgressPrinter progress(who, err, o.quiet);
+  const auto variants = static_cast<std::int64_t>(l.file.variants.size());
+  const std::vector<std::uint64_t> seeds = study::batch_seeds(l.file.variants.front(), l.choice);
+  study::BatchResult b;
+  study::SequentialLook last;
+  std::string recordings_dir;
+  for (int look = 1; look <= plan.looks; ++look) {
+    const int n = sizes[static_cast<std::size_t>(look - 1)];
+    // The first n seeds of every variant: the batch's pairs are seed-major.
+    study::BatchOptions options;
+    options.choice = l.choice;
+    options.jobs = o.jobs.value_or(0);
+    options.record_agents = o.record_agents;
+    options.slice_end = n * variants;
+    if (!o.no_record)
+      options.recordings_dir = o.recordings.empty() ? default_recordings_dir(o.db) : o.recordings;
+    recordings_dir = options.recordings_dir;
+    try {
+      b = study::run_batch(l.file, l.hash, *store, options, progress.hooks());
+    } catch (const clips::AgentLoadError& e) {
+      err << who << ": agent error:\n" << e.what() << "\n";
+      return kExitBadInput;
+    } catch (const core::ConfigError& e) {
+      err << who << ": " << e.what() << "\n";
+      return kExitBadInput;
+    }
+    if (progress.bar() && b.interrupted) err << "\n";
+    if (b.interrupted) {
+      if (!o.quiet) print_summary(l, b, store->path(), recordings_dir, out);
+      return kExitInterrupted;
+    }
+    // The two variants' values on the first n seeds, keyed by seed.
+    const std::set<std::uint64_t> first(seeds.begin(), seeds.begin() + n);
+    std::vector<study::KeyedValue> va, vb;
+    for (const study::RunValues& r : study::run_values(*store, b.batch_id)) {
+      if (first.count(r.seed) == 0 || (r.variant != ab.first && r.variant != ab.second)) continue;
+      for (const auto& [name, value] : r.statistics) {
+        if (name != o.statistic) continue;
+        (r.variant == ab.first ? va : vb).push_back({"seed=" + std::to_string(r.seed), value});
+      }
+    }
+    if (va.empty() || vb.empty()) {
+      if (!o.quiet) {
+        out << fmt::format("look {}/{}   {} seeds: no values of {} yet\n", look, plan.looks, n,
+                           o.statistic);
+      }
+      last = {};
+      last.look = look;
+      last.seeds = n;
+      last.outcome = look == plan.looks ? study::SequentialOutcome::kUndecided
+                                        : study::SequentialOutcome::kContinue;
+      if (look == plan.looks) break;
+      continue;
+    }
+    // Seeded by the comparison and the look: the same store gives the same decisions.
+    core::RandomStream rng =
+        core::Rng(1).stream("until/" + o.until + "/" + o.statistic + "/" + std::to_string(look));
+    last = study::sequential_look(plan, look, va, vb, rng);
+    const study::Comparison& c = last.comparison;
+    if (!o.quiet) {
+      out << fmt::format("look {}/{}   {} seeds: {:+.2f} [{:+.2f}, {:+.2f}] ({:.3g} % interval, {}",
+                         look, plan.looks, n, c.diff, c.ci.low, c.ci.high, 100.0 * (1.0 - c.alpha),
+                         study::to_string(c.pairing));
+      if (plan.margin) {
+        out << fmt::format("; equivalence [{:+.2f}, {:+.2f}]", c.ci_tost.low, c.ci_tost.high);
+      }
+      out << fmt::format("): {}\n", study::to_string(last.outcome));
+    }
+    if (last.outcome != study::SequentialOutcome::kContinue) break;
+  }
+  if (!o.quiet) {
+    print_summary(l, b, store->path(), recordings_dir, out);
+    std::string answer;
+    const study::Comparison& c = last.comparison;
+    switch (last.outcome) {
+      case study::SequentialOutcome::kSeparated:
+        answer = fmt::format("{} {} {} on {}: {:+.2f} after {} seeds", ab.first,
+                             c.diff > 0 ? "beats" : "is beaten by", ab.second, o.statistic, c.diff,
+                             last.seeds);
+        break;
+      case study::SequentialOutcome::kEquivalent:
+        answer = fmt::format("{} and {} are equivalent within +-{:g} {} after {} seeds", ab.first,
+                             ab.second, *plan.margin, o.statistic, last.seeds);
+        break;
+      default:
+        answer = fmt::format("undecided after {} seeds (neither separated{})", last.seeds,
+                             plan.margin ? " nor equivalent within the margin" : "");
+    }
+    out << "answer     " << answer << "\n";
+  }
+  return b.all_passed() ? kExitOk : kExitFailed;
+}
+
 int batch(const BatchCommandOptions& o, std::ostream& out, std::ostream& err) {
   if (o.scenarios.empty()) {
     err << "llsfsim batch: give one or more scenario files (or: batch status, batch merge)\n";
@@ -61,6 +232,7 @@ int batch(const BatchCommandOptions& o, std::ostream& out, std::ostream& err) {
   }
   if (o.slurm) return batch_submit(o, out, err);
   if (o.task) return batch_task(o, out, err);
+  if (!o.until.empty()) return batch_until(o, out, err);
   // Load and check everything before the first game: bad input costs no time.
   std::vector<LoadedBatch> loaded;
   try {
@@ -150,10 +322,11 @@ Action add_batch_command(CLI::App& app) {
                      "the scenario's seeds; at most 100000, and at most 100000 games in all "
                      "(variants x seeds)")
           ->check(CLI::PositiveNumber);
-  app.add_option("--seeds", o->seeds,
-                 "Exactly these seeds for every variant instead of the scenario's: a list of "
-                 "seeds and ranges, e.g. 1-100 or 1,5,9-12 (at most 100000)")
-      ->excludes(runs);
+  auto* seeds =
+      app.add_option("--seeds", o->seeds,
+                     "Exactly these seeds for every variant instead of the scenario's: a list of "
+                     "seeds and ranges, e.g. 1-100 or 1,5,9-12 (at most 100000)")
+          ->excludes(runs);
   app.add_option("--jobs,-j", o->jobs,
                  "Games played at once (default: the number of cores; with --slurm: 1 per array "
                  "task, its --cpus-per-task)")
@@ -175,12 +348,40 @@ Action add_batch_command(CLI::App& app) {
       ->excludes(no_rec);
   app.add_flag("-q,--quiet", o->quiet, "No progress and no summary, only the exit code");
 
+  // Playing until the answer is known.
+  const std::string until_group = "Play until the answer is known (docs/llsfsim.md)";
+  auto* until =
+      app.add_option("--until", o->until,
+                     "A>B: play the file's variants in rounds of seeds until variant A minus "
+                     "variant B is separated (or equivalent within --margin), or --max-runs "
+                     "seeds are played; a fixed number of looks, each at 5 % / --looks")
+          ->excludes(runs)
+          ->excludes(seeds)
+          ->group(until_group);
+  app.add_option("--max-runs", o->max_runs, "--until: seeds a variant at most (at least 10)")
+      ->needs(until)
+      ->group(until_group);
+  app.add_option("--looks", o->looks, "--until: looks at the comparison, after equal rounds")
+      ->needs(until)
+      ->capture_default_str()
+      ->group(until_group);
+  app.add_option("--statistic", o->statistic, "--until: the statistic compared")
+      ->needs(until)
+      ->capture_default_str()
+      ->group(until_group);
+  app.add_option("--margin", o->margin,
+                 "--until: also stop when A and B are equivalent within +-M (in the statistic's "
+                 "unit)")
+      ->needs(until)
+      ->group(until_group);
+
   // Slurm (docs/cluster.md).
   const std::string slurm = "Slurm (docs/cluster.md)";
   auto* on_slurm = app.add_flag("--slurm", o->slurm,
                                 "Submit the batch as a Slurm job array (sbatch) instead of "
                                 "playing it here; only the missing runs are submitted")
                        ->group(slurm);
+  on_slurm->excludes(until);
   app.add_option("--partition", o->partition, "sbatch --partition")->needs(on_slurm)->group(slurm);
   app.add_option("--time-limit", o->time_limit, "sbatch --time per array task, e.g. 30 or 1:00:00")
       ->needs(on_slurm)
@@ -217,7 +418,10 @@ Action add_batch_command(CLI::App& app) {
       "scenario file content and seeds are not played again; Ctrl-C stores the running games "
       "and stops. With --slurm the batch becomes a Slurm job array whose tasks write SQLite "
       "shards beside --db (`batch merge` folds them in) and `batch status` follows it "
-      "(docs/cluster.md).\n"
+      "(docs/cluster.md). With --until A>B --max-runs N the variants are played in rounds of "
+      "seeds and A - B is looked at after each round, until it is separated or equivalent "
+      "within --margin (each look at 5 % / --looks, so the error rate stays at 5 % despite the "
+      "repeated looks; docs/statistics.md).\n"
       "Exit code: 0 every run passed its test cases (--slurm: submitted), 1 one failed, 2 bad "
       "input, 3 internal error (a bug: please report it), 130 interrupted.");
   return [o, status, status_action, merge, merge_action](std::ostream& out, std::ostream& err) {

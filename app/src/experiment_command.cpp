@@ -234,10 +234,11 @@ Action add_experiment_command(CLI::App& app) {
       "Plays every batch of the experiment (each scenario file: every matrix variant x N seeds, "
       "as llsfsim batch; resumable, Ctrl-C stores the running games and stops), then evaluates "
       "its calibration targets, findings, sweeps and tables per group against the stored runs, "
-      "with "
-      "bootstrap 95 % intervals from a fixed seed (the same store gives the same report), and "
-      "prints the verdicts. Verdicts are results: a finding that is not reproduced still exits "
-      "0.\n"
+      "with bootstrap intervals from a fixed seed (the same store gives the same report; "
+      "differences paired by seed where the runs share their seeds; no better / no worse / same "
+      "against the check's margin; no verdict from fewer than 10 games a side; "
+      "docs/statistics.md), and prints the verdicts. Verdicts are results: a finding that is not "
+      "reproduced still exits 0.\n"
       "Exit code: 0 done, 2 bad input (the experiment, a scenario, the store, a markdown file "
       "without the markers), 3 internal error (a bug: please report it), 130 interrupted.");
   return [o](std::ostream& out, std::ostream& err) { return experiment(*o, out, err); };

@@ -94,15 +94,17 @@ Action add_report_command(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--csv", o->csv,
                  "Also write every statistic per variant (n, mean, median, quartiles, min, max, "
-                 "pass rate) as CSV");
+                 "pass rate, runs: n of runs) as CSV");
   app.add_option("--html", o->html,
                  "Also write a self-contained HTML page: box plots of the points per variant and "
                  "per phase, the tables, and every run's statistics as JSON");
   app.add_flag("--list", o->list, "List the stored batches");
   app.footer(
       "Per variant: runs, pass rate and the distribution of the points; then every variant's "
-      "mean points against the first variant's, with a bootstrap 95 % interval (* = the "
-      "interval excludes 0). The HTML page inlines the viewer's bundle from $LLSF_VIEWER_DIR or "
+      "mean points against the first variant's, paired by seed where both played the same "
+      "seeds, with a bootstrap 95 % interval (* = separated at 5 % after Holm's correction over "
+      "the variants; no star and no verdict below 10 games, but how many would be needed; "
+      "docs/statistics.md). The HTML page inlines the viewer's bundle from $LLSF_VIEWER_DIR or "
       "viewer/dist of the data directory (`make viewer` builds it).\n"
       "Exit code: 0 done, 2 bad input (a bad store or batch, a database server that cannot be "
       "reached, a file that cannot be written, a missing viewer bundle), 3 internal error (a bug: "

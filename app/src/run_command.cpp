@@ -170,13 +170,17 @@ void print_summary(const study::RunResult& r, std::ostream& out) {
   }
   out << fmt::format(
       "production first complex product {}, {} role changes{}, storage low {} pucks{}\n",
-      r.first_complex_s < 0 ? std::string("none") : fmt::format("at {:.0f} s", r.first_complex_s),
+      r.first_complex_production_s
+          ? fmt::format("at {:.0f} s of production", *r.first_complex_production_s)
+          : std::string("none"),
       r.role_changes,
-      r.first_role_change_s < 0 ? std::string()
-                                : fmt::format(" (first at {:.0f} s)", r.first_role_change_s),
+      r.first_role_change_game_s
+          ? fmt::format(" (first at {:.0f} s of the game)", *r.first_role_change_game_s)
+          : std::string(),
       r.storage_min,
-      r.storage_empty_s < 0 ? std::string()
-                            : fmt::format(" (empty at {:.0f} s)", r.storage_empty_s));
+      r.storage_empty_game_s
+          ? fmt::format(" (empty at {:.0f} s of the game)", *r.storage_empty_game_s)
+          : std::string());
   if (r.profile != "ideal" || r.jams > 0) {
     out << fmt::format(
         "profile    {}: {} jams, {} robots jammed at the end, {} failures of one "

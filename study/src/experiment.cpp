@@ -41,14 +41,31 @@ bool contains(const std::vector<std::string>& v, const std::string& x) {
   return std::find(v.begin(), v.end(), x) != v.end();
 }
 
-/// The names every stored run has (StatsStore writes numeric_statistics()).
+/// The names a stored run may have (StatsStore writes numeric_statistics()).
 const std::vector<std::string>& known_statistics() {
   static const std::vector<std::string> names = [] {
     std::vector<std::string> out;
-    for (const auto& [name, value] : numeric_statistics(RunResult{})) out.push_back(name);
+    for (const StatisticInfo& s : statistic_infos()) out.push_back(s.name);
     return out;
   }();
   return names;
+}
+
+/// Whether a game may lack `name` (then no run having it is no sign of an old store).
+bool may_be_absent(const std::string& name) {
+  for (const StatisticInfo& s : statistic_infos()) {
+    if (s.name == name) return s.may_be_absent;
+  }
+  return false;
+}
+
+/// A statistic no stored run of a batch has: an error unless games may lack it (a store written
+/// before the statistic existed, or a typo the loader could not see).
+void require_stored(const std::set<std::string>& stored, const std::string& statistic,
+                    const std::string& where, const std::string& batch) {
+  if (stored.empty() || stored.count(statistic) > 0 || may_be_absent(statistic)) return;
+  throw core::ConfigError(where + ": no stored run of batch '" + batch + "' has the statistic '" +
+                          statistic + "'");
 }
 
 /// The non-empty string under `key`; "missing key 'key'" at `map` if absent. `node`, if given,
@@ -144,7 +161,8 @@ std::string read_statistic(const core::ConfigNode& map) {
   if (!contains(known_statistics(), s)) {
     at.fail("unknown statistic '" + s +
             "' (docs/statistics.md; e.g. points, production_points, deliveries, "
-            "first_complex_s, storage_empty_s, role_changes, jams)");
+            "first_complex_production_s, storage_empty_game_s, storage_ran_empty, role_changes, "
+            "jams)");
   }
   return s;
 }
@@ -213,16 +231,20 @@ bool is_share(Check::Kind k) {
   return k == Check::Kind::kShareAtMost || k == Check::Kind::kShareAtLeast;
 }
 
+bool has_margin(Check::Kind k) {
+  return k == Check::Kind::kNotGreater || k == Check::Kind::kNotLess ||
+         k == Check::Kind::kEquivalent;
+}
+
 bool is_comparison(Check::Kind k) {
-  return k == Check::Kind::kGreater || k == Check::Kind::kNotGreater ||
-         k == Check::Kind::kDifferenceIn;
+  return k == Check::Kind::kGreater || has_margin(k) || k == Check::Kind::kDifferenceIn;
 }
 
 std::optional<Check::Kind> kind_of(const std::string& s) {
   for (const Check::Kind k :
-       {Check::Kind::kGreater, Check::Kind::kNotGreater, Check::Kind::kDifferenceIn,
-        Check::Kind::kMeanIn, Check::Kind::kMedianIn, Check::Kind::kShareAtMost,
-        Check::Kind::kShareAtLeast}) {
+       {Check::Kind::kGreater, Check::Kind::kNotGreater, Check::Kind::kNotLess,
+        Check::Kind::kEquivalent, Check::Kind::kDifferenceIn, Check::Kind::kMeanIn,
+        Check::Kind::kMedianIn, Check::Kind::kShareAtMost, Check::Kind::kShareAtLeast}) {
     if (to_string(k) == s) return k;
   }
   return std::nullopt;
@@ -273,16 +295,16 @@ Check read_check(const Experiment& e, const core::ConfigNode& entry) {
   entry.require_map();
   if (entry.size() != 1) {
     entry.fail(
-        "a check is one of greater, not_greater, difference_in, mean_in, median_in, "
-        "share_at_most, share_at_least: {batch: ..., ...}");
+        "a check is one of greater, not_greater, not_less, equivalent, difference_in, mean_in, "
+        "median_in, share_at_most, share_at_least: {batch: ..., ...}");
   }
   const std::string key = entry.keys().front();
   const std::optional<Check::Kind> kind = kind_of(key);
   const core::ConfigNode n = entry[key];
   if (!kind) {
     n.fail("unknown check '" + key +
-           "' (checks: greater, not_greater, difference_in, mean_in, median_in, share_at_most, "
-           "share_at_least)");
+           "' (checks: greater, not_greater, not_less, equivalent, difference_in, mean_in, "
+           "median_in, share_at_most, share_at_least)");
   }
   n.require_map();
   if (n.is_null()) n.fail("expected {batch: ..., statistic: ..., ...}");
@@ -299,6 +321,8 @@ Check read_check(const Experiment& e, const core::ConfigNode& entry) {
     const core::ConfigNode bn = n["b"];
     const core::ConfigNode range =
         c.kind == Check::Kind::kDifferenceIn ? n["range"] : core::ConfigNode();
+    const core::ConfigNode margin = has_margin(c.kind) ? n["margin"] : core::ConfigNode();
+    const core::ConfigNode reason = has_margin(c.kind) ? n["margin_reason"] : core::ConfigNode();
     n.no_other_keys();
     if (!a.defined()) n.fail("missing key 'a' (the axis values of the first side)");
     if (!bn.defined()) n.fail("missing key 'b' (the axis values of the second side)");
@@ -308,6 +332,22 @@ Check read_check(const Experiment& e, const core::ConfigNode& entry) {
     if (c.kind == Check::Kind::kDifferenceIn) {
       if (!range.defined()) n.fail("missing key 'range' ([low, high])");
       read_bound(c, range);
+    }
+    // "No better", "no worse" and "same" need a margin: without one a check would hold by
+    // absence of evidence (fewer or noisier games would make it easier to pass).
+    if (has_margin(c.kind)) {
+      if (!margin.defined()) {
+        n.fail(
+            "missing key 'margin' (the difference, in the statistic's unit, that still counts "
+            "as no difference, e.g. 10 points: docs/experiments.md)");
+      }
+      c.margin = margin.as_double();
+      if (!(c.margin > 0.0) || !std::isfinite(c.margin)) margin.fail("must be a number above 0");
+      if (!reason.defined()) {
+        n.fail("missing key 'margin_reason' (why this margin: cite the source or say why)");
+      }
+      c.margin_reason = reason.as_string();
+      if (c.margin_reason.empty()) reason.fail("must not be empty");
     }
   } else {
     const core::ConfigNode where = n["where"];
@@ -485,6 +525,10 @@ std::string to_string(Check::Kind k) {
       return "greater";
     case Check::Kind::kNotGreater:
       return "not_greater";
+    case Check::Kind::kNotLess:
+      return "not_less";
+    case Check::Kind::kEquivalent:
+      return "equivalent";
     case Check::Kind::kDifferenceIn:
       return "difference_in";
     case Check::Kind::kMeanIn:
@@ -572,8 +616,9 @@ namespace {
 struct BatchData {
   const ExperimentBatch* batch = nullptr;
   std::vector<int> expected;  ///< per variant: runs of a complete batch
-  std::vector<std::vector<std::map<std::string, double>>> runs;  ///< per variant
-  std::set<std::string> statistics;                              ///< every name a run has
+  /// Per variant, its runs in seed order: the seed and every statistic of the run.
+  std::vector<std::vector<std::pair<std::uint64_t, std::map<std::string, double>>>> runs;
+  std::set<std::string> statistics;  ///< every name a run has
 };
 
 BatchData load_batch_data(const ExperimentBatch& b, const StatsStore& store,
@@ -615,7 +660,7 @@ BatchData load_batch_data(const ExperimentBatch& b, const StatsStore& store,
       values[name] = value;
       d.statistics.insert(name);
     }
-    d.runs[it->second].push_back(std::move(values));
+    d.runs[it->second].emplace_back(run.seed, std::move(values));
     ++state.stored;
   }
   return d;
@@ -629,22 +674,57 @@ bool matches(const ExperimentBatch& b, std::size_t variant, const AxisFilter& fi
   return true;
 }
 
-/// The values of `sel`'s statistic over the runs of the variants `filter` selects.
-std::vector<double> collect(const BatchData& d, const Selection& sel, const AxisFilter& filter,
-                            SampleCounts& n) {
-  std::vector<double> out;
+/// The values of `sel`'s statistic over the runs of the variants `filter` selects, each keyed by
+/// its seed and its variant's values of `key_axes` (the axes pooled on both sides of a
+/// comparison): the key pairs a run with the other side's run of the same seed.
+std::vector<KeyedValue> collect_keyed(const BatchData& d, const Selection& sel,
+                                      const AxisFilter& filter,
+                                      const std::vector<std::size_t>& key_axes, SampleCounts& n) {
+  std::vector<KeyedValue> out;
+  const ExperimentBatch& b = *d.batch;
   for (std::size_t v = 0; v < d.runs.size(); ++v) {
-    if (!matches(*d.batch, v, filter)) continue;
+    if (!matches(b, v, filter)) continue;
     n.expected += d.expected[v];
-    for (const auto& run : d.runs[v]) {
+    std::string pooled;
+    for (const std::size_t a : key_axes) {
+      pooled += "," + b.scenario.axes[a] + "=" + b.variant_axes[v][a];
+    }
+    for (const auto& [seed, run] : d.runs[v]) {
       ++n.stored;
       const auto it = run.find(sel.statistic);
       if (it == run.end()) continue;
       if (sel.ignore_below && it->second < *sel.ignore_below) continue;
-      out.push_back(it->second);
+      out.push_back({"seed=" + std::to_string(seed) + pooled, it->second});
     }
   }
   n.used = static_cast<int>(out.size());
+  return out;
+}
+
+std::vector<double> values_of(const std::vector<KeyedValue>& kv) {
+  std::vector<double> out;
+  out.reserve(kv.size());
+  for (const KeyedValue& x : kv) out.push_back(x.value);
+  return out;
+}
+
+/// The values of `sel`'s statistic over the runs of the variants `filter` selects.
+std::vector<double> collect(const BatchData& d, const Selection& sel, const AxisFilter& filter,
+                            SampleCounts& n) {
+  return values_of(collect_keyed(d, sel, filter, {}, n));
+}
+
+/// The axes of `b` that neither filter names: pooled on both sides, part of the pairing key.
+std::vector<std::size_t> pooled_axes(const ExperimentBatch& b, const AxisFilter& x,
+                                     const AxisFilter& y) {
+  std::vector<std::size_t> out;
+  for (std::size_t a = 0; a < b.scenario.axes.size(); ++a) {
+    auto named = [&](const AxisFilter& f) {
+      return std::any_of(f.begin(), f.end(),
+                         [&](const auto& p) { return p.first == b.scenario.axes[a]; });
+    };
+    if (!named(x) && !named(y)) out.push_back(a);
+  }
   return out;
 }
 
@@ -723,7 +803,15 @@ std::string describe(const Check& c) {
       s = stat + ": " + filter_text(c.a) + " > " + filter_text(c.b);
       break;
     case Check::Kind::kNotGreater:
-      s = stat + ": " + filter_text(c.a) + " not > " + filter_text(c.b);
+      s = stat + ": " + filter_text(c.a) + " not > " + filter_text(c.b) + " by " + bound(c.margin) +
+          " or more";
+      break;
+    case Check::Kind::kNotLess:
+      s = stat + ": " + filter_text(c.a) + " not < " + filter_text(c.b) + " by " + bound(c.margin) +
+          " or more";
+      break;
+    case Check::Kind::kEquivalent:
+      s = stat + ": " + filter_text(c.a) + " = " + filter_text(c.b) + " within ±" + bound(c.margin);
       break;
     case Check::Kind::kDifferenceIn:
       s = stat + ": " + filter_text(c.a) + " - " + filter_text(c.b) + " in [" + bound(c.low) +
@@ -743,38 +831,94 @@ std::string describe(const Check& c) {
       break;
   }
   if (c.sel.ignore_below) s += " (values below " + bound(*c.sel.ignore_below) + " left out)";
+  if (has_margin(c.kind)) s += " (margin: " + c.margin_reason + ")";
   return s;
+}
+
+/// "paired by seed (100 pairs)" or "unpaired", with the runs a pairing left out.
+std::string method_text(const Comparison& c) {
+  if (c.pairing == Pairing::kUnpaired) return "unpaired";
+  std::string s =
+      "paired by seed (" + std::to_string(c.pairs) + (c.pairs == 1 ? " pair" : " pairs");
+  if (c.unmatched > 0) s += ", " + std::to_string(c.unmatched) + " runs without a partner left out";
+  return s + ")";
+}
+
+/// What the runs could show: the smallest detectable difference, the games a difference of the
+/// size seen would need.
+std::string power_text(const Comparison& c, bool detectable) {
+  std::string s;
+  if (detectable && c.detectable) s += "; smallest detectable " + num(*c.detectable);
+  if (c.games_needed) {
+    s += "; about " + std::to_string(*c.games_needed) +
+         (c.pairing == Pairing::kPaired ? " seeds" : " games per side") +
+         " would separate a difference of this size";
+  } else if (!c.se) {
+    s += "; the spread is unknown with one game";
+  }
+  return s;
+}
+
+std::string too_few_text(int games, int min_games) {
+  return "; too few games for a verdict (" + std::to_string(games) + ", needs " +
+         std::to_string(min_games) + ")";
 }
 
 /// Evaluates one check in one group, drawing its bootstrap from `rng`.
 CheckResult evaluate_check(const Experiment& e, const std::vector<BatchData>& data, const Check& c,
-                           const std::string& group, core::RandomStream rng) {
+                           const std::string& group, core::RandomStream rng, int min_games) {
   const BatchData& d = data[static_cast<std::size_t>(c.sel.batch)];
   const ExperimentBatch& b = *d.batch;
-  if (d.statistics.size() > 0 && d.statistics.count(c.sel.statistic) == 0) {
-    throw core::ConfigError(c.where + ": no stored run of batch '" + b.name +
-                            "' has the statistic '" + c.sel.statistic + "'");
-  }
+  require_stored(d.statistics, c.sel.statistic, c.where, b.name);
   CheckResult r;
   r.description = describe(c);
-  const std::vector<double> a = collect(d, c.sel, with_group(e, b, c.a, group), r.a);
+  const AxisFilter fa = with_group(e, b, c.a, group);
+  const AxisFilter fb = with_group(e, b, c.b, group);
+  const std::vector<std::size_t> key_axes = pooled_axes(b, fa, fb);
+  const std::vector<KeyedValue> ak = collect_keyed(d, c.sel, fa, key_axes, r.a);
+  const std::vector<double> a = values_of(ak);
   if (is_comparison(c.kind)) {
-    const std::vector<double> bv = collect(d, c.sel, with_group(e, b, c.b, group), r.b);
-    if (a.empty() || bv.empty()) {
+    const std::vector<KeyedValue> bk = collect_keyed(d, c.sel, fb, key_axes, r.b);
+    if (ak.empty() || bk.empty()) {
       r.measured = "no data: " + missing_text(r.a) + " vs " + missing_text(r.b);
       return r;
     }
-    r.value = mean_of(a) - mean_of(bv);
-    const Interval ci = bootstrap_interval(a, bv, Estimator::kMean, rng);
+    const Comparison cmp = compare_means(ak, bk, rng, min_games);
+    r.comparison = cmp;
+    r.value = cmp.diff;
+    const bool margin = has_margin(c.kind);
+    const Interval ci = margin ? cmp.ci_tost : cmp.ci;
     r.ci_low = ci.low;
     r.ci_high = ci.high;
-    r.measured = "difference " + signed_num(r.value) + ", 95 % CI [" + signed_num(ci.low) + ", " +
-                 signed_num(ci.high) + "]; " + counts_text(r.a) + " vs " +
-                 counts_text(r.b).substr(2);
+    r.measured = "difference " + signed_num(r.value) + (margin ? ", 90 % CI [" : ", 95 % CI [") +
+                 signed_num(ci.low) + ", " + signed_num(ci.high) + "], " + method_text(cmp) + "; " +
+                 counts_text(r.a) + " vs " + counts_text(r.b).substr(2);
     bool holds = false;
-    if (c.kind == Check::Kind::kGreater) holds = ci.low > 0.0;
-    if (c.kind == Check::Kind::kNotGreater) holds = ci.low <= 0.0;
-    if (c.kind == Check::Kind::kDifferenceIn) holds = r.value >= c.low && r.value <= c.high;
+    switch (c.kind) {
+      case Check::Kind::kGreater:
+        holds = cmp.ci.low > 0.0;
+        break;
+      case Check::Kind::kNotGreater:
+        holds = within_margin(cmp, MarginTest::kNotAbove, c.margin);
+        break;
+      case Check::Kind::kNotLess:
+        holds = within_margin(cmp, MarginTest::kNotBelow, c.margin);
+        break;
+      case Check::Kind::kEquivalent:
+        holds = within_margin(cmp, MarginTest::kSame, c.margin);
+        break;
+      default:
+        holds = r.value >= c.low && r.value <= c.high;
+    }
+    if (!cmp.enough) {
+      r.measured += too_few_text(cmp.games(), min_games) + power_text(cmp, margin);
+      r.outcome = CheckResult::Outcome::kTooFew;
+      return r;
+    }
+    // A greater that failed, or a margin check: what the runs could have shown.
+    if (margin || (c.kind == Check::Kind::kGreater && !holds)) {
+      r.measured += power_text(cmp, margin);
+    }
     r.outcome = holds ? CheckResult::Outcome::kHolds : CheckResult::Outcome::kFails;
     return r;
   }
@@ -805,6 +949,11 @@ CheckResult evaluate_check(const Experiment& e, const std::vector<BatchData>& da
     r.measured = std::string(est == Estimator::kMean ? "mean " : "median ") + num(r.value) +
                  ", 95 % CI [" + num(ci.low) + ", " + num(ci.high) + "]; " + counts_text(r.a);
   }
+  if (static_cast<int>(a.size()) < min_games) {
+    r.measured += too_few_text(static_cast<int>(a.size()), min_games);
+    r.outcome = CheckResult::Outcome::kTooFew;
+    return r;
+  }
   r.outcome = r.value >= c.low && r.value <= c.high ? CheckResult::Outcome::kHolds
                                                     : CheckResult::Outcome::kFails;
   return r;
@@ -829,10 +978,7 @@ SweepResult evaluate_sweep(const Experiment& e, const std::vector<BatchData>& da
                            const std::string& group, const EvaluateOptions& o) {
   const BatchData& d = data[static_cast<std::size_t>(s.sel.batch)];
   const ExperimentBatch& b = *d.batch;
-  if (d.statistics.size() > 0 && d.statistics.count(s.sel.statistic) == 0) {
-    throw core::ConfigError(s.where + ": no stored run of batch '" + b.name +
-                            "' has the statistic '" + s.sel.statistic + "'");
-  }
+  require_stored(d.statistics, s.sel.statistic, s.where, b.name);
   SweepResult r;
   r.sweep = &s;
   r.group = group;
@@ -842,14 +988,15 @@ SweepResult evaluate_sweep(const Experiment& e, const std::vector<BatchData>& da
   for (const std::string& value : rows) {
     SweepRow row;
     row.value = value;
-    std::vector<std::vector<double>> samples;
+    std::vector<std::vector<KeyedValue>> samples;
     for (const std::string& cv : r.compare_values) {
       AxisFilter f = s.fixed;
       f.emplace_back(s.axis, value);
       f.emplace_back(s.compare, cv);
       SampleCounts n;
-      samples.push_back(collect(d, s.sel, with_group(e, b, f, group), n));
-      row.means.push_back(samples.back().empty() ? 0.0 : mean_of(samples.back()));
+      // Every axis is fixed (or the group's): the seed alone pairs the compared values' runs.
+      samples.push_back(collect_keyed(d, s.sel, with_group(e, b, f, group), {}, n));
+      row.means.push_back(samples.back().empty() ? 0.0 : mean_of(values_of(samples.back())));
       row.n.push_back(n);
     }
     // Best mean first; equal means keep the file order.
@@ -866,20 +1013,27 @@ SweepResult evaluate_sweep(const Experiment& e, const std::vector<BatchData>& da
     }
     if (idx.size() >= 2) {
       row.has_top_two = true;
-      row.top_diff = row.means[idx[0]] - row.means[idx[1]];
       core::RandomStream rng = stream(o, "sweep/" + s.name + "/" + group + "/" + value);
-      const Interval ci =
-          bootstrap_interval(samples[idx[0]], samples[idx[1]], Estimator::kMean, rng);
-      row.top_low = ci.low;
-      row.top_high = ci.high;
-      row.separated = ci.low > 0.0 || ci.high < 0.0;
+      row.top = compare_means(samples[idx[0]], samples[idx[1]], rng, o.min_games);
+      row.top_diff = row.top->diff;
+      row.top_low = row.top->ci.low;
+      row.top_high = row.top->ci.high;
     }
     if (value == s.baseline) baseline_order = row.order;
     r.rows.push_back(std::move(row));
   }
+  // The rows' top-two comparisons are one family: Holm's correction over them.
+  std::vector<double> p;
+  for (const SweepRow& row : r.rows) {
+    if (row.top) p.push_back(row.top->p_value);
+  }
+  r.comparisons = static_cast<int>(p.size());
+  const std::vector<bool> rejected = holm(p);
+  std::size_t k = 0;
   for (SweepRow& row : r.rows) {
     row.comparable = !row.order.empty() && !baseline_order.empty();
     row.differs = row.comparable && row.value != s.baseline && row.order != baseline_order;
+    if (row.top) row.separated = rejected[k++] && row.top->enough;
   }
   return r;
 }
@@ -888,12 +1042,7 @@ TableResult evaluate_table(const Experiment& e, const std::vector<BatchData>& da
                            const std::string& group) {
   const BatchData& d = data[static_cast<std::size_t>(t.sel.batch)];
   const ExperimentBatch& b = *d.batch;
-  for (const std::string& st : t.statistics) {
-    if (d.statistics.size() > 0 && d.statistics.count(st) == 0) {
-      throw core::ConfigError(t.where + ": no stored run of batch '" + b.name +
-                              "' has the statistic '" + st + "'");
-    }
-  }
+  for (const std::string& st : t.statistics) require_stored(d.statistics, st, t.where, b.name);
   TableResult r;
   r.table = &t;
   r.group = group;
@@ -923,6 +1072,7 @@ ExperimentResult evaluate(const Experiment& e, const StatsStore& store, const Ev
   ExperimentResult r;
   r.experiment = &e;
   r.command = "llsfsim experiment " + e.file + (o.runs ? " --runs " + std::to_string(*o.runs) : "");
+  r.min_games = o.min_games;
   std::vector<BatchData> data;
   for (const ExperimentBatch& b : e.batches) {
     r.batches.emplace_back();
@@ -934,10 +1084,12 @@ ExperimentResult evaluate(const Experiment& e, const StatsStore& store, const Ev
       TargetResult tr;
       tr.target = &t;
       tr.group = g;
-      tr.check = evaluate_check(e, data, t.check, g, stream(o, "calibration/" + t.name + "/" + g));
-      tr.verdict = tr.check.outcome == CheckResult::Outcome::kHolds   ? Verdict::kHolds
-                   : tr.check.outcome == CheckResult::Outcome::kFails ? Verdict::kFails
-                                                                      : Verdict::kNoData;
+      tr.check = evaluate_check(e, data, t.check, g, stream(o, "calibration/" + t.name + "/" + g),
+                                o.min_games);
+      tr.verdict = tr.check.outcome == CheckResult::Outcome::kHolds    ? Verdict::kHolds
+                   : tr.check.outcome == CheckResult::Outcome::kFails  ? Verdict::kFails
+                   : tr.check.outcome == CheckResult::Outcome::kTooFew ? Verdict::kTooFew
+                                                                       : Verdict::kNoData;
       r.calibration.push_back(std::move(tr));
     }
   }
@@ -950,17 +1102,20 @@ ExperimentResult evaluate(const Experiment& e, const StatsStore& store, const Ev
     for (const std::string& g : groups_of(e, batches, f.groups)) {
       FindingGroupResult gr;
       gr.group = g;
-      bool no_data = false;
+      bool no_data = false, too_few = false;
       for (std::size_t i = 0; i < f.checks.size(); ++i) {
-        gr.checks.push_back(
-            evaluate_check(e, data, f.checks[i], g,
-                           stream(o, "finding/" + f.id + "/" + std::to_string(i + 1) + "/" + g)));
+        gr.checks.push_back(evaluate_check(
+            e, data, f.checks[i], g,
+            stream(o, "finding/" + f.id + "/" + std::to_string(i + 1) + "/" + g), o.min_games));
         const CheckResult::Outcome out = gr.checks.back().outcome;
         if (out == CheckResult::Outcome::kFails) gr.failed.push_back(static_cast<int>(i) + 1);
         no_data = no_data || out == CheckResult::Outcome::kNoData;
+        too_few = too_few || out == CheckResult::Outcome::kTooFew;
       }
+      // A check that failed with enough games decides; then missing runs, then too few games.
       gr.verdict = !gr.failed.empty() ? Verdict::kFails
                    : no_data          ? Verdict::kNoData
+                   : too_few          ? Verdict::kTooFew
                                       : Verdict::kHolds;
       fr.groups.push_back(std::move(gr));
     }
@@ -987,12 +1142,18 @@ namespace {
 // Rendering
 
 std::string target_verdict(Verdict v) {
-  return v == Verdict::kHolds ? "met" : v == Verdict::kFails ? "not met" : "no data";
+  return v == Verdict::kHolds    ? "met"
+         : v == Verdict::kFails  ? "not met"
+         : v == Verdict::kTooFew ? "too few games"
+                                 : "no data";
 }
 
-std::string finding_verdict(const FindingGroupResult& g) {
+std::string finding_verdict(const FindingGroupResult& g, int min_games) {
   if (g.verdict == Verdict::kHolds) return "reproduced";
   if (g.verdict == Verdict::kNoData) return "no data";
+  if (g.verdict == Verdict::kTooFew) {
+    return "no verdict: too few games (at least " + std::to_string(min_games) + " a side)";
+  }
   std::vector<std::string> nums;
   for (const int i : g.failed) nums.push_back(std::to_string(i));
   return std::string("not reproduced (check") + (g.failed.size() > 1 ? "s " : " ") +
@@ -1000,9 +1161,10 @@ std::string finding_verdict(const FindingGroupResult& g) {
 }
 
 std::string outcome_text(CheckResult::Outcome o) {
-  return o == CheckResult::Outcome::kHolds   ? "holds"
-         : o == CheckResult::Outcome::kFails ? "fails"
-                                             : "no data";
+  return o == CheckResult::Outcome::kHolds    ? "holds"
+         : o == CheckResult::Outcome::kFails  ? "fails"
+         : o == CheckResult::Outcome::kTooFew ? "too few"
+                                              : "no data";
 }
 
 std::string group_label(const std::string& g) { return g.empty() ? "all" : g; }
@@ -1024,20 +1186,50 @@ std::string batch_line(const BatchState& b) {
 
 std::string sweep_cell(const SweepRow& row, std::size_t i) {
   if (row.n[i].used == 0) return "-";
-  return num(row.means[i]) + " (n " + std::to_string(row.n[i].used) + ")";
+  const SampleCounts& n = row.n[i];
+  return num(row.means[i]) + " (n " + std::to_string(n.used) +
+         (n.used != n.stored ? " of " + std::to_string(n.stored) : "") + ")";
 }
 
 std::string top_two(const SweepRow& row) {
   if (!row.has_top_two) return "-";
-  return std::string(row.separated ? "separated" : "not separated") + ": " +
-         signed_num(row.top_diff) + " [" + signed_num(row.top_low) + ", " +
-         signed_num(row.top_high) + "]";
+  const std::string numbers = signed_num(row.top_diff) + " [" + signed_num(row.top_low) + ", " +
+                              signed_num(row.top_high) + "]";
+  if (!row.top->enough) {
+    return "too few games (" + std::to_string(row.top->games()) + "): " + numbers;
+  }
+  return std::string(row.separated ? "separated" : "not separated") + ": " + numbers;
 }
 
-/// A table's cell: the mean, with the runs it counts if some were left out.
+/// How a sweep's top two were compared: the method and the family Holm's correction controls.
+std::string sweep_method(const SweepResult& s) {
+  std::string method = "unpaired";
+  for (const SweepRow& row : s.rows) {
+    if (row.top && row.top->pairing == Pairing::kPaired) method = "paired by seed";
+  }
+  return method + ", Holm's correction over " + std::to_string(s.comparisons) +
+         (s.comparisons == 1 ? " comparison" : " comparisons");
+}
+
+/// Findings test each check at 5 % on its own; the report says so, with the number of checks.
+std::string findings_note(const ExperimentResult& r) {
+  int checks = 0;
+  for (const FindingResult& f : r.findings) {
+    for (const FindingGroupResult& g : f.groups) checks += static_cast<int>(g.checks.size());
+  }
+  return "Each of the " + std::to_string(checks) +
+         " checks is tested at the 5 % level on its own (no correction across checks: each "
+         "finding is its own claim); differences are paired by seed where the runs share their "
+         "seeds; no verdict from fewer than " +
+         std::to_string(r.min_games) + " games a side.";
+}
+
+/// A table's cell: the mean, with "n of N" if some runs have no value (absent, or left out).
 std::string table_cell(const TableRow& row, std::size_t i) {
   if (row.n[i] == 0) return "-";
-  return num(row.means[i]) + (row.n[i] != row.runs ? " (n " + std::to_string(row.n[i]) + ")" : "");
+  return num(row.means[i]) + (row.n[i] != row.runs ? " (n " + std::to_string(row.n[i]) + " of " +
+                                                         std::to_string(row.runs) + ")"
+                                                   : "");
 }
 
 std::string table_heading(const TableResult& t, const Experiment& e) {
@@ -1100,11 +1292,11 @@ std::string to_text(const ExperimentResult& r) {
     out += "           " + t.check.measured + "\n";
   }
 
-  if (!r.findings.empty()) out += "\nfindings\n";
+  if (!r.findings.empty()) out += "\nfindings   (" + findings_note(r) + ")\n";
   for (const FindingResult& f : r.findings) {
     out += "  " + f.finding->id + "  " + f.finding->claim + "\n";
     for (const FindingGroupResult& g : f.groups) {
-      out += "    " + group_label(g.group) + ": " + finding_verdict(g) + "\n";
+      out += "    " + group_label(g.group) + ": " + finding_verdict(g, r.min_games) + "\n";
       for (std::size_t i = 0; i < g.checks.size(); ++i) {
         const CheckResult& c = g.checks[i];
         out += "      " + std::to_string(i + 1) + " " + pad(outcome_text(c.outcome), 8) +
@@ -1120,7 +1312,8 @@ std::string to_text(const ExperimentResult& r) {
     out += "  " + sw.name + (s.group.empty() ? "" : " [" + s.group + "]") + ": " +
            sw.sel.statistic + " by " + sw.compare + " per " + sw.axis + " (batch " +
            e.batches[static_cast<std::size_t>(sw.sel.batch)].name +
-           (sw.fixed.empty() ? "" : ", " + filter_text(sw.fixed)) + ")\n";
+           (sw.fixed.empty() ? "" : ", " + filter_text(sw.fixed)) + "; top two " + sweep_method(s) +
+           ")\n";
     std::size_t w = sw.axis.size();
     for (const SweepRow& row : s.rows) w = std::max(w, row.value.size());
     std::vector<std::size_t> cw;
@@ -1194,12 +1387,13 @@ std::string to_markdown(const ExperimentResult& r) {
   }
 
   if (!r.findings.empty()) {
-    out += "\n### Findings\n\n";
+    out += "\n### Findings\n\n" + findings_note(r) + "\n\n";
     out += "| finding | claim | verdict |\n|---|---|---|\n";
     for (const FindingResult& f : r.findings) {
       std::vector<std::string> verdicts;
       for (const FindingGroupResult& g : f.groups) {
-        verdicts.push_back((g.group.empty() ? "" : g.group + ": ") + finding_verdict(g));
+        verdicts.push_back((g.group.empty() ? "" : g.group + ": ") +
+                           finding_verdict(g, r.min_games));
       }
       out += row({f.finding->id, f.finding->claim, join(verdicts, "; ")});
     }
@@ -1213,7 +1407,8 @@ std::string to_markdown(const ExperimentResult& r) {
           out += row({group_label(g.group), std::to_string(i + 1) + ". " + c.description,
                       c.measured, outcome_text(c.outcome)});
         }
-        out += row({group_label(g.group), "**verdict**", "", "**" + finding_verdict(g) + "**"});
+        out += row({group_label(g.group), "**verdict**", "",
+                    "**" + finding_verdict(g, r.min_games) + "**"});
       }
     }
   }
@@ -1229,7 +1424,8 @@ std::string to_markdown(const ExperimentResult& r) {
         (sw.fixed.empty() ? "" : " (" + filter_text(sw.fixed) + ")") +
         (sw.sel.ignore_below ? ", values below " + bound(*sw.sel.ignore_below) + " left out" : "") +
         "; baseline `" + sw.baseline +
-        "`. Top two: the bootstrap 95 % interval of the best minus the second mean.\n\n";
+        "`. Top two: the bootstrap 95 % interval of the best minus the second mean (" +
+        sweep_method(s) + ").\n\n";
     std::vector<std::string> head{sw.axis};
     std::string align = "|---|";
     for (const std::string& cv : s.compare_values) {

@@ -42,48 +42,7 @@ StatSummary summarize(const std::string& name, std::vector<double> v) {
   return s;
 }
 
-double mean_of(const std::vector<double>& x) {
-  return std::accumulate(x.begin(), x.end(), 0.0) / static_cast<double>(x.size());
-}
-
-// The estimator of one resample (sorted in place for the median).
-double estimate(std::vector<double>& x, Estimator e) {
-  if (e == Estimator::kMean) return mean_of(x);
-  std::sort(x.begin(), x.end());
-  return quantile(x, 0.5);
-}
-
 }  // namespace
-
-Interval bootstrap_interval(const std::vector<double>& a, const std::vector<double>& b,
-                            Estimator estimator, core::RandomStream& rng, int resamples) {
-  LLSF_DEMAND(!a.empty());
-  LLSF_DEMAND(resamples > 0);
-  auto resample = [&rng](const std::vector<double>& from, std::vector<double>& to) {
-    to.resize(from.size());
-    const auto last = static_cast<std::int64_t>(from.size()) - 1;
-    for (double& x : to) x = from[static_cast<std::size_t>(rng.uniform_int(0, last))];
-  };
-  std::vector<double> values;
-  values.reserve(static_cast<std::size_t>(resamples));
-  std::vector<double> ra, rb;
-  for (int k = 0; k < resamples; ++k) {
-    resample(a, ra);
-    resample(b, rb);
-    const double ea = estimate(ra, estimator);
-    values.push_back(b.empty() ? ea : ea - estimate(rb, estimator));
-  }
-  std::sort(values.begin(), values.end());
-  return {quantile(values, 0.025), quantile(values, 0.975)};
-}
-
-double quantile(const std::vector<double>& sorted, double q) {
-  if (sorted.empty()) return 0.0;
-  const double h = (static_cast<double>(sorted.size()) - 1.0) * std::clamp(q, 0.0, 1.0);
-  const auto lo = static_cast<std::size_t>(std::floor(h));
-  const std::size_t hi = std::min(lo + 1, sorted.size() - 1);
-  return sorted[lo] + (h - static_cast<double>(lo)) * (sorted[hi] - sorted[lo]);
-}
 
 const StatSummary* VariantReport::find(const std::string& name) const {
   for (const StatSummary& s : stats) {
@@ -97,9 +56,10 @@ BatchReport make_report(const StatsStore& store, std::int64_t batch_id, std::uin
   const auto batch = store.batch(batch_id);
   if (!batch) throw StatsError(store.path() + ": no batch " + std::to_string(batch_id));
   r.batch = *batch;
-  // Values per variant and statistic, variants in first-stored order.
+  // Values per variant and statistic (keyed by seed, for pairing), variants in first-stored
+  // order.
   std::vector<std::string> order;
-  std::map<std::string, std::map<std::string, std::vector<double>>> values;
+  std::map<std::string, std::map<std::string, std::vector<KeyedValue>>> values;
   std::map<std::string, std::pair<int, int>> pass;  // runs, passed
   // Runs by (variant, seed), not in stored order: the order in which workers, array tasks or a
   // merge stored them must not change the bootstrap's resamples (the same report from a local
@@ -111,7 +71,8 @@ BatchReport make_report(const StatsStore& store, std::int64_t batch_id, std::uin
   for (const StoredRun& run : runs) {
     if (values.find(run.variant) == values.end()) order.push_back(run.variant);
     auto& per = values[run.variant];
-    for (const auto& [name, v] : store.statistics(run.id)) per[name].push_back(v);
+    const std::string key = "seed=" + std::to_string(run.seed);
+    for (const auto& [name, v] : store.statistics(run.id)) per[name].push_back({key, v});
     auto& p = pass[run.variant];
     ++p.first;
     if (run.passed) ++p.second;
@@ -123,28 +84,49 @@ BatchReport make_report(const StatsStore& store, std::int64_t batch_id, std::uin
     vr.variant = variant;
     vr.runs = pass[variant].first;
     vr.passed = pass[variant].second;
-    for (const auto& [name, v] : values[variant]) vr.stats.push_back(summarize(name, v));
+    for (const auto& [name, kv] : values[variant]) {
+      std::vector<double> v;
+      for (const KeyedValue& x : kv) v.push_back(x.value);
+      vr.stats.push_back(summarize(name, v));
+    }
     r.variants.push_back(std::move(vr));
   }
-  // Differences of means against the first variant, percentile bootstrap.
+  // Differences against the first variant, paired by seed where the seeds are shared.
   if (order.size() < 2) return r;
-  core::RandomStream rng(seed);
+  // Each difference draws from its own named stream: a statistic added to the store (or a
+  // variant) changes no other difference's interval.
+  const core::Rng streams(seed);
   const auto& base = values[order.front()];
   for (std::size_t i = 1; i < order.size(); ++i) {
     const auto& other = values[order[i]];
     for (const auto& [name, b] : base) {
       const auto it = other.find(name);
       if (it == other.end() || b.empty() || it->second.empty()) continue;
-      const std::vector<double>& a = it->second;
-      const Interval ci = bootstrap_interval(a, b, Estimator::kMean, rng);
       Difference d;
       d.variant = order[i];
       d.baseline = order.front();
       d.statistic = name;
-      d.diff = mean_of(a) - mean_of(b);
-      d.ci_low = ci.low;
-      d.ci_high = ci.high;
+      core::RandomStream rng = streams.stream("report/" + order[i] + "/" + name);
+      d.comparison = compare_means(it->second, b, rng);
+      d.diff = d.comparison.diff;
+      d.ci_low = d.comparison.ci.low;
+      d.ci_high = d.comparison.ci.high;
       r.differences.push_back(std::move(d));
+    }
+  }
+  // Holm per statistic: its comparisons (each variant against the first) are one family.
+  std::map<std::string, std::vector<std::size_t>> family;
+  for (std::size_t k = 0; k < r.differences.size(); ++k) {
+    family[r.differences[k].statistic].push_back(k);
+  }
+  for (const auto& [name, members] : family) {
+    std::vector<double> p;
+    for (const std::size_t k : members) p.push_back(r.differences[k].comparison.p_value);
+    const std::vector<bool> rejected = holm(p);
+    for (std::size_t j = 0; j < members.size(); ++j) {
+      Difference& d = r.differences[members[j]];
+      d.comparisons = static_cast<int>(members.size());
+      d.separated = rejected[j] && d.comparison.enough;
     }
   }
   return r;
@@ -163,17 +145,60 @@ std::string csv_quoted(const std::string& field) {
 }  // namespace
 
 std::string to_csv(const BatchReport& r) {
-  std::string out = "variant,statistic,n,mean,median,q1,q3,min,max,pass_rate\n";
+  std::string out = "variant,statistic,n,mean,median,q1,q3,min,max,pass_rate,runs\n";
   for (const VariantReport& v : r.variants) {
     const double rate = v.runs > 0 ? static_cast<double>(v.passed) / v.runs : 0.0;
     for (const StatSummary& s : v.stats) {
       out += csv_quoted(v.variant) + "," + s.name + "," + std::to_string(s.n) + "," + fmt(s.mean) +
              "," + fmt(s.median) + "," + fmt(s.q1) + "," + fmt(s.q3) + "," + fmt(s.min) + "," +
-             fmt(s.max) + "," + fmt(rate) + "\n";
+             fmt(s.max) + "," + fmt(rate) + "," + std::to_string(v.runs) + "\n";
     }
   }
   return out;
 }
+
+namespace {
+
+/// The games a difference rests on: "30 pairs", "30 vs 28 games", and the runs left out.
+std::string games_text(const Comparison& c) {
+  std::string s =
+      c.pairing == Pairing::kPaired
+          ? "paired by seed: " + std::to_string(c.pairs) + (c.pairs == 1 ? " pair" : " pairs")
+          : "unpaired: " + std::to_string(c.n_a) + " vs " + std::to_string(c.n_b) + " games";
+  if (c.unmatched > 0) s += ", " + std::to_string(c.unmatched) + " without a partner left out";
+  return s;
+}
+
+/// "about 40 games per variant would separate a difference of this size" or why not known.
+std::string games_needed_text(const Comparison& c) {
+  const char* unit = c.pairing == Pairing::kPaired ? " seeds" : " games per variant";
+  if (c.games_needed) {
+    return "about " + std::to_string(*c.games_needed) + unit +
+           " would separate a difference of this size";
+  }
+  if (!c.se) return std::string("the spread is unknown with one game");
+  return std::string("no difference to separate");
+}
+
+/// One line of the differences: value, interval, star, and what the runs allow.
+std::string difference_line(const Difference& d) {
+  const Comparison& c = d.comparison;
+  char numbers[96];
+  std::snprintf(numbers, sizeof numbers, " %+8.1f  [%+.1f, %+.1f]%s  (", d.diff, d.ci_low,
+                d.ci_high, d.separated ? "  *" : "");
+  std::string out = d.variant;
+  if (out.size() < 28) out.resize(28, ' ');
+  out += numbers + games_text(c);
+  if (!c.enough) {
+    out += "; too few for a verdict, which needs " + std::to_string(kMinGamesForVerdict) + "; " +
+           games_needed_text(c);
+  } else if (!d.separated && c.games_needed) {
+    out += "; " + games_needed_text(c);
+  }
+  return out + ")\n";
+}
+
+}  // namespace
 
 std::string to_text(const BatchReport& r) {
   std::string out = "batch " + std::to_string(r.batch.id) + "  " + r.batch.scenario_name + " (" +
@@ -196,12 +221,15 @@ std::string to_text(const BatchReport& r) {
   for (const Difference& d : r.differences) {
     if (d.statistic != "points") continue;
     if (!header) {
-      out += "\npoints: difference of means against " + d.baseline + " (bootstrap 95 % interval)\n";
+      out += "\npoints: difference of means against " + d.baseline +
+             " (bootstrap 95 % interval; * separated at 5 % " +
+             (d.comparisons > 1
+                  ? "after Holm's correction for " + std::to_string(d.comparisons) + " comparisons"
+                  : std::string("(one comparison)")) +
+             ")\n";
       header = true;
     }
-    std::snprintf(line, sizeof line, "%-28s %+8.1f  [%+.1f, %+.1f]%s\n", d.variant.c_str(), d.diff,
-                  d.ci_low, d.ci_high, (d.ci_low > 0.0 || d.ci_high < 0.0) ? "  *" : "");
-    out += line;
+    out += difference_line(d);
   }
   return out;
 }
@@ -307,7 +335,7 @@ thead th { border-bottom: 2px solid #999; }
 std::string to_json(const BatchReport& r, const std::vector<RunValues>& runs) {
   Json j;
   j["format"] = "llsfsim-report";
-  j["format_version"] = 1;
+  j["format_version"] = 2;
   j["llsfsim_version"] = std::string(llsfsim_version());
   // The batch's identity and metadata; its created/finished times (wall clock) stay out.
   Json batch;
@@ -345,12 +373,25 @@ std::string to_json(const BatchReport& r, const std::vector<RunValues>& runs) {
 
   Json differences = Json::array();
   for (const Difference& d : r.differences) {
+    const Comparison& c = d.comparison;
+    auto optional_number = [](const auto& v) { return v ? number(*v) : Json(nullptr); };
     differences.push_back(Json{{"variant", d.variant},
                                {"baseline", d.baseline},
                                {"statistic", d.statistic},
                                {"diff", number(d.diff)},
                                {"ci_low", number(d.ci_low)},
-                               {"ci_high", number(d.ci_high)}});
+                               {"ci_high", number(d.ci_high)},
+                               {"method", to_string(c.pairing)},
+                               {"pairs", c.pairs},
+                               {"n_variant", c.n_a},
+                               {"n_baseline", c.n_b},
+                               {"unmatched", c.unmatched},
+                               {"p_value", number(c.p_value)},
+                               {"comparisons", d.comparisons},
+                               {"enough_games", c.enough},
+                               {"separated", d.separated},
+                               {"detectable", optional_number(c.detectable)},
+                               {"games_needed", c.games_needed ? Json(*c.games_needed) : Json()}});
   }
   j["differences"] = std::move(differences);
 

@@ -366,7 +366,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   LockHolds lock_holds;
   FailureStreaks streaks;
   int role_changes = 0;
-  double first_role_change_s = -1.0;
+  std::optional<double> first_role_change_game_s;
   int skill_failures = 0;
   std::vector<RunIssue> issues;
   int issues_dropped = 0;
@@ -399,13 +399,13 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
     const std::string name(game.robot(i).name());
     // The agent's decisions (info and above) go into the recording; the team agent's role
     // changes are counted.
-    clips::LogSink log = [&recorder, &role_changes, &first_role_change_s,
+    clips::LogSink log = [&recorder, &role_changes, &first_role_change_game_s,
                           &add_issue](const clips::LogRecord& rec) {
       if (rec.level == clips::LogLevel::kDebug) return;
       if (recorder) recorder->agent(rec);
       if (std::optional<RunIssue> issue = issue_of(rec)) add_issue(std::move(*issue));
       if (rec.text.find("production: role change") != std::string_view::npos) {
-        if (role_changes++ == 0) first_role_change_s = rec.time.seconds();
+        if (role_changes++ == 0) first_role_change_game_s = rec.time.seconds();
       }
     };
     auto locks = [&recorder, &lock_waits, &lock_holds, &game, i, name](const clips::LockEvent& e) {
@@ -545,7 +545,8 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   storage.lo -= core::Vec2(0.1, 0.1);
   storage.hi += core::Vec2(0.1, 0.1);
   int storage_min = pucks_in(game, storage);
-  double storage_empty_s = storage_min == 0 ? 0.0 : -1.0;
+  std::optional<double> storage_empty_game_s;
+  if (storage_min == 0) storage_empty_game_s = 0.0;
   core::SimTime next_storage_sample = core::SimTime::from_sec(1);
   core::SimTime next_reload_check = core::SimTime::from_sec(1);
   driver.run_until(end, [&](const sim::Game&) {
@@ -565,7 +566,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
       next_storage_sample += core::SimTime::from_sec(1);
       const int n = pucks_in(game, storage);
       storage_min = std::min(storage_min, n);
-      if (n == 0 && storage_empty_s < 0.0) storage_empty_s = game.time().seconds();
+      if (n == 0 && !storage_empty_game_s) storage_empty_game_s = game.time().seconds();
     }
     if (recorder) {
       if (hooks.profile) {
@@ -636,8 +637,8 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
         if (type == refbox::MachineType::kT3) ++r.products_p1;
         if (type == refbox::MachineType::kT4) ++r.products_p2;
         if ((type == refbox::MachineType::kT3 || type == refbox::MachineType::kT4) &&
-            r.first_complex_s < 0.0) {
-          r.first_complex_s = a.game_time.seconds();
+            !r.first_complex_production_s) {
+          r.first_complex_production_s = a.game_time.seconds();
         }
         if (type == refbox::MachineType::kT5) ++r.products_p3;
         break;
@@ -681,9 +682,9 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   r.issues = std::move(issues);
   r.issues_dropped = issues_dropped;
   r.role_changes = role_changes;
-  r.first_role_change_s = first_role_change_s;
+  r.first_role_change_game_s = first_role_change_game_s;
   r.storage_min = storage_min;
-  r.storage_empty_s = storage_empty_s;
+  r.storage_empty_game_s = storage_empty_game_s;
   for (int i = 0; i < game.robot_count(); ++i) {
     r.jams += game.robot(i).jams();
     if (game.robot(i).jammed()) ++r.jammed_at_end;
@@ -737,6 +738,10 @@ std::string to_json(const RunResult& r) {
   using Json = nlohmann::ordered_json;  // keys in the order documented (docs/llsfsim.md)
   // JSON has no NaN or infinity: null instead.
   auto number = [](double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); };
+  // Absent (it did not happen) is null, like a number that is not finite.
+  auto optional_number = [&number](const std::optional<double>& v) {
+    return v ? number(*v) : Json(nullptr);
+  };
   Json orders = Json::array();
   for (const OrderResult& x : r.orders) {
     orders.push_back({{"id", x.id},
@@ -776,11 +781,11 @@ std::string to_json(const RunResult& r) {
               {"wait_s", number(r.lock_wait_s)},
               {"wait_max_s", number(r.lock_wait_max_s)},
               {"hold_max_s", number(r.lock_hold_max_s)}}},
-            {"first_complex_s", number(r.first_complex_s)},
+            {"first_complex_production_s", optional_number(r.first_complex_production_s)},
             {"role_changes", r.role_changes},
-            {"first_role_change_s", number(r.first_role_change_s)},
+            {"first_role_change_game_s", optional_number(r.first_role_change_game_s)},
             {"storage_min", r.storage_min},
-            {"storage_empty_s", number(r.storage_empty_s)},
+            {"storage_empty_game_s", optional_number(r.storage_empty_game_s)},
             {"jams", r.jams},
             {"jammed_at_end", r.jammed_at_end},
             {"skill_failure_streak_max", r.skill_failure_streak_max},

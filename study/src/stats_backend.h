@@ -18,8 +18,9 @@
 namespace llsf::study {
 
 /// The schema version both backends create and migrate to (docs/statistics.md, "Schema").
-/// 1: the tables; 2: runs.recording; 3: the schema_migrations table.
-inline constexpr int kSchemaVersion = 3;
+/// 1: the tables; 2: runs.recording; 3: the schema_migrations table; 4: absent values instead of
+/// -1 placeholders, the time statistics named by their base, the "never happened" shares.
+inline constexpr int kSchemaVersion = 4;
 
 /// The schema's tables (count_rows() accepts these names only).
 inline constexpr std::array<std::string_view, 8> kStoreTables = {
@@ -31,11 +32,31 @@ struct Migration {
   const char* description;
 };
 /// The descriptions of versions 1..kSchemaVersion (the SQL is each backend's dialect).
-inline constexpr std::array<Migration, 3> kMigrations = {{
+inline constexpr std::array<Migration, 4> kMigrations = {{
     {1, "batches, runs, statistics, orders, tests, awards, events"},
     {2, "runs.recording"},
     {3, "schema_migrations"},
+    {4,
+     "absent values instead of -1; first_complex_production_s, first_role_change_game_s, "
+     "storage_empty_game_s; complex_made, storage_ran_empty"},
 }};
+
+/// Migration 4, the same SQL in both dialects: the "never happened" shares from the old -1
+/// placeholders, then the placeholders deleted (absent is no row) and the time statistics
+/// renamed to name their base (production time, game time).
+inline constexpr const char* kMissingIsMissingSql = R"sql(
+INSERT INTO statistics (run_id, name, value)
+  SELECT run_id, 'complex_made', CASE WHEN value >= 0 THEN 1.0 ELSE 0.0 END
+  FROM statistics WHERE name = 'first_complex_s';
+INSERT INTO statistics (run_id, name, value)
+  SELECT run_id, 'storage_ran_empty', CASE WHEN value >= 0 THEN 1.0 ELSE 0.0 END
+  FROM statistics WHERE name = 'storage_empty_s';
+DELETE FROM statistics
+  WHERE name IN ('first_complex_s', 'first_role_change_s', 'storage_empty_s') AND value < 0;
+UPDATE statistics SET name = 'first_complex_production_s' WHERE name = 'first_complex_s';
+UPDATE statistics SET name = 'first_role_change_game_s' WHERE name = 'first_role_change_s';
+UPDATE statistics SET name = 'storage_empty_game_s' WHERE name = 'storage_empty_s';
+)sql";
 
 /// One row of `events`.
 struct RunEvent {

@@ -121,6 +121,7 @@ CREATE TABLE schema_migrations (
   applied     TEXT
 );
 )sql",
+    kMissingIsMissingSql,
 };
 
 // The advisory lock that serialises migrations of one database ("llsf" in ASCII).

@@ -111,6 +111,7 @@ CREATE TABLE schema_migrations (
   applied     TEXT
 );
 )sql",
+    kMissingIsMissingSql,
 };
 
 // ---- RAII wrappers of the SQLite C API -------------------------------------------------------

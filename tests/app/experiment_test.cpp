@@ -51,8 +51,9 @@ void write_scenario(const TempDir& dir, const std::string& seeds = "[1, 2, 3]") 
                 "    P1P2: {robots.config.roles: [P1P2]}\n");
 }
 
-/// exp.yaml: a target that is met (every game lasts 60 s), a finding that is reproduced (equal
-/// game times) and one that is not (60 s is not longer than 60 s), a sweep.
+/// exp.yaml: a target (every game lasts 60 s), a finding that would be reproduced (equal game
+/// times) and one that would not (60 s is not longer than 60 s): with three seeds a variant, too
+/// few games for any verdict (docs/statistics.md), so the report prints the numbers only.
 void write_experiment(const TempDir& dir) {
   dir.write("exp.yaml",
             "name: tiny-exp\n"
@@ -72,7 +73,7 @@ void write_experiment(const TempDir& dir) {
             "      - difference_in: {batch: tiny, statistic: game_time_s, a: {config: P3},\n"
             "                        b: {config: P1P2}, range: [-0.01, 0.01]}\n"
             "      - not_greater: {batch: tiny, statistic: game_time_s, a: {config: P3},\n"
-            "                      b: {config: P1P2}}\n"
+            "                      b: {config: P1P2}, margin: 1, margin_reason: one second}\n"
             "  - id: F2\n"
             "    claim: P3 plays longer than P1P2\n"
             "    checks:\n"
@@ -102,9 +103,17 @@ TEST_CASE("llsfsim experiment plays its batches, evaluates, resumes and reports 
   CHECK(has(r.out, "batch      tiny (" + dir.file("tiny.yaml") + ") #1 in " + db +
                        ": 6 runs, 6 played, 0 stored before"));
   CHECK(has(r.out, "experiment tiny-exp (" + exp + ")"));
-  CHECK(has(r.out, "  met      Game length\n"));
-  CHECK(has(r.out, "  F1  P3 and P1P2 play equally long\n    all: reproduced\n"));
-  CHECK(has(r.out, "  F2  P3 plays longer than P1P2\n    all: not reproduced (check 1 failed)"));
+  CHECK(has(r.out, "  too few games Game length\n"));
+  CHECK(has(r.out,
+            "  F1  P3 and P1P2 play equally long\n"
+            "    all: no verdict: too few games (at least 10 a side)\n"));
+  CHECK(has(r.out,
+            "  F2  P3 plays longer than P1P2\n"
+            "    all: no verdict: too few games (at least 10 a side)\n"));
+  CHECK(has(r.out,
+            "difference 0, 95 % CI [0, 0], paired by seed (3 pairs); n 3 vs 3; too few "
+            "games for a verdict (3, needs 10)"));
+  CHECK(!has(r.out, "reproduced"));
   CHECK(has(r.out, "6 of 6 runs"));
   CHECK(!fs::exists(dir.file("exp-recordings")));
   const std::string md = slurp(dir.file("one.md"));
@@ -113,8 +122,10 @@ TEST_CASE("llsfsim experiment plays its batches, evaluates, resumes and reports 
   CHECK(has(md, "| tiny | `tiny.yaml` | 2 | 3 | 6 of 6 runs |"));
   CHECK(has(md,
             "| Game length | the scenario | all | game_time_s: mean in [59.5, 60.5] | mean "
-            "60.0, 95 % CI [60.0, 60.0]; n 6 | **met** |"));
-  CHECK(has(md, "| F2 | P3 plays longer than P1P2 | not reproduced (check 1 failed) |"));
+            "60.0, 95 % CI [60.0, 60.0]; n 6; too few games for a verdict (6, needs 10) | **too "
+            "few games** |"));
+  CHECK(has(md,
+            "| F2 | P3 plays longer than P1P2 | no verdict: too few games (at least 10 a side) |"));
   {
     const llsf::study::StatsStore store(db);
     CHECK(store.count_rows("runs") == 6);

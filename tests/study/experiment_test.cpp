@@ -167,12 +167,19 @@ struct StudyFixture {
                   std::string(group_by ? "group_by: profile\n" : "") + body);
     return dir.file("exp.yaml");
   }
-  /// Loads exp.yaml with `body` and evaluates it against the store.
-  ExperimentResult evaluate_body(const std::string& body, Experiment& keep,
-                                 bool group_by = true) const {
+  /// Loads exp.yaml with `body` and evaluates it against the store. The fixture's batches hold
+  /// 3 and 4 seeds: the checks' mechanics are tested with a minimum of 2 games a side (the
+  /// minimum itself has tests of its own).
+  ExperimentResult evaluate_body(const std::string& body, Experiment& keep, bool group_by = true,
+                                 EvaluateOptions o = few_games()) const {
     keep = load_experiment(experiment(body, group_by));
     const StatsStore store(db);
-    return evaluate(keep, store);
+    return evaluate(keep, store, o);
+  }
+  static EvaluateOptions few_games() {
+    EvaluateOptions o;
+    o.min_games = 2;
+    return o;
   }
 };
 
@@ -354,7 +361,8 @@ TEST_CASE("experiment checks: greater, not_greater and difference_in per group")
       "  - id: F2\n"
       "    claim: B is not better than A\n"
       "    checks:\n"
-      "      - not_greater: {batch: conf, statistic: points, a: {config: B}, b: {config: A}}\n"
+      "      - not_greater: {batch: conf, statistic: points, a: {config: B}, b: {config: A},\n"
+      "                      margin: 10, margin_reason: a test}\n"
       "      - difference_in: {batch: conf, statistic: points, a: {config: A}, b: {config: B},\n"
       "                        range: [45, 55]}\n",
       e);
@@ -503,7 +511,7 @@ TEST_CASE("experiment: an incomplete or missing batch is evaluated with what is 
       "      - mean_in: {batch: sweep, statistic: points, range: [0, 1000]}\n"
       "sweeps:\n  - {name: S, batch: sweep, axis: speed, compare: config, statistic: points}\n"));
   const StatsStore store(db);
-  const ExperimentResult r = evaluate(e, store);
+  const ExperimentResult r = evaluate(e, store, StudyFixture::few_games());
   REQUIRE(r.batches.size() == 2);
   CHECK(r.batches[0].stored == 8);
   CHECK(r.batches[0].expected == 16);
@@ -553,7 +561,9 @@ TEST_CASE("experiment sweeps: rankings per row, flips against the baseline, top 
   CHECK(s.rows[0].means[0] == doctest::Approx(200.0));
   CHECK(s.rows[0].n[0].used == 3);
   CHECK(s.rows[1].ranking == "A > B > C");
-  CHECK(!s.rows[1].separated);  // 101 vs 100 with a spread of +-10
+  // 101 vs 100 with a spread of +-10 by seed, but +1 on every seed: paired by seed, separated.
+  CHECK(s.rows[1].separated);
+  CHECK(s.rows[1].top->pairing == Pairing::kPaired);
   CHECK(s.rows[2].ranking == "B > A > C");
   CHECK(s.rows[2].differs);
   CHECK(s.rows[2].top_diff == doctest::Approx(80.0));
@@ -563,8 +573,8 @@ TEST_CASE("experiment sweeps: rankings per row, flips against the baseline, top 
             "|---|---:|---:|---:|---|---|---|\n"
             "| slow | 200.0 (n 3) | 150.0 (n 3) | 20.0 (n 3) | A > B > C | same | separated: "));
   CHECK(has(md,
-            "| mid | 101.0 (n 3) | 100.0 (n 3) | 20.0 (n 3) | A > B > C | baseline | not "
-            "separated: "));
+            "| mid | 101.0 (n 3) | 100.0 (n 3) | 20.0 (n 3) | A > B > C | baseline | separated: "
+            "+1.00 [+1.00, +1.00] |"));
   CHECK(has(md, "| fast | 100.0 (n 3) | 180.0 (n 3) | 20.0 (n 3) | B > A > C | **differs** |"));
 }
 
@@ -598,7 +608,7 @@ TEST_CASE("experiment tables: means per row and group, left-out values counted")
   CHECK(has(md, "#### Why (ideal)\n\nSource: the mechanisms\n\n"));
   CHECK(has(md,
             "| config | runs | points | lock_wait_max_s |\n|---|---:|---:|---:|\n"
-            "| B | 4 | 52.5 | - |\n| A | 4 | 102.5 | 620.0 (n 3) |\n"));
+            "| B | 4 | 52.5 | - |\n| A | 4 | 102.5 | 620.0 (n 3 of 4) |\n"));
   const std::string text = to_text(r);
   CHECK(has(text,
             "  Why [real]: Mean per run by `config` of batch `conf`, values below 0 left out.\n"));
@@ -624,7 +634,7 @@ TEST_CASE("experiment reports are deterministic and seeded per check") {
       "      - greater: {batch: conf, statistic: lock_wait_s, a: {config: B}, b: {config: A}}\n",
       e6, false);
   const StatsStore store(f.db);
-  EvaluateOptions o;
+  EvaluateOptions o = StudyFixture::few_games();
   o.seed = 2;
   const ExperimentResult r3 = evaluate(e6, store, o);
   const CheckResult& c6 = r6.findings[0].groups[0].checks[0];
@@ -679,4 +689,140 @@ TEST_CASE("replace_between_markers keeps everything outside the markers byte for
   CHECK_THROWS_AS(
       replace_between_markers("see <!-- experiment tiny begin --> here\n" + after, "tiny", ""),
       std::invalid_argument);
+}
+
+TEST_CASE("experiment: no better, no worse and same need a margin and its reason") {
+  const StudyFixture f;
+  const std::string file = f.dir.file("exp.yaml");
+  struct Case {
+    const char* check;
+    const char* what;
+  };
+  const std::vector<Case> cases{
+      {"not_greater: {batch: conf, statistic: points, a: {config: A}, b: {config: B}}",
+       "missing key 'margin' (the difference, in the statistic's unit, that still counts"},
+      {"equivalent: {batch: conf, statistic: points, a: {config: A}, b: {config: B}, margin: 0, "
+       "margin_reason: r}",
+       "margin: must be a number above 0"},
+      {"not_less: {batch: conf, statistic: points, a: {config: A}, b: {config: B}, margin: 5}",
+       "missing key 'margin_reason' (why this margin"},
+      {"not_less: {batch: conf, statistic: points, a: {config: A}, b: {config: B}, margin: 5, "
+       "margin_reason: ''}",
+       "margin_reason: must not be empty"},
+      {"greater: {batch: conf, statistic: points, a: {config: A}, b: {config: B}, margin: 5}",
+       "unknown key 'margin'"},
+  };
+  for (const Case& c : cases) {
+    const std::string e =
+        load_error(f, std::string("findings:\n  - id: F\n    claim: c\n    checks:\n      - ") +
+                          c.check + "\n");
+    INFO(c.check, " -> ", e);
+    CHECK(has(e, file + ":"));
+    CHECK(has(e, c.what));
+  }
+}
+
+TEST_CASE("experiment: equivalence within a margin, both one-sided forms, paired by seed") {
+  const StudyFixture f;
+  Experiment e;
+  // real: A - B per seed -3, -1, +1, +3 (mean 0); ideal: A - B = +50 on every seed.
+  const ExperimentResult r = f.evaluate_body(
+      "findings:\n"
+      "  - id: S\n"
+      "    claim: A and B score the same\n"
+      "    checks:\n"
+      "      - equivalent: {batch: conf, statistic: points, a: {config: A}, b: {config: B},\n"
+      "                     margin: 10, margin_reason: one delivery}\n"
+      "      - equivalent: {batch: conf, statistic: points, a: {config: A}, b: {config: B},\n"
+      "                     margin: 1, margin_reason: too strict}\n"
+      "      - not_less: {batch: conf, statistic: points, a: {config: A}, b: {config: B},\n"
+      "                   margin: 10, margin_reason: one delivery}\n"
+      "      - not_greater: {batch: conf, statistic: points, a: {config: A}, b: {config: B},\n"
+      "                      margin: 10, margin_reason: one delivery}\n",
+      e);
+  const FindingGroupResult& real = group(r.findings[0], "real");
+  REQUIRE(real.checks.size() == 4);
+  CHECK(real.checks[0].holds());
+  CHECK(!real.checks[1].holds());
+  CHECK(real.checks[2].holds());
+  CHECK(real.checks[3].holds());
+  REQUIRE(real.checks[0].comparison);
+  CHECK(real.checks[0].comparison->pairing == Pairing::kPaired);
+  CHECK(real.checks[0].comparison->pairs == 4);
+  CHECK(real.checks[0].ci_low == real.checks[0].comparison->ci_tost.low);  // the 90 % interval
+  CHECK(has(real.checks[0].description,
+            "points: config=A = config=B within ±10 (margin: one delivery)"));
+  CHECK(has(real.checks[0].measured, "difference 0, 90 % CI ["));
+  CHECK(has(real.checks[0].measured, "paired by seed (4 pairs)"));
+  CHECK(has(real.checks[0].measured, "smallest detectable "));
+  CHECK(real.failed == std::vector<int>{2});
+  const FindingGroupResult& ideal = group(r.findings[0], "ideal");
+  CHECK(!ideal.checks[0].holds());  // +50 is not within 10
+  CHECK(ideal.checks[2].holds());   // A is not worse than B
+  CHECK(!ideal.checks[3].holds());  // but it is better
+  CHECK(ideal.failed == std::vector<int>{1, 2, 4});
+}
+
+TEST_CASE("experiment: a comparison pools an axis pairwise: the key is the seed and the axis") {
+  const StudyFixture f;
+  Experiment e;
+  // Without group_by: A against B over both profiles, each seed once per profile.
+  const ExperimentResult r = f.evaluate_body(
+      "findings:\n  - id: F\n    claim: c\n    checks:\n"
+      "      - greater: {batch: conf, statistic: points, a: {config: A}, b: {config: B}}\n",
+      e, false);
+  const CheckResult& c = r.findings[0].groups[0].checks[0];
+  REQUIRE(c.comparison);
+  CHECK(c.comparison->pairing == Pairing::kPaired);
+  CHECK(c.comparison->pairs == 8);
+  CHECK(c.comparison->unmatched == 0);
+}
+
+TEST_CASE("experiment: too few games give the numbers and no verdict") {
+  const StudyFixture f;
+  Experiment e;
+  // The default minimum (10 a side) against the fixture's 4 seeds: A clearly beats B in ideal,
+  // yet no verdict; the calibration target and the sweep likewise.
+  const ExperimentResult r = f.evaluate_body(
+      "calibration:\n"
+      "  - {name: Pace, batch: conf, where: {config: A}, groups: [ideal], statistic: points,\n"
+      "     mean_in: [0, 1000]}\n"
+      "findings:\n  - id: F1\n    claim: A beats B\n    checks:\n"
+      "      - greater: {batch: conf, statistic: points, a: {config: A}, b: {config: B}}\n"
+      "sweeps:\n  - {name: Speed, batch: sweep, axis: speed, compare: config, "
+      "statistic: points}\n",
+      e, true, EvaluateOptions{});
+  const FindingGroupResult& ideal = group(r.findings[0], "ideal");
+  CHECK(ideal.checks[0].outcome == CheckResult::Outcome::kTooFew);
+  CHECK(ideal.verdict == Verdict::kTooFew);
+  CHECK(ideal.checks[0].value == doctest::Approx(50.0));
+  CHECK(has(ideal.checks[0].measured, "difference +50.0, 95 % CI [+50.0, +50.0]"));
+  CHECK(has(ideal.checks[0].measured, "too few games for a verdict (4, needs 10)"));
+  REQUIRE(r.calibration.size() == 1);
+  CHECK(r.calibration[0].verdict == Verdict::kTooFew);
+  CHECK(has(r.calibration[0].check.measured, "too few games for a verdict (4, needs 10)"));
+  for (const SweepRow& row : r.sweeps[0].rows) CHECK(!row.separated);
+  const std::string text = to_text(r);
+  CHECK(has(text, "ideal: no verdict: too few games (at least 10 a side)"));
+  CHECK(!has(text, "reproduced"));
+  CHECK(has(text, "too few games (3): "));
+  CHECK(has(to_markdown(r), "| **too few games** |"));
+}
+
+TEST_CASE("experiment sweeps: Holm's correction over the rows, named with the count") {
+  const StudyFixture f;
+  Experiment e;
+  const ExperimentResult r = f.evaluate_body(
+      "sweeps:\n  - {name: Speed, batch: sweep, axis: speed, compare: config, "
+      "statistic: points}\n",
+      e);
+  const SweepResult& s = r.sweeps[0];
+  CHECK(s.comparisons == 3);
+  REQUIRE(s.rows[1].top);
+  CHECK(s.rows[1].top->pairing == Pairing::kPaired);
+  // mid: A 101 against B 100 on every seed: a constant +1, every resample above 0: p = 0,
+  // below Holm's first bound 5 % / 3.
+  CHECK(s.rows[1].top->p_value == 0.0);
+  CHECK(s.rows[1].separated);
+  CHECK(has(to_text(r), "top two paired by seed, Holm's correction over 3 comparisons"));
 }

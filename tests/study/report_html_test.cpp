@@ -70,7 +70,7 @@ TEST_CASE("to_json holds the batch, the summaries, the differences and every run
   const json j = json::parse(text);  // throws on invalid JSON (NaN, inf, ...)
 
   CHECK(j["format"] == "llsfsim-report");
-  CHECK(j["format_version"] == 1);
+  CHECK(j["format_version"] == 2);
   CHECK(j["llsfsim_version"] == std::string(llsfsim_version()));
   CHECK(j["batch"]["id"] == id);
   CHECK(j["batch"]["scenario_name"] == "x");

@@ -36,7 +36,7 @@ TEST_CASE("to_json(RunResult): valid JSON for odd names, NaN as null, one line, 
   r.points = 42;
   r.orders.push_back({3, "P2", 2, 1, 120, 300});
   r.cpu_s = std::numeric_limits<double>::quiet_NaN();
-  r.first_complex_s = -1.0;
+  r.first_role_change_game_s = 750.0;  // first_complex_production_s absent
   r.result_hash = 0x00ab'cdef'0123'4567ull;
   r.tests.push_back({"points \"by\" 720 s", false, "12 points\t(need >= 30)\\", 720.0});
   const std::string text = to_json(r);
@@ -50,7 +50,8 @@ TEST_CASE("to_json(RunResult): valid JSON for odd names, NaN as null, one line, 
   CHECK(j["points"] == 42);
   CHECK(j["orders"][0]["window"] == Json{120, 300});
   CHECK(j["cpu_s"].is_null());
-  CHECK(j["first_complex_s"] == -1.0);
+  CHECK(j["first_complex_production_s"].is_null());  // absent: null, not -1
+  CHECK(j["first_role_change_game_s"] == 750.0);
   CHECK(j["result_hash"] == "00abcdef01234567");  // fixed width, as the text summary
   CHECK(j["passed"] == false);
   CHECK(j["tests"][0]["name"] == "points \"by\" 720 s");

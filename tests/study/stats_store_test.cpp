@@ -10,10 +10,12 @@
 #include <stdlib.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 #include <string>
 #include <thread>
@@ -85,19 +87,29 @@ std::int64_t rows_of_one_run() {
 }
 
 // The backends the suite runs on: each makes fresh stores (`fresh()` returns what --db takes).
+// The database name at the end of a test cluster's URL.
+std::string db_name(const std::string& url) { return url.substr(url.rfind('/') + 1); }
+
 struct SqliteBackend {
   static constexpr bool kPostgres = false;
   TempDir dir;
   int n = 0;
   std::string fresh() { return dir.file("stats" + std::to_string(++n) + ".db"); }
+  /// Runs SQL on the store `db` behind llsfsim's back (to make an older store).
+  static void sql(const std::string& db, const std::string& statements) {
+    sqlite3* h = nullptr;
+    REQUIRE(sqlite3_open(db.c_str(), &h) == SQLITE_OK);
+    CHECK(sqlite3_exec(h, statements.c_str(), nullptr, nullptr, nullptr) == SQLITE_OK);
+    sqlite3_close(h);
+  }
 };
 struct PostgresBackend {
   static constexpr bool kPostgres = true;
   std::string fresh() { return PgCluster::shared().create_database(); }
+  static void sql(const std::string& db, const std::string& statements) {
+    PgCluster::shared().psql(db_name(db), statements);
+  }
 };
-
-// The database name at the end of a test cluster's URL.
-std::string db_name(const std::string& url) { return url.substr(url.rfind('/') + 1); }
 
 // Sets (or unsets, for nullptr) an environment variable for one scope.
 struct EnvVar {
@@ -138,14 +150,14 @@ TEST_CASE_TEMPLATE("StatsStore creates its schema once and reopens the store", B
     for (const char* t : {"batches", "runs", "statistics", "orders", "tests", "awards", "events"}) {
       CHECK(store.count_rows(t) == 0);
     }
-    CHECK(store.count_rows("schema_migrations") == 3);  // versions 1, 2, 3
+    CHECK(store.count_rows("schema_migrations") == 4);  // versions 1, 2, 3, 4
     CHECK_THROWS_AS(store.count_rows("sqlite_schema"), StatsError);
     CHECK_THROWS_AS(store.count_rows("runs; DROP TABLE runs"), StatsError);
     store.add_run(store.open_batch(sample_key()), sample_run("a", 1));
   }
   StatsStore again(db);  // the schema is there: nothing recreated, nothing lost
   CHECK(again.count_rows("runs") == 1);
-  CHECK(again.count_rows("schema_migrations") == 3);
+  CHECK(again.count_rows("schema_migrations") == 4);
   if constexpr (!B::kPostgres) CHECK(fs::exists(db));
 }
 
@@ -206,7 +218,14 @@ TEST_CASE_TEMPLATE("StatsStore writes a run and reads it back", B, BACKENDS) {
   CHECK(stat("order_units_requested") == 3.0);
   CHECK(stat("passed") == 1.0);
   CHECK(stat("real_time_factor") == 1.0 / 3.0);
-  CHECK(stat("first_complex_s") == -1.0);
+  // Absent is no row: sample_run() made no complex product and the storage never ran empty.
+  for (const char* absent :
+       {"first_complex_production_s", "first_role_change_game_s", "storage_empty_game_s"}) {
+    CHECK(
+        std::none_of(stats.begin(), stats.end(), [&](const auto& s) { return s.first == absent; }));
+  }
+  CHECK(stat("complex_made") == 0.0);
+  CHECK(stat("storage_ran_empty") == 0.0);
 
   const auto awards = store.awards(id);
   REQUIRE(awards.size() == 3);
@@ -448,6 +467,50 @@ TEST_CASE("StatsStore (SQLite) refuses files that are not a statistics store") {
                        doctest::Contains("not an llsfsim statistics store"), StatsError);
 }
 
+TEST_CASE_TEMPLATE("StatsStore migrates -1 placeholders to absent values and shares", B, BACKENDS) {
+  B backend;
+  const std::string db = backend.fresh();
+  {
+    StatsStore store(db);
+    const std::int64_t batch = store.open_batch(sample_key());
+    store.add_run(batch, sample_run("a", 1));
+    store.add_run(batch, sample_run("b", 2));
+  }
+  // Back to version 3 as an llsfsim before issue #33 wrote it: the time statistics under their
+  // old names, -1 for "never", no shares.
+  B::sql(db,
+         "DELETE FROM schema_migrations WHERE version = 4;"
+         "DELETE FROM statistics WHERE name IN ('complex_made', 'storage_ran_empty');"
+         "INSERT INTO statistics (run_id, name, value) VALUES (1, 'first_complex_s', -1),"
+         " (1, 'first_role_change_s', 750), (1, 'storage_empty_s', -1),"
+         " (2, 'first_complex_s', 412.5), (2, 'first_role_change_s', -1),"
+         " (2, 'storage_empty_s', 900);" +
+             std::string(B::kPostgres ? "" : "PRAGMA user_version = 3;"));
+  const StatsStore store(db);
+  CHECK(store.count_rows("schema_migrations") == 4);
+  auto stats = [&](std::int64_t run) {
+    std::map<std::string, double> out;
+    for (const auto& [name, value] : store.statistics(run)) out[name] = value;
+    return out;
+  };
+  const std::map<std::string, double> one = stats(1), two = stats(2);
+  for (const char* old : {"first_complex_s", "first_role_change_s", "storage_empty_s"}) {
+    CHECK(one.count(old) == 0);
+    CHECK(two.count(old) == 0);
+  }
+  CHECK(one.count("first_complex_production_s") == 0);  // -1: absent
+  CHECK(one.at("complex_made") == 0.0);
+  CHECK(one.at("first_role_change_game_s") == 750.0);
+  CHECK(one.count("storage_empty_game_s") == 0);
+  CHECK(one.at("storage_ran_empty") == 0.0);
+  CHECK(two.at("first_complex_production_s") == 412.5);
+  CHECK(two.at("complex_made") == 1.0);
+  CHECK(two.count("first_role_change_game_s") == 0);
+  CHECK(two.at("storage_empty_game_s") == 900.0);
+  CHECK(two.at("storage_ran_empty") == 1.0);
+  CHECK(one.at("points") == 28.0);  // the rest untouched
+}
+
 namespace {
 // The schema of llsfsim's stores before schema_migrations (version 2, `PRAGMA user_version`),
 // as that llsfsim created it.
@@ -581,7 +644,7 @@ TEST_CASE("StatsStore (SQLite) opens and migrates the files of older llsfsim") {
       REQUIRE(store.runs(batch).size() == 1);
       CHECK(store.runs(batch)[0].points == 28);
       CHECK(store.runs(batch)[0].recording.empty());
-      CHECK(store.count_rows("schema_migrations") == 3);
+      CHECK(store.count_rows("schema_migrations") == 4);
       // The stored run again: nothing written; a new run with a recording.
       CHECK(store.add_run(batch, sample_run("a", 1)) == 1);
       RunResult again = sample_run("b", 2);
@@ -589,8 +652,8 @@ TEST_CASE("StatsStore (SQLite) opens and migrates the files of older llsfsim") {
       store.add_run(batch, again);
       CHECK(store.runs(batch).back().recording == again.recording);
     }
-    CHECK(sqlite_int(db, "PRAGMA user_version") == 3);
-    CHECK(sqlite_int(db, "SELECT max(version) FROM schema_migrations") == 3);
+    CHECK(sqlite_int(db, "PRAGMA user_version") == 4);
+    CHECK(sqlite_int(db, "SELECT max(version) FROM schema_migrations") == 4);
     // Versions applied now carry the time; older ones (applied before the table) do not.
     CHECK(sqlite_int(db, "SELECT count(*) FROM schema_migrations WHERE applied IS NULL") ==
           version);
@@ -605,10 +668,10 @@ TEST_CASE("StatsStore (SQLite) refuses a store of a newer schema") {
   { StatsStore store(db); }
   sqlite3* h = nullptr;
   REQUIRE(sqlite3_open(db.c_str(), &h) == SQLITE_OK);
-  CHECK(sqlite3_exec(h, "INSERT INTO schema_migrations VALUES (4, 'future', NULL)", nullptr,
+  CHECK(sqlite3_exec(h, "INSERT INTO schema_migrations VALUES (5, 'future', NULL)", nullptr,
                      nullptr, nullptr) == SQLITE_OK);
   sqlite3_close(h);
-  CHECK_THROWS_WITH_AS(StatsStore{db}, doctest::Contains("schema version 4"), StatsError);
+  CHECK_THROWS_WITH_AS(StatsStore{db}, doctest::Contains("schema version 5"), StatsError);
 }
 
 // ---- PostgreSQL ------------------------------------------------------------------------------
@@ -731,8 +794,8 @@ TEST_CASE("StatsStore (PostgreSQL): refuses databases that are not a store, or n
                        StatsError);
   const std::string newer = pg.create_database();
   { StatsStore store(newer); }
-  pg.psql(db_name(newer), "INSERT INTO schema_migrations VALUES (4, 'future', NULL)");
-  CHECK_THROWS_WITH_AS(StatsStore{newer}, doctest::Contains("schema version 4"), StatsError);
+  pg.psql(db_name(newer), "INSERT INTO schema_migrations VALUES (5, 'future', NULL)");
+  CHECK_THROWS_WITH_AS(StatsStore{newer}, doctest::Contains("schema version 5"), StatsError);
   // Other tables of the database do not matter (a lab's shared database).
   const std::string shared = pg.create_database();
   pg.psql(db_name(shared), "CREATE TABLE notes (t text)");
@@ -764,7 +827,7 @@ TEST_CASE("StatsStore (PostgreSQL): a new store created by two processes at once
     CHECK((WIFEXITED(status) && WEXITSTATUS(status) == 0));
   }
   const StatsStore store(url);
-  CHECK(store.count_rows("schema_migrations") == 3);
+  CHECK(store.count_rows("schema_migrations") == 4);
   REQUIRE(store.batches().size() == 1);
   CHECK(store.runs(store.batches()[0].id).size() == 2);
 }

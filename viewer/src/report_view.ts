@@ -7,7 +7,7 @@
 // mean.
 import * as Plot from "@observablehq/plot";
 
-// The data, as written by llsf::sim::to_json (format_version 1). Non-finite numbers are null.
+// The data, as written by llsf::sim::to_json (format_version 2). Non-finite numbers are null.
 interface Summary {
   n: number;
   mean: number | null;
@@ -33,6 +33,14 @@ interface DifferenceData {
   diff: number | null;
   ci_low: number | null;
   ci_high: number | null;
+  method: string;
+  pairs: number;
+  n_variant: number;
+  n_baseline: number;
+  comparisons: number;
+  enough_games: boolean;
+  separated: boolean;
+  games_needed: number | null;
 }
 
 interface RunData {
@@ -305,14 +313,19 @@ function differencesTable(data: ReportData, names: Naming): HTMLElement {
   const rows: Child[][] = [];
   for (const statistic of kDifferenceStatistics) {
     for (const d of data.differences.filter((x) => x.statistic === statistic)) {
-      const significant =
-        d.ci_low !== null && d.ci_high !== null && (d.ci_low > 0 || d.ci_high < 0);
+      // The star is the report's verdict: enough games, separated after Holm's correction.
+      const significant = d.separated;
       const cell = el(
         "span",
         significant ? {class: "significant"} : {},
         `[${signed(d.ci_low)}, ${signed(d.ci_high)}]${significant ? " *" : ""}`,
       );
-      rows.push([names.label(d.variant), statistic, signed(d.diff), cell]);
+      const games =
+        d.method === "paired by seed" ? `${d.pairs} pairs` : `${d.n_variant} vs ${d.n_baseline}`;
+      const note = d.enough_games
+        ? ""
+        : "too few games" + (d.games_needed !== null ? `; about ${d.games_needed} needed` : "");
+      rows.push([names.label(d.variant), statistic, signed(d.diff), cell, games, note]);
     }
   }
   const baseline = names.label(data.differences[0].baseline);
@@ -322,10 +335,12 @@ function differencesTable(data: ReportData, names: Naming): HTMLElement {
     el(
       "p",
       {class: "note"},
-      `Mean of the variant minus the mean of ${baseline} (the first variant), with a ` +
-        "percentile-bootstrap 95 % interval (2,000 resamples); * marks intervals that exclude 0.",
+      `Mean of the variant minus the mean of ${baseline} (the first variant), paired by seed ` +
+        "where both played the same seeds, with an expanded percentile-bootstrap 95 % interval " +
+        "(2,000 resamples); * marks differences separated at 5 % after Holm's correction over " +
+        "the variants, with at least 10 games (pairs) each.",
     ),
-    table([names.axis, "statistic", "difference", "95 % interval"], rows, {
+    table([names.axis, "statistic", "difference", "95 % interval", "games", "note"], rows, {
       "data-table": "differences",
     }),
   );

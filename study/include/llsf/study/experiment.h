@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "llsf/study/compare.h"
 #include "llsf/study/scenario.h"
 #include "llsf/study/stats_store.h"
 
@@ -50,7 +51,9 @@ struct Selection {
 struct Check {
   enum class Kind : std::uint8_t {
     kGreater,       ///< mean(a) - mean(b): the 95 % interval lies above 0
-    kNotGreater,    ///< mean(a) - mean(b): the 95 % interval reaches 0 or below
+    kNotGreater,    ///< mean(a) - mean(b): the 90 % interval lies below +margin
+    kNotLess,       ///< mean(a) - mean(b): the 90 % interval lies above -margin
+    kEquivalent,    ///< mean(a) - mean(b): the 90 % interval lies inside +-margin
     kDifferenceIn,  ///< mean(a) - mean(b) lies in [low, high]
     kMeanIn,        ///< mean(a) lies in [low, high]
     kMedianIn,      ///< median(a) lies in [low, high]
@@ -62,6 +65,9 @@ struct Check {
   AxisFilter a;  ///< the runs (comparisons: the first side)
   AxisFilter b;  ///< comparisons only: the second side
   double low = 0.0, high = 0.0;
+  /// not_greater, not_less, equivalent: the margin in the statistic's unit (> 0), and why.
+  double margin = 0.0;
+  std::string margin_reason;
   std::string where;  ///< "file:line:column: path" of the check (for errors)
 };
 
@@ -143,6 +149,8 @@ struct EvaluateOptions {
   /// The bootstrap's seed: every check draws from its own named stream of it, so the same store
   /// gives the same report, and adding a check changes no other check's interval.
   std::uint64_t seed = 1;
+  /// Fewest games a side (pairs, if paired) for a verdict; fewer give "too few games".
+  int min_games = kMinGamesForVerdict;
 };
 
 /// What the store holds of one batch.
@@ -168,14 +176,18 @@ struct SampleCounts {
 
 /// A check's numbers and whether it holds.
 struct CheckResult {
-  enum class Outcome : std::uint8_t { kHolds, kFails, kNoData };
+  /// kTooFew: fewer than kMinGamesForVerdict games (pairs) on a side: numbers, no verdict.
+  enum class Outcome : std::uint8_t { kHolds, kFails, kNoData, kTooFew };
   Outcome outcome = Outcome::kNoData;
   std::string description;  ///< "points: config=P3-P3 > config=P1P2-P3"
   /// The measured value: the difference, mean, median or share.
   double value = 0.0;
   /// Its 95 % interval: bootstrap (differences, means, medians) or Wilson (shares).
   double ci_low = 0.0, ci_high = 0.0;
-  SampleCounts a, b;     ///< b: comparisons only
+  SampleCounts a, b;  ///< b: comparisons only
+  /// Comparisons: the method (paired by seed or unpaired), the 90 % interval, p, the smallest
+  /// detectable difference and the games a difference of this size would need.
+  std::optional<Comparison> comparison;
   std::string measured;  ///< the numbers as one readable line
   bool holds() const { return outcome == Outcome::kHolds; }
 };
@@ -185,6 +197,7 @@ enum class Verdict : std::uint8_t {
   kHolds,   ///< "met" / "reproduced"
   kFails,   ///< "not met" / "not reproduced"
   kNoData,  ///< a check had no runs at all
+  kTooFew,  ///< no check failed, but one had too few games for a verdict
 };
 
 struct TargetResult {
@@ -215,9 +228,11 @@ struct SweepRow {
   std::vector<std::string> order;  ///< compare values with runs, best first
   bool comparable = false;         ///< this row and the baseline row both have a ranking
   bool differs = false;            ///< comparable, and the ranking differs from the baseline row's
-  bool separated = false;          ///< the top two's 95 % interval of the difference excludes 0
-  double top_diff = 0.0, top_low = 0.0, top_high = 0.0;  ///< mean(first) - mean(second)
+  /// The top two differ at 5 % after Holm's correction over the sweep's rows, with enough games.
+  bool separated = false;
+  double top_diff = 0.0, top_low = 0.0, top_high = 0.0;  ///< mean(first) - mean(second), 95 %
   bool has_top_two = false;
+  std::optional<Comparison> top;  ///< the comparison of the top two (paired by seed if shared)
 };
 
 struct SweepResult {
@@ -225,6 +240,7 @@ struct SweepResult {
   std::string group;
   std::vector<std::string> compare_values;
   std::vector<SweepRow> rows;
+  int comparisons = 0;  ///< rows with a top two: the family Holm's correction controls
 };
 
 /// One row of a table: one value of its axis.
@@ -244,7 +260,8 @@ struct TableResult {
 /// Everything an evaluation found; rendered by to_text() and to_markdown().
 struct ExperimentResult {
   const Experiment* experiment = nullptr;
-  std::string command;  ///< the command that reproduces it
+  std::string command;                  ///< the command that reproduces it
+  int min_games = kMinGamesForVerdict;  ///< EvaluateOptions::min_games
   std::vector<BatchState> batches;
   std::vector<TargetResult> calibration;
   std::vector<FindingResult> findings;

@@ -13,6 +13,7 @@
 
 #include "llsf/core/error.h"
 #include "llsf/core/rng.h"
+#include "llsf/study/compare.h"
 #include "llsf/study/stats_store.h"
 
 namespace llsf::study {
@@ -32,13 +33,19 @@ struct VariantReport {
   const StatSummary* find(const std::string& name) const;
 };
 
-/// mean(variant) - mean(baseline) of one statistic with a percentile-bootstrap 95 % interval.
+/// mean(variant) - mean(baseline) of one statistic (compare_means: paired by seed when both
+/// played the same seeds) with an expanded percentile-bootstrap 95 % interval.
 struct Difference {
   std::string variant;
   std::string baseline;
   std::string statistic;
   double diff = 0.0;
   double ci_low = 0.0, ci_high = 0.0;
+  Comparison comparison;  ///< the method, the counts, p, the smallest detectable difference
+  /// Holm's correction over this statistic's comparisons (each variant against the first):
+  /// separated at the 5 % family-wise level, and enough games for a verdict.
+  bool separated = false;
+  int comparisons = 0;  ///< the size of the Holm family
 };
 
 struct BatchReport {
@@ -48,10 +55,13 @@ struct BatchReport {
 };
 
 /// Builds the report of batch `batch_id` (StatsError if there is no such batch). The bootstrap
-/// (2,000 resamples) draws from a stream seeded with `seed`: the same store gives the same report.
+/// (2,000 resamples) of each difference draws from its own stream of `seed`, named after the
+/// variant and the statistic: the same store gives the same report.
+/// Runs are paired by their seed (docs/statistics.md, "Comparing variants").
 BatchReport make_report(const StatsStore& store, std::int64_t batch_id, std::uint64_t seed = 1);
 
-/// One line per (variant, statistic): variant,statistic,n,mean,median,q1,q3,min,max,pass_rate.
+/// One line per (variant, statistic): variant,statistic,n,mean,median,q1,q3,min,max,pass_rate,
+/// runs -- n of runs: a statistic a game may lack counts the games that have it.
 std::string to_csv(const BatchReport& r);
 /// A readable table: per variant the pass rate and points, then the differences.
 std::string to_text(const BatchReport& r);
@@ -90,29 +100,5 @@ std::string viewer_dir();
 /// `json` (to_json's output) in `<script id="llsf-report-data" type="application/json">`; the
 /// text report in a <noscript>. Throws ViewerBundleMissing if `dir`/report.js cannot be read.
 std::string to_html(const BatchReport& r, const std::string& json, const std::string& dir);
-
-/// Resamples of the percentile bootstrap (reports, experiments).
-constexpr int kBootstrapResamples = 2000;
-
-/// What a bootstrap interval is taken of.
-enum class Estimator : std::uint8_t { kMean, kMedian };
-
-/// A percentile-bootstrap 95 % interval.
-struct Interval {
-  double low = 0.0;
-  double high = 0.0;
-};
-
-/// Percentile-bootstrap 95 % interval of estimator(a) - estimator(b), or of estimator(a) if `b`
-/// is empty: `resamples` times, a and then b are resampled with replacement (independently, each
-/// to its own size) from `rng`; the interval is the 2.5 % and 97.5 % quantiles of the resampled
-/// values. `a` must not be empty.
-Interval bootstrap_interval(const std::vector<double>& a, const std::vector<double>& b,
-                            Estimator estimator, core::RandomStream& rng,
-                            int resamples = kBootstrapResamples);
-
-/// Quantile `q` in [0, 1] of sorted values, linear interpolation between order statistics
-/// (R's type 7); 0 for an empty vector.
-double quantile(const std::vector<double>& sorted, double q);
 
 }  // namespace llsf::study

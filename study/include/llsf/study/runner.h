@@ -99,17 +99,18 @@ struct RunResult {
   /// The longest time one robot held one lock (grant to release or the end), not counting
   /// holds of a robot that was jammed (robot profiles) when the hold ended.
   double lock_hold_max_s = 0.0;
-  /// The thesis' measures (docs/statistics.md): the production game time at which the first
-  /// complex product (P1/P2: a T3 or T4 completed) was made, -1 if none; the team agent's role
-  /// changes ("production: role change" decisions) and the game time of the first, -1 if none;
-  /// the fewest pucks left in the input storage (its area grown by 0.1 m, so that pucks pushed
-  /// just past its marks count; sampled every second; pucks held by a robot not counted) and the
-  /// game time it first was empty, -1 if never.
-  double first_complex_s = -1.0;
+  /// The thesis' measures (docs/statistics.md): the production time (the refbox's phase clock,
+  /// s) at which the first complex product (P1/P2: a T3 or T4 completed) was made, absent if
+  /// none; the team agent's role changes ("production: role change" decisions) and the game time
+  /// (s since the start) of the first, absent if none; the fewest pucks left in the input storage
+  /// (its area grown by 0.1 m, so that pucks pushed just past its marks count; sampled every
+  /// second; pucks held by a robot not counted) and the game time it first was empty, absent if
+  /// never. Absent is not a value: the store keeps no row for it.
+  std::optional<double> first_complex_production_s;
   int role_changes = 0;
-  double first_role_change_s = -1.0;
+  std::optional<double> first_role_change_game_s;
   int storage_min = 0;
-  double storage_empty_s = -1.0;
+  std::optional<double> storage_empty_game_s;
   /// Robot profiles: jams at devices, robots jammed at the end, and the longest run of failures
   /// of one skill by one robot without a success of that skill in between (not counting
   /// failures of a jammed robot, skills aborted by a newer one, and get_s0's "no puck seen").

@@ -167,8 +167,20 @@ std::string file_content_hash(const std::string& path);
 std::string batch_identity_hash(const std::string& scenario_path, const ScenarioFile& file);
 
 /// The statistics of `r` by name, in the order of docs/statistics.md: every numeric field of
-/// RunResult (points, exploration_points, ..., cpu_s, real_time_factor).
+/// RunResult (points, exploration_points, ..., cpu_s, real_time_factor) that has a value. A
+/// statistic that may be absent (the time of something that did not happen) is left out when
+/// absent: the store keeps no row for it, never a placeholder.
 std::vector<std::pair<std::string, double>> numeric_statistics(const RunResult& r);
+
+/// One statistic of the store: its name and whether a game may lack it (statistic_infos()).
+struct StatisticInfo {
+  std::string name;
+  bool may_be_absent = false;  ///< a time of something that may not happen in a game
+};
+
+/// Every statistic numeric_statistics() can give, in its order: the one definition the store,
+/// the experiment file's checks and the reports read.
+const std::vector<StatisticInfo>& statistic_infos();
 
 /// How the store keeps a recording path: relative to the database file's directory when the
 /// file lies inside it (database and recordings can move together), else absolute; always
