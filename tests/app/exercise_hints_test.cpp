@@ -84,6 +84,24 @@ TEST_CASE("exercise: each mistake gets its own message at the participant's file
       {"result_table.lua", "02", kExitFailed,
        "fsm.result must be a string (e.g. \"1.20 3.40\") or a number, not a table",
        "report text, not a table"},
+      // At the skill's execute, not the prelude's line; not the syntax-error hint.
+      {"execute_nil.lua", "01", kExitFailed,
+       "drive_to_point: execute() returned nil, expected S_RUNNING, S_FINAL or S_FAILED (a path "
+       "through execute() without a `return`?)",
+       "execute() must return S_RUNNING, S_FINAL or S_FAILED on every path"},
+      // The method meant; not the syntax-error hint ("nearst" has "near" in it).
+      {"typo_method.lua", "02", kExitFailed,
+       "attempt to call a nil value (method 'nearst') (did you mean 'nearest'?)",
+       "the interface has no such method"},
+      {"assign_in_cond.lua", "01", kExitBadInput,
+       "bad cond \"vars.x = 1\": `=` assigns; a condition compares with `==` (or `~=`)",
+       "in a cond string write `==` to compare"},
+      // Not taken for a state only: a constant used too early is named as such too.
+      {"early_constant.lua", "01", kExitBadInput,
+       "undeclared global 'MAX_SPEED': if it is a state, no state is defined yet: call "
+       "fsm:define_states{...} before using it (function MAX_SPEED:init() ...); otherwise define "
+       "it before this line (local MAX_SPEED = ...)",
+       "a name the file uses before defining it"},
   };
   for (const Mistake& m : mistakes) {
     const std::string path = kMistakes + m.file;
@@ -97,6 +115,18 @@ TEST_CASE("exercise: each mistake gets its own message at the participant's file
     CHECK_FALSE(has(r.out, "llsfex-"));  // never the temporary copy's path
     CHECK_FALSE(has(r.out, "your skill failed with this error"));  // not the catch-all
   }
+}
+
+TEST_CASE("exercise: drive_to with string coordinates says what was wrong, not to retry") {
+  const std::string path = kMistakes + "string_coordinates.lua";
+  const Run r = llsfsim({"exercise", "01", "--skill", path, "-q"});
+  INFO(r.out, r.err);
+  CHECK(r.code == llsf::app::kExitFailed);
+  CHECK(has(r.out,
+            "drive_to needs place=<name> or x=, y=: x= and y= must be numbers (got "
+            "x=\"1.5\" (a string), y=\"2\" (a string))"));
+  CHECK(has(r.out, "hint     the arguments your skill gave drive_to are wrong"));
+  CHECK_FALSE(has(r.out, "try again"));
 }
 
 TEST_CASE("exercise: silent mistakes are warnings with the line; a load-time print is shown") {
