@@ -28,6 +28,7 @@ struct BatchCommandOptions {
   bool no_record = false;
   bool record_agents = false;
   bool quiet = false;
+  bool fail_fast = false;  ///< stop at the first run with an agent error (not with --slurm)
   // Slurm
   bool slurm = false;
   std::string partition;

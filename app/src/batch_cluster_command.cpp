@@ -29,6 +29,7 @@
 
 #include "batch_cluster.h"
 #include "batch_progress.h"
+#include "cli_checks.h"
 #include "llsf/app/cli.h"
 #include "llsf/clips/agent.h"
 #include "llsf/core/error.h"
@@ -688,7 +689,7 @@ int batch_status(const StatusOptions& o, std::ostream& out, std::ostream& err) {
 Action add_batch_status_command(CLI::App& sub) {
   auto o = std::make_shared<StatusOptions>();
   sub.add_option("scenarios", o->scenarios, "The batch's scenario files")->required();
-  auto* runs = sub.add_option("--runs", o->runs, "As given to `batch`")->check(CLI::PositiveNumber);
+  auto* runs = sub.add_option("--runs", o->runs, "As given to `batch`")->check(kPositive);
   sub.add_option("--seeds", o->seeds, "As given to `batch`")->excludes(runs);
   sub.add_option("--db", o->db, "The statistics store given to `batch`")->capture_default_str();
   auto* wait =

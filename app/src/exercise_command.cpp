@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "batch_progress.h"
+#include "cli_checks.h"
 #include "commands.h"
 #include "exercise.h"
 #include "exercise_hints.h"
@@ -769,7 +770,8 @@ Action add_exercise_command(CLI::App& app) {
   app.add_option("--skill", o->skill_file,
                  "Your skill file (start from a copy of the exercise's skill.lua); it is loaded "
                  "as the exercise's skill, next to the skill library");
-  auto* seed = app.add_option("--seed", o->seed, "Seed to play (default: the exercise's first)");
+  auto* seed = app.add_option("--seed", o->seed, "Seed to play (default: the exercise's first)")
+                   ->check(kSeed);
   auto* seeds =
       app.add_option("--seeds", o->seeds,
                      "Play these seeds and print a table and the verdict over them (PASS only when "
@@ -777,7 +779,7 @@ Action add_exercise_command(CLI::App& app) {
           ->excludes(seed);
   app.add_option("--jobs,-j", o->jobs,
                  "Games played at once by --seeds (default: the number of cores)")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->needs(seeds);
   app.add_flag("--json", o->json,
                "Print only one JSON object on stdout: the exercise, each seed's result, value, "

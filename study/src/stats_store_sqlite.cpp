@@ -123,11 +123,15 @@ using sqlite::exec;
 using sqlite::Statement;
 using sqlite::Transaction;
 
-// The store's directory is created if missing (a failure shows when SQLite opens the file).
-const std::string& with_parent_dir(const std::string& path) {
+// The store's folder must exist: a typo in `--db` (or a path meant for another machine) is the
+// user's error, not a folder to create (docs/llsfsim.md; a folder made at `/` by a run as root).
+const std::string& in_existing_dir(const std::string& path) {
   const std::filesystem::path dir = std::filesystem::path(path).parent_path();
   std::error_code ec;
-  if (!dir.empty()) std::filesystem::create_directories(dir, ec);
+  if (!dir.empty() && !std::filesystem::is_directory(dir, ec)) {
+    throw StatsError(path + ": cannot open the statistics store: the folder " + dir.string() +
+                     " does not exist");
+  }
   return path;
 }
 
@@ -135,7 +139,7 @@ const std::string& with_parent_dir(const std::string& path) {
 
 class SqliteBackend final : public StatsBackend {
  public:
-  explicit SqliteBackend(const std::string& p) : path_(with_parent_dir(p)) {
+  explicit SqliteBackend(const std::string& p) : path_(in_existing_dir(p)) {
     sqlite3* raw = nullptr;
     const int rc =
         sqlite3_open_v2(path_.c_str(), &raw, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);

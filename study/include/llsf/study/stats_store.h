@@ -99,9 +99,9 @@ class StatsStore {
 
   /// Opens the store `path` names: a PostgreSQL database for a `postgresql://` or `postgres://`
   /// URL (what it leaves out comes from the PG* environment variables, as for psql), else a
-  /// SQLite file (created if missing). Creates the schema in a new store and migrates an older
-  /// one. Throws StatsError if the store cannot be opened or reached, or holds a newer schema
-  /// version or other tables.
+  /// SQLite file (created if missing; its folder must exist). Creates the schema in a new store and
+  /// migrates an older one. Throws StatsError if the store cannot be opened or reached, or holds a
+  /// newer schema version or other tables.
   explicit StatsStore(const std::string& path);
   ~StatsStore();
   StatsStore(const StatsStore&) = delete;
