@@ -198,6 +198,10 @@ class SqliteBackend final : public StatsBackend {
 
   void finish_batch(std::int64_t batch_id) override { finish_batch_->start().bind(batch_id).run(); }
 
+  void remove_empty_batch(std::int64_t batch_id) override {
+    remove_empty_batch_->start().bind(batch_id).bind(batch_id).run();
+  }
+
   std::optional<StoredBatch> batch(std::int64_t batch_id) const override {
     Statement& q = *get_batch_;
     q.start().bind(batch_id);
@@ -442,6 +446,8 @@ class SqliteBackend final : public StatsBackend {
     finish_batch_ = prep(
         "UPDATE batches SET finished = strftime('%Y-%m-%dT%H:%M:%SZ', 'now') "
         "WHERE id = ? AND finished IS NULL");
+    remove_empty_batch_ = prep(
+        "DELETE FROM batches WHERE id = ? AND NOT EXISTS (SELECT 1 FROM runs WHERE batch_id = ?)");
     get_batch_ = prep(
         "SELECT id, kind, created, coalesce(finished, ''), scenario_file, scenario_name, "
         "scenario_hash, runs_per_variant, variants, seeds FROM batches WHERE id = ?");
@@ -498,9 +504,10 @@ class SqliteBackend final : public StatsBackend {
   std::string path_;
   DbHandle db_;
   // Prepared once, used for every run.
-  std::unique_ptr<Statement> find_batch_, insert_batch_, finish_batch_, get_batch_, list_batches_,
-      find_run_, delete_run_, insert_run_, insert_stat_, insert_order_, insert_test_, insert_award_,
-      insert_event_, select_runs_, select_run_, select_stats_, select_awards_;
+  std::unique_ptr<Statement> find_batch_, insert_batch_, finish_batch_, remove_empty_batch_,
+      get_batch_, list_batches_, find_run_, delete_run_, insert_run_, insert_stat_, insert_order_,
+      insert_test_, insert_award_, insert_event_, select_runs_, select_run_, select_stats_,
+      select_awards_;
 };
 
 }  // namespace

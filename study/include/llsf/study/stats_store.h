@@ -124,6 +124,9 @@ class StatsStore {
   std::int64_t open_batch(const BatchKey& key);
   /// Marks a batch complete (sets `finished` to now, once).
   void finish_batch(std::int64_t batch_id);
+  /// Removes the batch `batch_id` if it holds no run (a submission that failed after opening
+  /// it); does nothing otherwise.
+  void remove_empty_batch(std::int64_t batch_id);
   /// Every batch (and stored single run's batch), by id.
   std::vector<StoredBatch> batches() const;
   /// The batch `batch_id`, if it exists.
