@@ -129,6 +129,26 @@ TEST_CASE("exercise: drive_to with string coordinates says what was wrong, not t
   CHECK_FALSE(has(r.out, "try again"));
 }
 
+TEST_CASE("exercise 02: the verdict's why names what the wrong position is") {
+  struct Wrong {
+    const char* file;
+    const char* why;  ///< follows "why      "
+  };
+  const Wrong wrongs[] = {
+      {"find_robot_frame.lua",
+       "the position is the red puck's in the robot's frame (ahead, left): turn the sighting "
+       "into field coordinates"},
+      {"find_wrong_colour.lua", "the position is a green puck's (puck "},
+      {"find_robot_position.lua", "the position is the robot's own (pose:get()), not the puck's"},
+  };
+  for (const Wrong& w : wrongs) {
+    const Run r = llsfsim({"exercise", "02", "--skill", kMistakes + w.file, "-q"});
+    INFO(w.file, "\n", r.out, r.err);
+    CHECK(r.code == llsf::app::kExitFailed);
+    CHECK(has(r.out, std::string("why      ") + w.why));
+  }
+}
+
 TEST_CASE("exercise: silent mistakes are warnings with the line; a load-time print is shown") {
   struct Warning {
     const char* file;
