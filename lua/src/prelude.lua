@@ -499,6 +499,7 @@ function SkillHSM:define_states(spec)
       error(fmt("define_states: state '%s': class must be JumpState or SkillJumpState", name), 2)
     end
     local st = new_state(self, name, class.kind)
+    st.where = where(2)
     if class == SkillJumpState then
       if type(e.skills) ~= "table" or #e.skills == 0 then
         error(fmt("SkillJumpState '%s' needs skills={{skill}, ...}", name), 2)
@@ -762,6 +763,7 @@ local function fsm_step(fsm)
     path[#path + 1] = st.name
   end
   if trs or fsm.spin ~= nil then watch_spin(fsm, now, path, trs, progress) end
+  fsm.passed = path  -- the states this step went through (nil: it stayed), for skill_state
   if st.kind == "final" then return S_FINAL end
   if st.kind == "failed" then
     fsm.error = fsm.error or "FAILED"
@@ -809,6 +811,7 @@ reset_skill = function(h)
   end
   if h.fsm then
     h.fsm.current, h.fsm.error, h.fsm.result, h.fsm.vars = nil, nil, nil, {}
+    h.fsm.passed = nil
     h.fsm.spin = nil
     for _, st in ipairs(h.fsm.state_list) do st.visit = 0 end
   end
@@ -953,6 +956,19 @@ function E.finish_module(name)
                 unknown_state(fsm, fsm.start)), 0)
     end
     h.fsm = fsm
+    -- A state nothing leaves (no transition, timeout, precondition or sub-skill, no transition
+    -- of every state) would only show as "still running" at the end: warn at load.
+    if #fsm.defaults == 0 then
+      for _, st in ipairs(fsm.state_list) do
+        if st.kind ~= "final" and st.kind ~= "failed" and not st.skills and
+           #st.transitions == 0 and #st.preconds == 0 then
+          log(2, fmt("%s: %s: state '%s' has no way out: no transition, timeout or sub-skill " ..
+                     "leaves it, so the skill would stay there; add one (fsm:add_transitions" ..
+                     "{{\"%s\", \"STATE\", cond=...}} or timeout=SECS)", st.where or at, h.name,
+                     st.name, st.name))
+        end
+      end
+    end
   elseif type(rawget(env, "execute")) ~= "function" then
     fail("the skill has no state machine: add fsm = SkillHSM:new{name=name, start=\"STATE\"} " ..
          "and its fsm:define_states{...} (or an execute() function)")
@@ -992,10 +1008,15 @@ function E.skill_info(name)
          h.documentation or "", concat(h.depends, ",")
 end
 
--- Only the state (SkillBrain asks it in every cycle while a state listener is set).
+-- Only the state (SkillBrain asks it in every cycle while a state listener is set), the states
+-- the last step went through ("GO,NEXT,GO"; nil if it stayed in one), so that states passed
+-- within one cycle are seen too, and that step's number (a step not taken reports nothing new).
 function E.skill_state(name)
   local h = handles[name]
-  return h and h.fsm and h.fsm.current and h.fsm.current.name or ""
+  local fsm = h and h.fsm
+  if not fsm then return "" end
+  return fsm.current and fsm.current.name or "", fsm.passed and concat(fsm.passed, ",") or nil,
+         fsm.step_id
 end
 
 local string_env = setmetatable({}, {

@@ -739,6 +739,26 @@ std::string SkillEngine::skill_state(std::string_view skill) const {
   return out;
 }
 
+SkillEngine::StatePath SkillEngine::skill_state_path(std::string_view skill) const {
+  Impl& e = *impl_;
+  lua_pushlstring(e.L, skill.data(), skill.size());
+  StatePath out;
+  if (e.call_entry("skill_state", 1, 3) == LUA_OK) {
+    if (const char* p = lua_tostring(e.L, -2); p != nullptr) {
+      const std::string_view path(p);
+      std::size_t b = 0;
+      while (b <= path.size()) {
+        const std::size_t c = std::min(path.find(',', b), path.size());
+        out.states.emplace_back(path.substr(b, c - b));
+        b = c + 1;
+      }
+    }
+    out.step = static_cast<std::int64_t>(lua_tointeger(e.L, -1));
+  }
+  lua_settop(e.L, 0);
+  return out;
+}
+
 std::vector<SkillInfo> SkillEngine::skills() const {
   std::vector<SkillInfo> out;
   for (const SkillFile& f : impl_->files) {

@@ -160,6 +160,9 @@ TEST_CASE("exercise: silent mistakes are warnings with the line; a load-time pri
       {"args_ignored.lua",
        "drive_to_point: state 'DRIVE' sets self.args[\"drive_to\"], but it runs no sub-skill (it "
        "is a JumpState), so the arguments are ignored"},
+      {"no_way_out.lua",
+       "drive_to_point: state 'WAIT' has no way out: no transition, timeout or sub-skill leaves "
+       "it, so the skill would stay there"},
   };
   for (const Warning& w : warnings) {
     const std::string path = kMistakes + w.file;
