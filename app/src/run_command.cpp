@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
@@ -439,6 +440,91 @@ std::vector<AgentSource> read_agent_sources(const std::vector<std::string>& entr
   return out;
 }
 
+/// The argument names a skill's documentation declares, one `@param NAME[, NAME...]` per line
+/// (docs/skills.md).
+std::vector<std::string> documented_params(const std::string& doc) {
+  std::vector<std::string> out;
+  for (std::size_t at = doc.find("@param"); at != std::string::npos;
+       at = doc.find("@param", at + 1)) {
+    std::size_t i = at + 6;
+    for (;;) {
+      while (i < doc.size() && (doc[i] == ' ' || doc[i] == '\t')) ++i;
+      std::size_t e = i;
+      while (e < doc.size() &&
+             (std::isalnum(static_cast<unsigned char>(doc[e])) != 0 || doc[e] == '_'))
+        ++e;
+      if (e == i) break;
+      out.push_back(doc.substr(i, e - i));
+      i = e;
+      if (i < doc.size() && doc[i] == ',') {
+        ++i;
+        continue;
+      }
+      break;
+    }
+  }
+  return out;
+}
+
+/// The literal argument names of a `(skill-call NAME key value key value ...)` whose name ends
+/// at `pos` of `code` (comments blanked): each key that is a plain symbol; stops at the call's
+/// `)` or at anything else (a variable or an expression in a key's place).
+std::vector<std::string> skill_call_arguments(const std::string& code, std::size_t pos) {
+  std::vector<std::string> out;
+  auto skip_space = [&] {
+    while (pos < code.size() && std::isspace(static_cast<unsigned char>(code[pos])) != 0) ++pos;
+  };
+  // Skips one value: a string, a parenthesised expression or a token.
+  auto skip_value = [&] {
+    if (pos >= code.size()) return;
+    if (code[pos] == '"') {
+      for (++pos; pos < code.size() && code[pos] != '"'; ++pos) {
+        if (code[pos] == '\\') ++pos;
+      }
+      ++pos;
+    } else if (code[pos] == '(') {
+      int depth = 0;
+      bool in_string = false;
+      for (; pos < code.size(); ++pos) {
+        const char c = code[pos];
+        if (in_string) {
+          if (c == '\\')
+            ++pos;
+          else if (c == '"')
+            in_string = false;
+        } else if (c == '"') {
+          in_string = true;
+        } else if (c == '(') {
+          ++depth;
+        } else if (c == ')' && --depth == 0) {
+          ++pos;
+          break;
+        }
+      }
+    } else {
+      while (pos < code.size() && std::isspace(static_cast<unsigned char>(code[pos])) == 0 &&
+             code[pos] != '(' && code[pos] != ')') {
+        ++pos;
+      }
+    }
+  };
+  for (;;) {
+    skip_space();
+    if (pos >= code.size() || code[pos] == ')') break;
+    const std::size_t b = pos;
+    while (pos < code.size() && (std::isalnum(static_cast<unsigned char>(code[pos])) != 0 ||
+                                 code[pos] == '_' || code[pos] == '-')) {
+      ++pos;
+    }
+    if (pos == b || (pos < code.size() && std::isspace(static_cast<unsigned char>(code[pos])) == 0))
+      break;  // not a plain symbol: a variable, an expression, a string
+    out.push_back(code.substr(b, pos - b));
+    skip_space();
+    skip_value();
+  }
+  return out;
+}
+
 /// One of `check`'s findings about an agent.
 struct AgentWarning {
   enum class Kind { kWarn, kNote };
@@ -463,8 +549,12 @@ std::vector<AgentWarning> agent_warnings(const study::RobotSpec& spec,
   };
   const std::vector<AgentSource> sources = read_agent_sources(spec.agent);
   std::vector<std::string> skills;
+  std::map<std::string, std::vector<std::string>> params;  // skill -> its @param names
   if (brain != nullptr) {
-    for (const lua::SkillInfo& s : brain->skills().engine().skills()) skills.push_back(s.name);
+    for (const lua::SkillInfo& s : brain->skills().engine().skills()) {
+      skills.push_back(s.name);
+      params[s.name] = documented_params(s.documentation);
+    }
   }
   static const std::regex kSkillCall(R"(\(skill-call\s+([A-Za-z_][A-Za-z0-9_]*))");
   static const std::regex kConfval(R"re("(/clips-agent/[^"\s]*)")re");
@@ -476,7 +566,24 @@ std::vector<AgentWarning> agent_warnings(const study::RobotSpec& spec,
          it != std::sregex_iterator(); ++it) {
       const std::string name = (*it)[1].str();
       if (brain == nullptr) continue;
-      if (std::find(skills.begin(), skills.end(), name) != skills.end()) continue;
+      if (std::find(skills.begin(), skills.end(), name) != skills.end()) {
+        // Literal argument names the skill does not document (`plac` for `place`).
+        const std::vector<std::string>& known = params[name];
+        if (known.empty()) continue;  // a skill without @param lines: nothing to compare with
+        const std::size_t after = static_cast<std::size_t>(it->position() + it->length());
+        for (const std::string& arg : skill_call_arguments(src.code, after)) {
+          if (std::find(known.begin(), known.end(), arg) != known.end()) continue;
+          const auto meant = core::closest_match(arg, known);
+          std::string list;
+          for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
+          warn(
+              fmt::format("{}:{}: (skill-call {} {} ...): {} has no argument '{}' ({}its "
+                          "arguments: {})",
+                          src.file, src.line_of(static_cast<std::size_t>(it->position())), name,
+                          arg, name, arg, meant ? "did you mean '" + *meant + "'? " : "", list));
+        }
+        continue;
+      }
       const auto hint = core::closest_match(name, skills);
       warn(fmt::format(
           "{}:{}: (skill-call {} ...): the skill library has no skill "

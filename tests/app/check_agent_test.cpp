@@ -61,6 +61,23 @@ TEST_CASE("an agent that uses lock facts with the locks switch off: the error na
             "protocol on: set `robots.locks: true`"));
 }
 
+TEST_CASE("check warns on a skill-call argument the skill does not document") {
+  const TempDir dir;
+  write(dir, "agent/a.clp",
+        "(defrule go (time $?) (not (went))\n"
+        "  => (assert (went)) (skill-call drive_to plac \"M1\" ori (+ 1 2)))\n"
+        "(defrule fine (time $?) (place ?p) (not (fine))\n"
+        "  => (assert (fine)) (skill-call drive_to x 1.0 y (* 2 1.5) place ?p))\n");
+  write(dir, "s.yaml", "name: c\nrobots:\n  count: 1\n  agent: [agent]\n");
+  const auto r = llsfsim({"check", dir.file("s.yaml")});
+  INFO(r.out, r.err);
+  CHECK(r.code == 0);
+  CHECK(has(r.out,
+            "a.clp:2: (skill-call drive_to plac ...): drive_to has no argument 'plac' (did "
+            "you mean 'place'? its arguments: place, x, y, ori, forward_only, timeout)"));
+  CHECK(r.out.find("has no argument") == r.out.rfind("has no argument"));  // ori, x, y: known
+}
+
 TEST_CASE("check: the shipped scenarios get no warning") {
   for (const char* name : {"default", "auction-vs-roles", "packet-loss", "thesis-two-robots",
                            "thesis-three-robots", "hackathon"}) {
