@@ -378,6 +378,13 @@ TEST_CASE("exercise --submit: queued over HTTP; refusals, bad URLs and a closed 
   r = llsf::test::llsfsim({"exercise", "01", "--skill", big, "--submit", url, "--team", "t"});
   CHECK(r.code == 2);
   CHECK(llsf::test::has(r.err, "(HTTP 413): the skill file is 3000 bytes; at most 2000 bytes"));
+  // Over the server's request body limit: its 413 is read, not "Broken pipe".
+  const std::string huge = tmp.file("huge.lua");
+  std::ofstream(huge) << std::string(4 << 20, '-');
+  r = llsf::test::llsfsim({"exercise", "01", "--skill", huge, "--submit", url, "--team", "t"});
+  CHECK(r.code == 2);
+  CHECK(llsf::test::has(r.err, "refused the submission (HTTP 413): the request body is larger"));
+  CHECK_FALSE(llsf::test::has(r.err, "cannot reach"));
   const std::string latin1 = tmp.file("latin1.lua");
   std::ofstream(latin1) << "-- gr\xfc\xdf\n";
   r = llsf::test::llsfsim({"exercise", "01", "--skill", latin1, "--submit", url, "--team", "t"});
