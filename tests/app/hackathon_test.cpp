@@ -250,6 +250,18 @@ TEST_CASE("hackathon: workers play submissions on hidden seeds; ranked; seeds ne
     REQUIRE(board["entries"].size() == 2);
     CHECK(board["entries"][0]["team"] == "good");
     CHECK(board["entries"][1]["team"] == "weak");
+    // The page shows why a played submission failed: its first run not passed, no seed.
+    for (const json& s : board["recent"]) {
+      CAPTURE(s.dump());
+      if (s["team"] == "weak") {
+        REQUIRE(s.contains("reason"));
+        CHECK(s["reason"].get<std::string>().starts_with("run 1 of 2: "));
+        CHECK(s["reason"].get<std::string>().find("not solved yet") != std::string::npos);
+        CHECK(s["reason"].get<std::string>().find("1001") == std::string::npos);
+      } else {
+        CHECK_FALSE(s.contains("reason"));
+      }
+    }
     r.path = {"api", "hackathon", "submissions", std::to_string(good)};
     const std::string shown = server.route(r)->body;
     CHECK(shown.find("1001") == std::string::npos);
