@@ -28,6 +28,7 @@ struct BatchCommandOptions {
   bool no_record = false;
   bool record_agents = false;
   bool quiet = false;
+  bool fail_fast = false;  ///< stop at the first run with an agent error (not with --slurm)
   // Playing until the answer is known (docs/llsfsim.md, "--until").
   std::string until;  ///< "VARIANT_A>VARIANT_B" ("" = a plain batch)
   std::string statistic = "points";

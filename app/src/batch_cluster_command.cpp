@@ -29,6 +29,7 @@
 
 #include "batch_cluster.h"
 #include "batch_progress.h"
+#include "cli_checks.h"
 #include "llsf/app/cli.h"
 #include "llsf/clips/agent.h"
 #include "llsf/core/error.h"
@@ -231,17 +232,35 @@ int batch_submit(const BatchCommandOptions& o, std::ostream& out, std::ostream& 
 
   // The batches exist in the main store before a task starts: tasks name their recordings'
   // directory by the main store's batch id, as a local batch does.
+  std::vector<std::int64_t> opened_now;  // batches this submission created (undone if it fails)
   try {
     study::StatsStore store(db);
     store.require_writable();
-    for (const LoadedBatch& l : loaded) (void)store.open_batch(l.key);
+    for (const LoadedBatch& l : loaded) {
+      const bool existed = find_batch(store, l.key).has_value();
+      const std::int64_t id = store.open_batch(l.key);
+      if (!existed) opened_now.push_back(id);
+    }
   } catch (const study::StatsError& e) {
     err << who << ": " << e.what() << "\n";
     return kExitBadInput;
   }
+  // A submission that fails leaves nothing behind: no empty batch, no job script.
+  auto undo = [&db, &opened_now, &script](const std::string& script_file) {
+    std::error_code ignored;
+    if (!script_file.empty()) fs::remove(script_file, ignored);
+    fs::remove(script.log_dir, ignored);  // only if it is empty
+    try {
+      study::StatsStore store(db);
+      for (const std::int64_t id : opened_now) store.remove_empty_batch(id);
+    } catch (const study::StatsError&) {
+      // The store was just written; if it cannot be reached now the error above says enough.
+    }
+  };
   fs::create_directories(script.log_dir, ec);
   if (ec) {
     err << who << ": cannot create " << script.log_dir << ": " << ec.message() << "\n";
+    undo("");
     return kExitBadInput;
   }
   const std::string stamp = utc_now();
@@ -254,11 +273,13 @@ int batch_submit(const BatchCommandOptions& o, std::ostream& out, std::ostream& 
     if (f == nullptr) {
       if (errno == EEXIST) continue;
       err << who << ": cannot write " << script_path << ": " << std::strerror(errno) << "\n";
+      undo("");
       return kExitBadInput;
     }
     const bool written = std::fwrite(text.data(), 1, text.size(), f) == text.size();
     if (std::fclose(f) != 0 || !written) {
       err << who << ": cannot write " << script_path << "\n";
+      undo(script_path);
       return kExitBadInput;
     }
     break;
@@ -269,7 +290,9 @@ int batch_submit(const BatchCommandOptions& o, std::ostream& out, std::ostream& 
       !std::all_of(job_id.begin(), job_id.end(), [](char c) { return c >= '0' && c <= '9'; })) {
     err << who << ": sbatch " << script_path << " failed"
         << (sb.code == 127 ? " (sbatch not found: is slurm-client installed?)" : "") << ":\n"
-        << sb.output;
+        << sb.output
+        << "(nothing was submitted: the job script and the new batch rows are removed)\n";
+    undo(script_path);
     return kExitBadInput;
   }
   study::SlurmJob job;
@@ -688,7 +711,7 @@ int batch_status(const StatusOptions& o, std::ostream& out, std::ostream& err) {
 Action add_batch_status_command(CLI::App& sub) {
   auto o = std::make_shared<StatusOptions>();
   sub.add_option("scenarios", o->scenarios, "The batch's scenario files")->required();
-  auto* runs = sub.add_option("--runs", o->runs, "As given to `batch`")->check(CLI::PositiveNumber);
+  auto* runs = sub.add_option("--runs", o->runs, "As given to `batch`")->check(kPositive);
   sub.add_option("--seeds", o->seeds, "As given to `batch`")->excludes(runs);
   sub.add_option("--db", o->db, "The statistics store given to `batch`")->capture_default_str();
   auto* wait =

@@ -11,6 +11,7 @@
 
 #include "batch_cluster.h"
 #include "batch_progress.h"
+#include "cli_checks.h"
 #include "commands.h"
 #include "llsf/app/cli.h"
 #include "llsf/clips/agent.h"
@@ -230,6 +231,13 @@ int batch(const BatchCommandOptions& o, std::ostream& out, std::ostream& err) {
     err << "llsfsim batch: give one or more scenario files (or: batch status, batch merge)\n";
     return kExitBadInput;
   }
+  // --task is the job script's (hidden from --help, so not a CLI11 `excludes`: its help line
+  // would read "--slurm Excludes:" with the hidden name left out).
+  if (o.slurm && o.task) {
+    err << "llsfsim batch: --task is what a Slurm array task runs; it cannot be given with "
+           "--slurm\n";
+    return kExitBadInput;
+  }
   if (o.slurm) return batch_submit(o, out, err);
   if (o.task) return batch_task(o, out, err);
   if (!o.until.empty()) return batch_until(o, out, err);
@@ -259,6 +267,7 @@ int batch(const BatchCommandOptions& o, std::ostream& out, std::ostream& err) {
     options.choice = l.choice;
     options.jobs = o.jobs.value_or(0);
     options.record_agents = o.record_agents;
+    options.fail_fast = o.fail_fast;
     if (!o.no_record)
       options.recordings_dir = o.recordings.empty() ? default_recordings_dir(o.db) : o.recordings;
     const study::BatchHooks hooks = progress.hooks();
@@ -275,6 +284,13 @@ int batch(const BatchCommandOptions& o, std::ostream& out, std::ostream& err) {
     if (progress.bar() && b.interrupted) err << "\n";
     if (!o.quiet)
       print_summary(l, b, store->path(), options.recordings_dir, out);  // (password masked)
+    if (b.agent_error) {
+      err << "llsfsim batch: --fail-fast: stopped at the first run with an agent error ("
+          << *b.agent_error << " of " << l.path
+          << "); the games already running were stored; run it again with `llsfsim run` to "
+             "see its issues, or again without --fail-fast to play the rest\n";
+      return kExitFailed;
+    }
     if (b.interrupted) return kExitInterrupted;
     all_passed = all_passed && b.all_passed();
   }
@@ -321,7 +337,7 @@ Action add_batch_command(CLI::App& app) {
                      "seeds after its largest, counting up (a single seed s: s..s+N-1). Default: "
                      "the scenario's seeds; at most 100000, and at most 100000 games in all "
                      "(variants x seeds)")
-          ->check(CLI::PositiveNumber);
+          ->check(kPositive);
   auto* seeds =
       app.add_option("--seeds", o->seeds,
                      "Exactly these seeds for every variant instead of the scenario's: a list of "
@@ -330,7 +346,7 @@ Action add_batch_command(CLI::App& app) {
   app.add_option("--jobs,-j", o->jobs,
                  "Games played at once (default: the number of cores; with --slurm: 1 per array "
                  "task, its --cpus-per-task)")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   app.add_option("--db", o->db,
                  "Statistics store: a SQLite file or a postgresql://USER@HOST:PORT/DB URL "
                  "(docs/statistics.md); with --slurm a file on shared storage or the URL")
@@ -347,6 +363,10 @@ Action add_batch_command(CLI::App& app) {
                "docs/benchmarks.md)")
       ->excludes(no_rec);
   app.add_flag("-q,--quiet", o->quiet, "No progress and no summary, only the exit code");
+  auto* fail_fast = app.add_flag(
+      "--fail-fast", o->fail_fast,
+      "Stop at the first run with an agent error (a runtime error or a halted agent): no new "
+      "game starts, the running ones are stored; exit code 1");
 
   // Playing until the answer is known.
   const std::string until_group = "Play until the answer is known (docs/llsfsim.md)";
@@ -380,7 +400,8 @@ Action add_batch_command(CLI::App& app) {
   auto* on_slurm = app.add_flag("--slurm", o->slurm,
                                 "Submit the batch as a Slurm job array (sbatch) instead of "
                                 "playing it here; only the missing runs are submitted")
-                       ->group(slurm);
+                       ->group(slurm)
+                       ->excludes(fail_fast);
   on_slurm->excludes(until);
   app.add_option("--partition", o->partition, "sbatch --partition")->needs(on_slurm)->group(slurm);
   app.add_option("--time-limit", o->time_limit, "sbatch --time per array task, e.g. 30 or 1:00:00")
@@ -388,7 +409,7 @@ Action add_batch_command(CLI::App& app) {
       ->group(slurm);
   app.add_option("--array-throttle", o->array_throttle,
                  "At most K array tasks at once (sbatch --array=...%K)")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->needs(on_slurm)
       ->group(slurm);
   auto* gpt = app.add_option("--games-per-task", o->games_per_task,
@@ -406,10 +427,7 @@ Action add_batch_command(CLI::App& app) {
       ->needs(on_slurm)
       ->group(slurm);
   // What an array task runs (written into the job script, not for users).
-  app.add_option("--task", o->task, "")
-      ->check(CLI::NonNegativeNumber)
-      ->excludes(on_slurm)
-      ->group("");
+  app.add_option("--task", o->task, "")->check(kNonNegative)->group("");
   (void)gpt;
   app.footer(
       "Plays every matrix variant x N seeds of each scenario on worker threads and stores every "

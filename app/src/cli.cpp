@@ -5,12 +5,15 @@
 
 #include <algorithm>
 #include <exception>
+#include <optional>
 #include <ostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "commands.h"
 #include "llsf/core/error.h"
+#include "llsf/core/text.h"
 #include "llsf/core/version.h"
 
 namespace llsf::app {
@@ -23,6 +26,72 @@ int internal_error(const std::string& who, const char* what, std::ostream& err) 
       << "This is a bug in llsfsim " << core::kVersion
       << "; please report it with the command line and the scenario file.\n";
   return kExitInternalError;
+}
+
+/// The candidate `name` is a likely typo of: core::closest_match, or one with two neighbouring
+/// characters swapped (`rnu` for `run`, too far for a third of three letters).
+std::optional<std::string> likely_meant(const std::string& name,
+                                        const std::vector<std::string>& candidates) {
+  if (auto m = core::closest_match(name, candidates)) return m;
+  for (const std::string& c : candidates) {
+    if (c.size() != name.size()) continue;
+    for (std::size_t i = 0; i + 1 < c.size(); ++i) {
+      std::string swapped = name;
+      std::swap(swapped[i], swapped[i + 1]);
+      if (swapped == c) return c;
+    }
+  }
+  return std::nullopt;
+}
+
+/// What the command line names that `app` does not know, with a did-you-mean: an unknown
+/// command (`llsfsim rnu`) or long option (`--verison`) of the innermost command parsed. Empty
+/// if every name is known (the parse error is about something else).
+std::string unknown_name(const CLI::App& app, std::span<const std::string> args) {
+  const CLI::App* ctx = &app;
+  std::string who = "llsfsim";
+  while (!ctx->get_subcommands().empty()) {
+    ctx = ctx->get_subcommands().front();
+    who += " " + ctx->get_name();
+  }
+  std::vector<std::string> commands;
+  for (const CLI::App* sub : ctx->get_subcommands({})) commands.push_back(sub->get_name());
+  std::vector<std::string> options;
+  bool takes_words = false;  // a positional (`batch SCENARIO...`): any word may be its value
+  for (const CLI::Option* o : ctx->get_options()) {
+    for (const std::string& l : o->get_lnames()) options.push_back("--" + l);
+    takes_words = takes_words || o->get_positional();
+  }
+  for (std::size_t i = 1; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "--") break;
+    if (a.rfind("--", 0) == 0 && a.size() > 2) {
+      const std::string name = a.substr(0, a.find('='));
+      if (std::find(options.begin(), options.end(), name) != options.end()) continue;
+      // An option of an outer command (`--help`, `--version`) is not a typo either.
+      bool outer = false;
+      for (const CLI::App* p = ctx->get_parent(); p != nullptr && !outer; p = p->get_parent()) {
+        for (const CLI::Option* o : p->get_options())
+          outer = outer || o->check_lname(name.substr(2));
+      }
+      if (outer) continue;
+      std::string text = who + ": unknown option " + name;
+      if (auto m = likely_meant(name, options)) text += "; did you mean " + *m + "?";
+      return text;
+    }
+  }
+  // The first word after the command chain where a command is expected: a command name.
+  if (!commands.empty() && !takes_words && ctx->get_subcommands().empty()) {
+    std::size_t i = 1;
+    for (const CLI::App* p = ctx; p->get_parent() != nullptr; p = p->get_parent()) ++i;
+    if (i < args.size() && args[i].rfind('-', 0) != 0 &&
+        std::find(commands.begin(), commands.end(), args[i]) == commands.end()) {
+      std::string text = who + ": unknown command '" + args[i] + "'";
+      if (auto m = likely_meant(args[i], commands)) text += "; did you mean '" + *m + "'?";
+      return text;
+    }
+  }
+  return "";
 }
 
 }  // namespace
@@ -110,7 +179,24 @@ int run(std::span<const std::string> args, std::ostream& out, std::ostream& err)
     out << app.version() << "\n";
     return kExitOk;
   } catch (const CLI::ParseError& e) {
-    err << "llsfsim: " << e.what() << "\n";
+    if (const std::string unknown = unknown_name(app, args); !unknown.empty()) {
+      err << unknown << "\n";
+    } else {
+      err << "llsfsim: " << e.what() << "\n";
+    }
+    // `run --refbox-sockets SCENARIO`: the optional value took the scenario.
+    if (const CLI::App* r = app.get_subcommand("run"); r->parsed()) {
+      const CLI::Option* scenario = r->get_option("scenario");
+      const CLI::Option* sockets = r->get_option("--refbox-sockets");
+      if (scenario->count() == 0 && sockets->count() > 0 && !sockets->results().empty() &&
+          !sockets->results().front().empty()) {
+        const std::string taken = sockets->results().front();
+        err << "hint: --refbox-sockets took '" << taken
+            << "' as its sockets file (its value is optional): put it after the scenario, "
+               "llsfsim run "
+            << taken << " --refbox-sockets\n";
+      }
+    }
     if (app.get_subcommands().empty()) {
       err << "Run 'llsfsim --help' for the commands.\n";
     } else {

@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "batch_progress.h"
+#include "cli_checks.h"
 #include "commands.h"
 #include "exercise.h"
 #include "exercise_hints.h"
@@ -179,6 +180,54 @@ void friendly(const std::string& message, const std::string& tmp, const std::str
 /// happens on `out` (progress, log lines, the verdict) as a single run does, and returns the
 /// outcome. Thread-safe for distinct `out`/`err` streams when `o` asks for no server and no
 /// recording.
+/// Why a reported find position `p` of robot `robot` is not the goal colour's puck, by what lies
+/// there: another colour's puck (the camera's false colour, or the wrong sighting taken), the
+/// puck in the robot's holder or the robot itself, or the goal puck's position in the robot's
+/// frame (the sighting not turned into field coordinates); else the general advice.
+std::string find_why_not(const sim::Game& game, const Exercise& ex, int robot, core::Vec2 p,
+                         int goal_puck) {
+  const kinematic::World& w = game.world();
+  const sim::HackathonConfig& h = *ex.scenario.game.hackathon;
+  const double within = ex.goal.within_m;
+  const core::RobotId rid = w.robot_by_name(game.robot(robot).name());
+  const core::Pose2D pose = w.robot_pose(rid);
+  const std::optional<core::PuckId> held = w.held_puck(rid);
+  // The held puck or the robot's own position.
+  if (held && (w.puck_position(*held) - p).norm() <= within) {
+    return fmt::format(
+        "the position is the puck in the robot's holder (puck {}), not a {} puck on the field: "
+        "report the sighting's position, before taking a puck",
+        held->value(), ex.goal.colour);
+  }
+  if ((pose.position() - p).norm() <= within) {
+    return "the position is the robot's own (pose:get()), not the puck's: add the sighting "
+           "(robot frame) turned into field coordinates";
+  }
+  // Another colour's puck.
+  for (const sim::HackathonPuck& k : game.hackathon_layout()->pucks) {
+    if (k.colour == h.colour_index(ex.goal.colour) || !w.has_puck(k.id)) continue;
+    if ((w.puck_position(k.id) - p).norm() > within) continue;
+    return fmt::format(
+        "the position is a {} puck's (puck {}), not a {} one: the camera reports a wrong colour "
+        "now and then (false_colour_rate), so wait for the colour in two or more sightings, and "
+        "ask puck_detector:nearest(\"{}\") for that colour only",
+        h.colours.at(static_cast<std::size_t>(k.colour)).name, k.id.value(), ex.goal.colour,
+        ex.goal.colour);
+  }
+  // The goal puck's position in the robot's frame at the end: not turned into field coordinates.
+  if (goal_puck >= 0) {
+    const core::Vec2 in_robot = pose.to_local(w.puck_position(core::PuckId(goal_puck)));
+    if ((in_robot - p).norm() <= within) {
+      return "the position is the " + ex.goal.colour +
+             " puck's in the robot's frame (ahead, left): turn the sighting into field "
+             "coordinates with pose:get() (see the README's hints)";
+    }
+  }
+  return "the position is no " + ex.goal.colour +
+         " puck's: turn the sighting (robot frame) into field coordinates with pose:get() (see "
+         "the README's hints), and report it when the colour is sure";
+}
+
 SeedRun play_seed(const Exercise& ex, const ExerciseOptions& o, std::uint64_t seed,
                   std::ostream& out, std::ostream& err) {
   SeedRun run;
@@ -398,11 +447,7 @@ SeedRun play_seed(const Exercise& ex, const ExerciseOptions& o, std::uint64_t se
                             p->x(), p->y(), best, ex.goal.colour, best_id, ex.goal.within_m);
         passed = best <= ex.goal.within_m;
         if (best_id >= 0) run.value = best;
-        if (!passed) {
-          why_not = "the position is not a " + ex.goal.colour +
-                    " puck's: turn the sighting (robot frame) into field coordinates with "
-                    "pose:get() (see the README's hints)";
-        }
+        if (!passed) why_not = find_why_not(game, ex, 0, *p, best_id);
       }
       break;
     }
@@ -769,7 +814,8 @@ Action add_exercise_command(CLI::App& app) {
   app.add_option("--skill", o->skill_file,
                  "Your skill file (start from a copy of the exercise's skill.lua); it is loaded "
                  "as the exercise's skill, next to the skill library");
-  auto* seed = app.add_option("--seed", o->seed, "Seed to play (default: the exercise's first)");
+  auto* seed = app.add_option("--seed", o->seed, "Seed to play (default: the exercise's first)")
+                   ->check(kSeed);
   auto* seeds =
       app.add_option("--seeds", o->seeds,
                      "Play these seeds and print a table and the verdict over them (PASS only when "
@@ -777,7 +823,7 @@ Action add_exercise_command(CLI::App& app) {
           ->excludes(seed);
   app.add_option("--jobs,-j", o->jobs,
                  "Games played at once by --seeds (default: the number of cores)")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->needs(seeds);
   app.add_flag("--json", o->json,
                "Print only one JSON object on stdout: the exercise, each seed's result, value, "

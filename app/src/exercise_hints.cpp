@@ -63,6 +63,15 @@ std::string hint_for(const std::string& msg, const std::string& skill) {
     return "skills run in a sandbox without os, io, require, load, dofile, debug and coroutine: "
            "use what the message names instead (docs/skills.md, \"Sandbox\").";
   }
+  if (has("execute() returned")) {
+    return "execute() must return S_RUNNING, S_FINAL or S_FAILED on every path: a function "
+           "that ends without `return` returns nil (check the branches of its if/else).";
+  }
+  if (has("if it is a state, no state is defined yet")) {
+    return "a name the file uses before defining it: a state exists only after "
+           "fsm:define_states{ export_to=_M, ... }; a constant needs `local NAME = value` above "
+           "its first use; or it is a typo.";
+  }
   if (has("fsm:define_states{...} is missing") || has("no state is defined yet")) {
     return "define the states right after SkillHSM:new: fsm:define_states{ export_to=_M, "
            "{\"DRIVE\", SkillJumpState, skills={{drive_to}}, final_to=\"FINAL\"}, ... }, then "
@@ -143,6 +152,18 @@ std::string hint_for(const std::string& msg, const std::string& skill) {
     return "the exercise loads your file as the skill '" + skill + "': keep the line name = \"" +
            skill + "\".";
   }
+  if (has("(method '") && has("did you mean")) {
+    return "the interface has no such method: use the name the message suggests (the "
+           "interfaces' methods: docs/skills.md; call them with `:`, puck_detector:nearest()).";
+  }
+  if (has("`=` assigns; a condition compares with `==`")) {
+    return "in a cond string write `==` to compare (`~=` for not equal): cond=\"vars.n == 3\".";
+  }
+  if (has("needs place=<name> or x=, y=:")) {
+    return "the arguments your skill gave drive_to are wrong (the message says which): x and y "
+           "are numbers (tonumber(\"1.5\") is 1.5), place a place name; set them in "
+           "self.args[\"drive_to\"] in the state's init().";
+  }
   if (has("'end' expected")) {
     return "a block is not closed: check the `end` of the function, `if` or state above (every "
            "function, if, for and while needs its own `end`).";
@@ -151,7 +172,9 @@ std::string hint_for(const std::string& msg, const std::string& skill) {
     return "a table or call is not closed: look for a missing `,` between entries or a missing "
            "`}` / `)` on this line or the one above.";
   }
-  if (has("unexpected symbol") || has("near") || has("expected")) {
+  // Lua's syntax errors end "near '<token>'" or "near <eof>" (not any text with "near" or
+  // "expected" in it: `nearest`, "expected S_RUNNING").
+  if (has("unexpected symbol") || has(" near '") || has(" near <eof>") || has(" near \"")) {
     return "a syntax error: check this line and the one above (a missing `then`, `do`, `end`, "
            "`,` or quote; `=` vs `==`).";
   }

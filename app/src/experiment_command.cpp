@@ -16,6 +16,7 @@
 #include <string>
 
 #include "batch_progress.h"
+#include "cli_checks.h"
 #include "commands.h"
 #include "llsf/app/cli.h"
 #include "llsf/clips/agent.h"
@@ -209,10 +210,10 @@ Action add_experiment_command(CLI::App& app) {
   app.add_option("--runs", o->runs,
                  "Seeds per variant of every batch: the first N of each scenario's list, or "
                  "s..s+N-1 for a single seed s (default: each scenario's seeds)")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   auto* jobs =
       app.add_option("--jobs,-j", o->jobs, "Games played at once (default: the number of cores)")
-          ->check(CLI::PositiveNumber);
+          ->check(kPositive);
   auto* rec = app.add_option("--recordings", o->recordings,
                              "Directory for the games' recordings, one subdirectory per batch "
                              "(default: <db name>-recordings beside the --db file)");

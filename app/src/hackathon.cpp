@@ -130,6 +130,23 @@ json public_json(const Submission& s, bool with_result) {
     j["total"] = s.total;
     j["value"] = s.value ? json(*s.value) : json(nullptr);
     j["verdict"] = s.verdict;
+    // Why a played submission did not pass, for the page: its first run not passed, by number
+    // (never its seed): the error, else the verdict's `why`.
+    if (s.verdict != "PASS") {
+      const json r = json::parse(s.result, nullptr, false);
+      if (r.is_object() && r.contains("runs") && r["runs"].is_array()) {
+        int i = 0;
+        for (const json& run : r["runs"]) {
+          ++i;
+          if (!run.is_object() || run.value("result", std::string()) == "PASS") continue;
+          std::string why = run.value("error", std::string());
+          if (why.empty()) why = run.value("why", std::string());
+          if (why.empty()) why = run.value("score", std::string());
+          j["reason"] = fmt::format("run {} of {}: {}", i, r["runs"].size(), tail(why, 400));
+          break;
+        }
+      }
+    }
   }
   if (!s.error.empty()) j["error"] = s.error;
   if (with_result && !s.result.empty()) {

@@ -140,13 +140,12 @@ int submit_skill(const SubmitOptions& o, const std::string& exercise, const std:
           }
           stream.expires_after(step_limit);
           http::async_write(stream, req, [&](beast::error_code wec, std::size_t) {
-            if (wec) {
-              failed = wec;
-              return;
-            }
+            // A server that refuses the upload (413) answers before the body is all sent and
+            // closes: the write fails, but its answer may be there to read.
             stream.expires_after(step_limit);
-            http::async_read(stream, buffer, parser,
-                             [&](beast::error_code rec, std::size_t) { failed = rec; });
+            http::async_read(stream, buffer, parser, [&, wec](beast::error_code rec, std::size_t) {
+              failed = parser.is_done() ? beast::error_code() : (wec ? wec : rec);
+            });
           });
         });
     ioc.run();

@@ -3,12 +3,14 @@
 
 #include <thread>
 
+#include "cli_checks.h"
+
 namespace llsf::app {
 
 void add_live_options(CLI::App& app, LiveOptions& o, const std::string& serve_help) {
   auto* speed = app.add_option("--speed", o.speed,
                                "Paced: play X game seconds per wall-clock second (e.g. 4)")
-                    ->check(CLI::PositiveNumber);
+                    ->check(kPositive);
   app.add_flag("--realtime", o.realtime, "Paced at real time (= --speed 1)")->excludes(speed);
   auto* serve = app.add_flag("--serve", o.serve, serve_help);
   app.add_option("--port", o.port, "With --serve: the port (0: any free port)")

@@ -45,11 +45,13 @@ struct RefboxSockets::Peer {
   std::vector<std::uint8_t> buffer = std::vector<std::uint8_t>(kReceiveBuffer);
 };
 
-RefboxSockets::RefboxSockets(comm::SocketConfig config, comm::LogSink log)
-    : config_(std::move(config)) {
+RefboxSockets::RefboxSockets(comm::SocketConfig config, comm::LockNumbering lock_messages,
+                             comm::LogSink log)
+    : config_(std::move(config)), lock_messages_(lock_messages) {
   config_.validate();
+  // The game's registry (sim::Game): frames are decoded and encoded here as the radio does.
   sim::add_refbox_messages(registry_);
-  comm::add_agent_messages(registry_);
+  comm::add_agent_messages(registry_, lock_messages_);
   address_ = asio::ip::make_address(config_.address);
   if (config_.stream_enabled) {
     comm::StreamServerOptions o;
@@ -59,9 +61,8 @@ RefboxSockets::RefboxSockets(comm::SocketConfig config, comm::LogSink log)
     try {
       server_ = std::make_unique<comm::StreamServer>(registry_, o);
     } catch (const std::runtime_error& e) {
-      throw core::UserError("--refbox-sockets: cannot listen for controllers on " +
-                            config_.address + ":" + std::to_string(config_.stream_port) + ": " +
-                            e.what());
+      throw core::UserError("cannot listen for controllers on " + config_.address + ":" +
+                            std::to_string(config_.stream_port) + ": " + e.what());
     }
   }
   for (std::size_t i = 0; i < config_.udp_peers.size(); ++i) {
@@ -72,16 +73,15 @@ RefboxSockets::RefboxSockets(comm::SocketConfig config, comm::LogSink log)
     p->socket.open(local.protocol(), ec);
     if (!ec) p->socket.bind(local, ec);
     if (ec) {
-      throw core::UserError("--refbox-sockets: udp peer '" + c.name + "': cannot bind " +
-                            config_.address + ":" + std::to_string(c.send_port) + ": " +
-                            ec.message());
+      throw core::UserError("udp peer '" + c.name + "': cannot bind " + config_.address + ":" +
+                            std::to_string(c.send_port) + ": " + ec.message());
     }
     p->bound_port = p->socket.local_endpoint(ec).port();
     // A port chosen at bind time (send_port 0) may be another peer's recv_port: a frame would
     // then go round for ever (load_socket_config() refuses the fixed ports already).
     for (std::size_t j = 0; j < config_.udp_peers.size(); ++j) {
       if (config_.udp_peers[j].recv_port == p->bound_port) {
-        throw core::UserError("--refbox-sockets: udp peer '" + c.name + "': listening port " +
+        throw core::UserError("udp peer '" + c.name + "': listening port " +
                               std::to_string(p->bound_port) + " is the recv_port of '" +
                               config_.udp_peers[j].name + "' (a forwarding loop)");
       }
@@ -109,6 +109,7 @@ std::vector<sim::ExternalPeerConfig> RefboxSockets::external_peers() const {
 
 void RefboxSockets::attach(sim::Game& game) {
   LLSF_DEMAND(static_cast<std::size_t>(game.config().external_peers.size()) == peers_.size());
+  LLSF_DEMAND(game.config().hub.lock_messages == lock_messages_);
   game_ = &game;
   // The 2013 time base: the game's start (its time now) is the wall clock now.
   const auto wall = std::chrono::duration_cast<std::chrono::nanoseconds>(

@@ -28,16 +28,20 @@ class RefboxSockets {
  public:
   /// Binds the controllers' TCP server (unless `config.stream_enabled` is false) and one UDP
   /// socket per entry of `config.udp_peers` (config validated first). Throws core::UserError
-  /// naming the address and port that cannot be bound. `log` receives the transports' lines.
-  explicit RefboxSockets(comm::SocketConfig config, comm::LogSink log = comm::log_to_stderr);
+  /// naming the address and port that cannot be bound. `lock_messages` is the numbering of the
+  /// lock messages on the wire: the game's (its radio's `lock_messages`), so that a 2013 peer
+  /// sends and receives them as (2000, 1337/1338). `log` receives the transports' lines.
+  RefboxSockets(comm::SocketConfig config, comm::LockNumbering lock_messages,
+                comm::LogSink log = comm::log_to_stderr);
   ~RefboxSockets();
   RefboxSockets(const RefboxSockets&) = delete;
   RefboxSockets& operator=(const RefboxSockets&) = delete;
 
   /// The UDP peers as GameConfig::external_peers (same order, names and channels).
   std::vector<sim::ExternalPeerConfig> external_peers() const;
-  /// Serves `game` (borrowed until destruction; built with external_peers()) from now on: its
-  /// start is mapped to the wall clock now. Call before the first tick.
+  /// Serves `game` (borrowed until destruction; built with external_peers() and the lock
+  /// numbering given at construction) from now on: its start is mapped to the wall clock now.
+  /// Call before the first tick.
   void attach(sim::Game& game);
 
   /// After a tick: the refbox's messages of that tick for stream clients go to the TCP
@@ -71,6 +75,7 @@ class RefboxSockets {
   bool is_own_endpoint(const boost::asio::ip::udp::endpoint& ep) const;
 
   comm::SocketConfig config_;
+  comm::LockNumbering lock_messages_;
   comm::MessageRegistry registry_;  // before server_: borrowed by it
   std::unique_ptr<comm::StreamServer> server_;
   boost::asio::io_context io_;  // before the peers' sockets

@@ -31,8 +31,15 @@ int report(const ReportOptions& o, std::ostream& out, std::ostream& err) {
     const std::vector<study::StoredBatch> batches = store.batches();
     if (o.list) {
       for (const study::StoredBatch& b : batches) {
-        out << b.id << "  " << b.kind << "  " << b.scenario_name << "  " << b.scenario_file << "  "
-            << b.variants << " variant(s) x " << b.runs_per_variant << " run(s)  "
+        out << b.id << "  " << b.kind << "  " << b.scenario_name << "  " << b.scenario_file << "  ";
+        if (b.kind == "run") {
+          // The single games of `llsfsim run`: a collection with no planned size, never
+          // "finished" (docs/statistics.md), so neither finished nor unfinished.
+          out << b.variants << " variant(s), " << store.run_keys(b.id).size()
+              << " game(s) of llsfsim run\n";
+          continue;
+        }
+        out << b.variants << " variant(s) x " << b.runs_per_variant << " run(s)  "
             << (b.finished.empty() ? "unfinished" : "finished " + b.finished) << "\n";
       }
       return kExitOk;

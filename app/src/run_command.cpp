@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
@@ -22,6 +23,7 @@
 #include <thread>
 #include <vector>
 
+#include "cli_checks.h"
 #include "commands.h"
 #include "live.h"
 #include "llsf/app/cli.h"
@@ -56,6 +58,7 @@ struct RunOptions {
   bool no_record = false;
   bool no_reload = false;          // paced runs: do not reload changed CLIPS files
   bool strict = false;             ///< an agent mistake (RunIssue::is_mistake) fails the run
+  bool fail_fast = false;          ///< stop the game at the first agent error
   std::vector<std::string> trace;  ///< --trace ROBOT[:KINDS], repeatable
   std::string trace_file;          ///< "" = stderr
   bool no_record_agents = false;   ///< no facts/fact/rules lines in the recording
@@ -96,6 +99,12 @@ const study::Scenario* pick_variant(const study::ScenarioFile& f, const std::str
       return &s;
     }
   }
+  if (f.variants.size() == 1 && f.variants.front().variant.empty()) {
+    err << "llsfsim run: " << f.file << " has no matrix, so no variant '" << name
+        << "': play it without --variant (variants come from a scenario's `matrix`, "
+           "docs/scenarios.md)\n";
+    return nullptr;
+  }
   err << "llsfsim run: " << f.file << " has no variant '" << name << "'; its variants:\n";
   for (const study::Scenario& s : f.variants) err << "  " << s.variant << "\n";
   return nullptr;
@@ -125,8 +134,13 @@ void print_issues(const study::RunResult& r, std::ostream& out) {
     out << fmt::format("issue      {:7.1f} s {} {}{}: {}\n", i.time_s, i.robot, i.kind, where,
                        i.text);
   }
-  if (mistakes > 10)
-    out << fmt::format("issue      ... and {} more (--json lists them)\n", mistakes - 10);
+  // r.mistakes counts those not kept too (RunResult::kMaxIssues).
+  if (r.mistakes > std::min(mistakes, 10)) {
+    out << fmt::format(
+        "issue      ... and {} more mistakes, {} in all (--json lists the first {} "
+        "issues)\n",
+        r.mistakes - std::min(mistakes, 10), r.mistakes, study::RunResult::kMaxIssues);
+  }
   int shown = 0;
   for (const auto& [what, f] : failures) {
     if (shown++ >= 10) {
@@ -197,6 +211,10 @@ void print_summary(const study::RunResult& r, std::ostream& out) {
   }
 }
 
+/// Prints the agent warnings `run` shows before its game (a confval nobody reads, the sandbox
+/// off; `check` has them all), each once, on `err`.
+void print_run_warnings(const study::Scenario& s, std::ostream& err);
+
 int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
   study::ScenarioFile file;
   try {
@@ -208,6 +226,7 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
   const study::Scenario* s = pick_variant(file, o.variant, err);
   if (s == nullptr) return kExitBadInput;
   const std::uint64_t seed = o.seed.value_or(s->seeds.front());
+  if (!o.quiet) print_run_warnings(*s, err);
   // The statistics store is opened before playing so that a bad path costs no game.
   std::optional<study::StatsStore> store;
   study::BatchKey key;
@@ -237,10 +256,11 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
       if (!o.sockets_file.empty()) {
         sc = comm::load_socket_config(core::ConfigNode::load_file(o.sockets_file));
       }
-      sockets = std::make_unique<RefboxSockets>(sc, [&err](std::string_view line) {
-        err << "llsfsim run: " << line << "\n";
-        err.flush();
-      });
+      sockets = std::make_unique<RefboxSockets>(sc, played.game.hub.lock_messages,
+                                                [&err](std::string_view line) {
+                                                  err << "llsfsim run: " << line << "\n";
+                                                  err.flush();
+                                                });
       played.game.external_peers = sockets->external_peers();
       played.game.validate();
     } catch (const core::UserError& e) {
@@ -276,6 +296,7 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
     hooks.trace_sink = [trace_out](std::string_view line) { *trace_out << line << '\n'; };
   }
   hooks.record_agents = !o.no_record_agents;
+  hooks.stop_at_agent_error = o.fail_fast;
   if (!o.no_record) {
     hooks.record_path = o.record;
     if (hooks.record_path.empty()) {
@@ -423,26 +444,152 @@ std::vector<AgentSource> read_agent_sources(const std::vector<std::string>& entr
   return out;
 }
 
+/// The argument names a skill's documentation declares, one `@param NAME[, NAME...]` per line
+/// (docs/skills.md).
+std::vector<std::string> documented_params(const std::string& doc) {
+  std::vector<std::string> out;
+  for (std::size_t at = doc.find("@param"); at != std::string::npos;
+       at = doc.find("@param", at + 1)) {
+    std::size_t i = at + 6;
+    for (;;) {
+      while (i < doc.size() && (doc[i] == ' ' || doc[i] == '\t')) ++i;
+      std::size_t e = i;
+      while (e < doc.size() &&
+             (std::isalnum(static_cast<unsigned char>(doc[e])) != 0 || doc[e] == '_'))
+        ++e;
+      if (e == i) break;
+      out.push_back(doc.substr(i, e - i));
+      i = e;
+      if (i < doc.size() && doc[i] == ',') {
+        ++i;
+        continue;
+      }
+      break;
+    }
+  }
+  return out;
+}
+
+/// The literal argument names of a `(skill-call NAME key value key value ...)` whose name ends
+/// at `pos` of `code` (comments blanked): each key that is a plain symbol; stops at the call's
+/// `)` or at anything else (a variable or an expression in a key's place).
+std::vector<std::string> skill_call_arguments(const std::string& code, std::size_t pos) {
+  std::vector<std::string> out;
+  auto skip_space = [&] {
+    while (pos < code.size() && std::isspace(static_cast<unsigned char>(code[pos])) != 0) ++pos;
+  };
+  // Skips one value: a string, a parenthesised expression or a token.
+  auto skip_value = [&] {
+    if (pos >= code.size()) return;
+    if (code[pos] == '"') {
+      for (++pos; pos < code.size() && code[pos] != '"'; ++pos) {
+        if (code[pos] == '\\') ++pos;
+      }
+      ++pos;
+    } else if (code[pos] == '(') {
+      int depth = 0;
+      bool in_string = false;
+      for (; pos < code.size(); ++pos) {
+        const char c = code[pos];
+        if (in_string) {
+          if (c == '\\')
+            ++pos;
+          else if (c == '"')
+            in_string = false;
+        } else if (c == '"') {
+          in_string = true;
+        } else if (c == '(') {
+          ++depth;
+        } else if (c == ')' && --depth == 0) {
+          ++pos;
+          break;
+        }
+      }
+    } else {
+      while (pos < code.size() && std::isspace(static_cast<unsigned char>(code[pos])) == 0 &&
+             code[pos] != '(' && code[pos] != ')') {
+        ++pos;
+      }
+    }
+  };
+  for (;;) {
+    skip_space();
+    if (pos >= code.size() || code[pos] == ')') break;
+    const std::size_t b = pos;
+    while (pos < code.size() && (std::isalnum(static_cast<unsigned char>(code[pos])) != 0 ||
+                                 code[pos] == '_' || code[pos] == '-')) {
+      ++pos;
+    }
+    if (pos == b || (pos < code.size() && std::isspace(static_cast<unsigned char>(code[pos])) == 0))
+      break;  // not a plain symbol: a variable, an expression, a string
+    out.push_back(code.substr(b, pos - b));
+    skip_space();
+    skip_value();
+  }
+  return out;
+}
+
+/// One of `check`'s findings about an agent.
+struct AgentWarning {
+  enum class Kind { kWarn, kNote };
+  Kind kind = Kind::kWarn;
+  bool in_run = false;  ///< `run` prints it too (before the game, on stderr)
+  std::string text;
+  bool operator<(const AgentWarning& o) const { return text < o.text; }
+};
+
 /// `check`'s warnings about one robot's agent (docs/llsfsim.md, `check`): skill names in
-/// `(skill-call NAME ...)` the skill library does not have; confval paths the scenario sets that
-/// no agent file names, and the reverse; the lock switch against the agent's use of lock facts.
-std::vector<std::string> agent_warnings(const study::RobotSpec& spec,
-                                        const sim::AgentBrain& brain) {
-  std::vector<std::string> warnings;
+/// `(skill-call NAME ...)` the skill library does not have (with `brain` only); confval paths
+/// the scenario sets that no agent file names, and the reverse; the lock switch against the
+/// agent's use of lock facts; the sandbox switched off. Those marked in_run `run` prints too.
+std::vector<AgentWarning> agent_warnings(const study::RobotSpec& spec,
+                                         const sim::AgentBrain* brain) {
+  std::vector<AgentWarning> warnings;
+  auto warn = [&warnings](std::string text, bool in_run = false) {
+    warnings.push_back({AgentWarning::Kind::kWarn, in_run, std::move(text)});
+  };
+  auto note = [&warnings](std::string text, bool in_run = false) {
+    warnings.push_back({AgentWarning::Kind::kNote, in_run, std::move(text)});
+  };
   const std::vector<AgentSource> sources = read_agent_sources(spec.agent);
   std::vector<std::string> skills;
-  for (const lua::SkillInfo& s : brain.skills().engine().skills()) skills.push_back(s.name);
+  std::map<std::string, std::vector<std::string>> params;  // skill -> its @param names
+  if (brain != nullptr) {
+    for (const lua::SkillInfo& s : brain->skills().engine().skills()) {
+      skills.push_back(s.name);
+      params[s.name] = documented_params(s.documentation);
+    }
+  }
   static const std::regex kSkillCall(R"(\(skill-call\s+([A-Za-z_][A-Za-z0-9_]*))");
   static const std::regex kConfval(R"re("(/clips-agent/[^"\s]*)")re");
   std::vector<std::string> read_paths;  // literal paths in the agent (a trailing / is a prefix)
+  std::vector<std::string> read_where;  // each one's file:line
   bool uses_locks = false;
   for (const AgentSource& src : sources) {
     for (auto it = std::sregex_iterator(src.code.begin(), src.code.end(), kSkillCall);
          it != std::sregex_iterator(); ++it) {
       const std::string name = (*it)[1].str();
-      if (std::find(skills.begin(), skills.end(), name) != skills.end()) continue;
+      if (brain == nullptr) continue;
+      if (std::find(skills.begin(), skills.end(), name) != skills.end()) {
+        // Literal argument names the skill does not document (`plac` for `place`).
+        const std::vector<std::string>& known = params[name];
+        if (known.empty()) continue;  // a skill without @param lines: nothing to compare with
+        const std::size_t after = static_cast<std::size_t>(it->position() + it->length());
+        for (const std::string& arg : skill_call_arguments(src.code, after)) {
+          if (std::find(known.begin(), known.end(), arg) != known.end()) continue;
+          const auto meant = core::closest_match(arg, known);
+          std::string list;
+          for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
+          warn(
+              fmt::format("{}:{}: (skill-call {} {} ...): {} has no argument '{}' ({}its "
+                          "arguments: {})",
+                          src.file, src.line_of(static_cast<std::size_t>(it->position())), name,
+                          arg, name, arg, meant ? "did you mean '" + *meant + "'? " : "", list));
+        }
+        continue;
+      }
       const auto hint = core::closest_match(name, skills);
-      warnings.push_back(fmt::format(
+      warn(fmt::format(
           "{}:{}: (skill-call {} ...): the skill library has no skill "
           "'{}'{}",
           src.file, src.line_of(static_cast<std::size_t>(it->position())), name, name,
@@ -451,6 +598,8 @@ std::vector<std::string> agent_warnings(const study::RobotSpec& spec,
     for (auto it = std::sregex_iterator(src.code.begin(), src.code.end(), kConfval);
          it != std::sregex_iterator(); ++it) {
       read_paths.push_back((*it)[1].str());
+      read_where.push_back(
+          fmt::format("{}:{}", src.file, src.line_of(static_cast<std::size_t>(it->position()))));
     }
     if (src.code.find("resource-request") != std::string::npos ||
         src.code.find("(lock ") != std::string::npos ||
@@ -469,9 +618,15 @@ std::vector<std::string> agent_warnings(const study::RobotSpec& spec,
     if (e.path == "/clips-agent/use-locks") continue;  // the host's (robots.locks)
     set_paths.push_back(e.path);
     if (read_by_agent(e.path)) continue;
-    const auto hint = core::closest_match(e.path, read_paths);
-    warnings.push_back(fmt::format("robots.config: the agent reads no confval {}{}", e.path,
-                                   hint ? " (did you mean " + *hint + "?)" : ""));
+    // Either side may hold the typo: name the near path the agent reads and where, not a fix.
+    std::string near;
+    if (const auto hint = core::closest_match(e.path, read_paths)) {
+      const auto i = std::find(read_paths.begin(), read_paths.end(), *hint) - read_paths.begin();
+      near = fmt::format("; it reads {} ({}): one of the two is misspelt", *hint,
+                         read_where[static_cast<std::size_t>(i)]);
+    }
+    warn(fmt::format("robots.config: the agent reads no confval {}{}", e.path, near),
+         /*in_run=*/true);
   }
   std::sort(read_paths.begin(), read_paths.end());
   read_paths.erase(std::unique(read_paths.begin(), read_paths.end()), read_paths.end());
@@ -482,15 +637,32 @@ std::vector<std::string> agent_warnings(const study::RobotSpec& spec,
     unset += (unset.empty() ? "" : ", ") + p;
   }
   if (!unset.empty()) {
-    warnings.push_back("note: robots.config leaves these confvals of the agent at its defaults: " +
-                       unset);
+    note("robots.config leaves these confvals of the agent at its defaults: " + unset);
   }
   if (spec.locks && !uses_locks) {
-    warnings.push_back(
+    warn(
         "robots.locks is on, but the agent uses no lock facts (no resource-request or lock "
         "fact in its files): the lock protocol runs for nothing (set `robots.locks: false`?)");
   }
+  if (!spec.sandbox) {
+    note(
+        "robots.sandbox is off: the agent may open, load and write files and run programs "
+        "(docs/security.md); only for a trusted local agent",
+        /*in_run=*/true);
+  }
   return warnings;
+}
+
+void print_run_warnings(const study::Scenario& s, std::ostream& err) {
+  std::set<AgentWarning> shown;
+  for (const study::RobotSpec& spec : s.robots) {
+    if (spec.agent.empty()) continue;
+    for (AgentWarning& w : agent_warnings(spec, nullptr)) {
+      if (!w.in_run || !shown.insert(w).second) continue;
+      err << "llsfsim run: " << (w.kind == AgentWarning::Kind::kNote ? "note: " : "warn: ")
+          << w.text << "\n";
+    }
+  }
 }
 
 int check(const std::vector<std::string>& files, std::ostream& out, std::ostream& err) {
@@ -517,13 +689,10 @@ int check(const std::vector<std::string>& files, std::ostream& out, std::ostream
           for (const std::string& e : brain.skills().engine().load_errors()) {
             throw core::ConfigError("skill file error: " + e);
           }
-          for (const std::string& w : agent_warnings(spec, brain)) {
-            if (!warned.insert(w).second) continue;
-            if (w.starts_with("note: ")) {
-              out << "note " << path << ": " << w.substr(6) << "\n";
-            } else {
-              out << "warn " << path << ": " << w << "\n";
-            }
+          for (const AgentWarning& w : agent_warnings(spec, &brain)) {
+            if (!warned.insert(w.text).second) continue;
+            out << (w.kind == AgentWarning::Kind::kNote ? "note " : "warn ") << path << ": "
+                << w.text << "\n";
           }
         }
       }
@@ -541,7 +710,7 @@ int check(const std::vector<std::string>& files, std::ostream& out, std::ostream
 Action add_run_command(CLI::App& app) {
   auto o = std::make_shared<RunOptions>();
   app.add_option("scenario", o->scenario, "Scenario file (docs/scenarios.md)")->required();
-  app.add_option("--seed", o->seed, "Seed to play (default: the scenario's first)");
+  app.add_option("--seed", o->seed, "Seed to play (default: the scenario's first)")->check(kSeed);
   app.add_option("--variant", o->variant,
                  "Matrix variant, e.g. 'config=P3-P3' or just 'P3-P3' (default: the first)");
   app.add_flag("--json", o->json, "Print the summary as one JSON object");
@@ -550,6 +719,9 @@ Action add_run_command(CLI::App& app) {
                "Fail the run (exit 1) on any agent mistake: a runtime error (also a rule stopped "
                "by the work budget), a rule loop cut by the firing limit, a lock held over 300 s, "
                "an unknown skill (as the scenario key strict: true)");
+  app.add_flag("--fail-fast", o->fail_fast,
+               "Stop the game at the first agent error (a runtime error or a halted agent); the "
+               "run fails (exit 1)");
   auto* db = app.add_option("--db", o->db,
                             "Statistics store the run is written to: a SQLite file or a "
                             "postgresql://USER@HOST:PORT/DB URL (docs/statistics.md)")

@@ -8,6 +8,7 @@
 #include <pthread.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/tcp.hpp>
@@ -575,7 +576,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
              error_reply(http::status::payload_too_large,
                          fmt::format("the request body is larger than {} bytes",
                                      server_.options.max_body_bytes)),
-             /*close=*/true);
+             /*close=*/true, /*drain=*/true);
         return;
       }
       if (ec.category() == http::make_error_code(http::error::bad_target).category()) {
@@ -642,7 +643,22 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     send(req, server_.handle(*path));
   }
 
-  void send(const http::request<http::string_body>& req, Reply reply, bool close = false) {
+  // After refusing an upload: reads (and drops) what the client still sends, at most `left`
+  // bytes within the request timeout, so that closing does not reset the connection before the
+  // client read the refusal (its write would fail with "Broken pipe" and the 413 be lost).
+  void drain(std::uint64_t left) {
+    if (left == 0) return;
+    auto scratch = std::make_shared<std::array<char, 16384>>();
+    stream_.expires_after(server_.options.request_timeout);
+    stream_.async_read_some(asio::buffer(*scratch), [self = shared_from_this(), scratch, left](
+                                                        beast::error_code ec, std::size_t n) {
+      if (ec) return;  // the client closed (or the time is up): done
+      self->drain(n >= left ? 0 : left - n);
+    });
+  }
+
+  void send(const http::request<http::string_body>& req, Reply reply, bool close = false,
+            bool drain_after = false) {
     auto res = std::make_shared<http::response<http::string_body>>(
         reply.status, req.version() ? req.version() : 11);
     res->set(http::field::server, "llsfsim");
@@ -655,15 +671,20 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     res->body() = std::move(reply.body);
     res->prepare_payload();
     stream_.expires_after(kWriteTimeout);
-    http::async_write(stream_, *res,
-                      [self = shared_from_this(), res](beast::error_code ec, std::size_t) {
-                        if (ec) return;
-                        if (!res->keep_alive()) {
-                          self->stream_.socket().shutdown(tcp::socket::shutdown_send, ec);
-                          return;
-                        }
-                        self->read();
-                      });
+    http::async_write(
+        stream_, *res,
+        [self = shared_from_this(), res, drain_after](beast::error_code ec, std::size_t) {
+          if (ec) return;
+          if (!res->keep_alive()) {
+            self->stream_.socket().shutdown(tcp::socket::shutdown_send, ec);
+            if (drain_after) {
+              self->drain(64 * static_cast<std::uint64_t>(self->server_.options.max_body_bytes) +
+                          (1U << 20));
+            }
+            return;
+          }
+          self->read();
+        });
   }
 
   beast::tcp_stream stream_;

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_checks.h"
 #include "commands.h"
 #include "llsf/app/cli.h"
 #include "llsf/refbox/protocol.h"
@@ -250,7 +251,9 @@ Action add_skill_command(CLI::App& app) {
   app.add_option("--robots", o->robots, "Robots on the field (the others stand still)")
       ->capture_default_str()
       ->check(CLI::Range(1, 3));
-  app.add_option("--seed", o->seed, "Scenario seed (game plan, noise)")->capture_default_str();
+  app.add_option("--seed", o->seed, "Scenario seed (game plan, noise)")
+      ->capture_default_str()
+      ->check(kSeed);
   app.add_option("--phase", o->phase, "Refbox phase to run in")
       ->capture_default_str()
       ->check(CLI::IsMember({"pre_game", "setup", "exploration", "production"}));
@@ -276,10 +279,10 @@ Action add_skill_command(CLI::App& app) {
       ->check(CLI::ExistingDirectory);
   app.add_option("--timeout", o->timeout_s, "Seconds of game time each skill string may run")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   app.add_option("--after", o->after_s, "Seconds of game time to play before the first string")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegative);
   app.add_flag("--trace", o->trace, "Also print every state change of every skill's FSM");
   app.add_option("--record", o->record,
                  "Also write the game's recording to FILE (gzip JSON lines: poses, events, the "

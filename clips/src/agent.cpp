@@ -12,6 +12,7 @@
 #include "feature.h"
 #include "llsf/core/config.h"
 #include "llsf/core/input_file.h"
+#include "llsf/core/text.h"
 #include "sandbox.h"
 #include "tracer.h"
 
@@ -203,6 +204,43 @@ struct AgentHost::Impl {
     report_errors();
   }
 
+  // CLIPS' message for a misspelt function or slot with the name meant: "Missing function
+  // declaration for prinout." gets " (did you mean 'printout'?)", "Invalid slot plac not defined
+  // in corresponding deftemplate job." the nearest slot of job.
+  std::string with_hint(std::string msg) const {
+    auto word_after = [&msg](std::string_view lead, std::size_t& end) -> std::string {
+      const std::size_t at = msg.find(lead);
+      if (at == std::string::npos) return {};
+      const std::size_t b = at + lead.size();
+      end = b;
+      while (end < msg.size() && std::isspace(static_cast<unsigned char>(msg[end])) == 0) ++end;
+      std::string w = msg.substr(b, end - b);
+      while (!w.empty() && w.back() == '.') {
+        w.pop_back();
+        --end;
+      }
+      return w;
+    };
+    std::size_t end = 0;
+    if (const std::string fn = word_after("Missing function declaration for ", end); !fn.empty()) {
+      if (const auto m = core::closest_match(fn, env.callable_names())) {
+        msg.insert(end, " (did you mean '" + *m + "'?)");
+      }
+      return msg;
+    }
+    std::size_t slot_end = 0;
+    const std::string slot = word_after("Invalid slot ", slot_end);
+    std::size_t tmpl_end = 0;
+    const std::string tmpl = word_after("corresponding deftemplate ", tmpl_end);
+    if (!slot.empty() && !tmpl.empty()) {
+      const std::vector<std::string> slots = env.template_slot_names(tmpl);
+      if (const auto m = core::closest_match(slot, slots)) {
+        msg.insert(tmpl_end, " (did you mean '" + *m + "'?)");
+      }
+    }
+    return msg;
+  }
+
   // Logs collected error output as one runtime error, naming the rule CLIPS stopped.
   int report_errors() {
     if (werror.empty()) return 0;
@@ -218,7 +256,7 @@ struct AgentHost::Impl {
       if (auto first = text.find("[PRCCODE4]"); first > 0) text = text.substr(0, first);
     }
     if (rule.empty()) rule = werror_rule;
-    std::string msg = one_line(text);
+    std::string msg = with_hint(one_line(text));
     if (!budget_reason.empty()) {
       msg = budget_reason;
       budget_reason.clear();
@@ -312,7 +350,11 @@ struct AgentHost::Impl {
     std::string msg;
     for (const auto& e : errors) {
       if (!msg.empty()) msg += '\n';
-      msg.append(source).append(":").append(std::to_string(e.line)).append(": ").append(e.message);
+      msg.append(source)
+          .append(":")
+          .append(std::to_string(e.line))
+          .append(": ")
+          .append(with_hint(e.message));
     }
     throw AgentLoadError(msg);
   }

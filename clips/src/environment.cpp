@@ -1150,6 +1150,29 @@ void Environment::build(const std::string& construct) {
   if (!errors.empty()) throw std::logic_error("CLIPS: built-in construct: " + errors[0].message);
 }
 
+std::vector<std::string> Environment::callable_names() const {
+  std::vector<std::string> out;
+  for (struct FunctionDefinition* f = GetFunctionList(env_); f != nullptr; f = f->next) {
+    std::string name = ValueToString(f->callFunctionName);
+    if (forbidden_.find(name) == forbidden_.end()) out.push_back(std::move(name));
+  }
+  for (void* f = EnvGetNextDeffunction(env_, nullptr); f; f = EnvGetNextDeffunction(env_, f))
+    out.emplace_back(EnvGetDeffunctionName(env_, f));
+  for (void* g = EnvGetNextDefgeneric(env_, nullptr); g; g = EnvGetNextDefgeneric(env_, g))
+    out.emplace_back(EnvGetDefgenericName(env_, g));
+  return out;
+}
+
+std::vector<std::string> Environment::template_slot_names(const std::string& name) const {
+  std::vector<std::string> out;
+  void* t = EnvFindDeftemplate(env_, name.c_str());
+  if (t == nullptr || static_cast<struct deftemplate*>(t)->implied) return out;
+  DATA_OBJECT names;
+  EnvDeftemplateSlotNames(env_, t, &names);
+  for (const auto& v : to_value(env_, names).items) out.push_back(v.text);
+  return out;
+}
+
 Template Environment::find_template(const std::string& name) {
   Template t;
   t.ptr = EnvFindDeftemplate(env_, name.c_str());

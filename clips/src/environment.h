@@ -163,6 +163,11 @@ class Environment {
   void guard_concatenation(const std::string& name);
   /// Why `name` is forbidden (forbid_function).
   std::string forbidden_reason(std::string_view name) const;
+  /// The names an agent may call: CLIPS' and llsfsim's functions (not the forbidden ones), the
+  /// deffunctions and defgenerics (for "did you mean").
+  std::vector<std::string> callable_names() const;
+  /// The slot names of deftemplate `name` (empty if there is none or it is ordered).
+  std::vector<std::string> template_slot_names(const std::string& name) const;
   /// Reports a bad call: prints "[LLSF1] name: message" to werror and sets CLIPS' evaluation
   /// error, which stops the rule's actions (the host then logs it as a runtime error).
   void error(std::string_view function, std::string_view message);

@@ -825,7 +825,10 @@ class CaseRunner {
   bool run(const std::vector<Step>& steps) {
     for (const Step& s : steps) {
       try {
-        if (!exec(s)) return false;
+        if (!exec(s)) {
+          runtime_errors_context();
+          return false;
+        }
       } catch (const PatternMismatch& e) {
         r_.bad_input = true;
         return fail(s, e.what());
@@ -859,6 +862,18 @@ class CaseRunner {
   void add_error_lines() {
     for (const LoggedLine& l : f_.log())
       if (l.level == LogLevel::kError) context(l.text);
+  }
+
+  // A failed expectation is often the effect of a runtime error earlier in the case (the rule
+  // stopped before it asserted or called what was expected): show the errors with it, not only
+  // with -v.
+  void runtime_errors_context() {
+    const int n = f_.agent().runtime_errors();
+    if (n == 0) return;
+    context("the agent had " + std::to_string(n) + " runtime error" + (n == 1 ? "" : "s") +
+            " (a likely cause):");
+    for (const LoggedLine& l : f_.log())
+      if (l.level == LogLevel::kError) context("  " + l.text);
   }
 
   void facts_context(const std::string& template_name) {

@@ -66,6 +66,7 @@ void StreamConnection::on_bytes(std::size_t n) {
     MessageRegistry::Decoded d = registry_->decode(next.frame);
     if (d.error != FrameError::kNone) {
       ++counters_->malformed[static_cast<std::size_t>(d.error)];
+      log_dropped(next.frame, d.error);
       continue;  // the framing is intact: skip this frame only
     }
     ++counters_->frames_in;
@@ -79,6 +80,26 @@ void StreamConnection::on_bytes(std::size_t n) {
     if (!open_) return;  // the sink closed us
   }
   watch_partial_frame(frame_done);
+}
+
+void StreamConnection::log_dropped(const FrameView& frame, FrameError error) {
+  // A tool speaking another dialect (other message numbers, another .proto) should see why its
+  // frames do nothing, but a client sending garbage must not flood the log.
+  if (!limits_.log || dropped_logged_ > kMaxDroppedLogged) return;
+  if (dropped_logged_++ == kMaxDroppedLogged) {
+    limits_.log("stream " + peer_ + ": more frames dropped; they are counted, not logged");
+    return;
+  }
+  const std::string why =
+      error == FrameError::kUnknownType  ? "no message type is registered under these numbers"
+      : error == FrameError::kBadPayload ? "the payload does not parse as that type (a missing "
+                                           "required field or another .proto)"
+                                         : std::string(frame_error_name(error));
+  limits_.log("stream " + peer_ + ": dropped a frame (component " +
+              std::to_string(frame.header.key.component_id) + ", type " +
+              std::to_string(frame.header.key.msg_type) + ", " +
+              std::to_string(frame.header.payload_size) +
+              " payload bytes): " + std::string(frame_error_name(error)) + ": " + why);
 }
 
 void StreamConnection::watch_partial_frame(bool frame_done) {

@@ -51,6 +51,8 @@ class StreamConnection : public std::enable_shared_from_this<StreamConnection> {
   /// Arms the partial-frame timer when a frame is incomplete (again when a new frame started
   /// after `frame_done`), disarms it when none is.
   void watch_partial_frame(bool frame_done);
+  // Logs a frame dropped for `error` (the first kMaxDroppedLogged of the connection).
+  void log_dropped(const FrameView& frame, FrameError error);
   /// Closes for a limit: logs "stream <peer>: <reason>: <detail>" and records the reason.
   void close_for(const char* reason, const std::string& detail);
 
@@ -68,8 +70,10 @@ class StreamConnection : public std::enable_shared_from_this<StreamConnection> {
   /// The frame async_write is writing (empty when none): Asio reads it until the completion
   /// runs, even after close(), so only on_written() releases it.
   std::vector<std::uint8_t> in_flight_;
-  std::int64_t queued_bytes_ = 0;        ///< in write_queue_ and in_flight_
-  std::int64_t partial_generation_ = 0;  ///< bumped whenever the partial-frame watch changes
+  std::int64_t queued_bytes_ = 0;               ///< in write_queue_ and in_flight_
+  std::int64_t partial_generation_ = 0;         ///< bumped whenever the partial-frame watch changes
+  static constexpr int kMaxDroppedLogged = 10;  ///< dropped frames logged per connection
+  int dropped_logged_ = 0;
   bool partial_watched_ = false;
   bool writing_ = false;  ///< an async_write of in_flight_ is under way
   bool open_ = true;

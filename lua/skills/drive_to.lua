@@ -41,9 +41,24 @@ local function timed_out(self, vars)
    return true
 end
 
+-- What was given, for the error: `"1.5" (a string)`, `nil`.
+local function given(v)
+   if type(v) == "string" then return string.format("%q (a string)", v) end
+   return tostring(v)
+end
+
 local function bad_args(self, vars)
-   if vars.place ~= nil then return type(vars.place) ~= "string" end
-   return type(vars.x) ~= "number" or type(vars.y) ~= "number"
+   local why
+   if vars.place ~= nil then
+      if type(vars.place) ~= "string" then
+         why = "place= must be a place name, not " .. given(vars.place)
+      end
+   elseif type(vars.x) ~= "number" or type(vars.y) ~= "number" then
+      why = string.format("x= and y= must be numbers (got x=%s, y=%s)", given(vars.x),
+                          given(vars.y))
+   end
+   if why then self.fsm.error = "drive_to needs place=<name> or x=, y=: " .. why end
+   return why ~= nil
 end
 
 fsm:define_states{ export_to=_M,
@@ -51,7 +66,7 @@ fsm:define_states{ export_to=_M,
 }
 
 fsm:add_transitions{
-   {"DRIVE", "FAILED", precond=bad_args, error="drive_to needs place=<name> or x=, y="},
+   {"DRIVE", "FAILED", precond=bad_args},
    {"DRIVE", "FINAL", cond="navigator:arrived() and navigator:msgid() == vars.msgid",
     desc="arrived"},
    {"DRIVE", "FAILED", cond=navigator_failed, desc="navigator failed"},

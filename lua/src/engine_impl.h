@@ -135,5 +135,8 @@ void push_pattern_functions(lua_State* L);
 /// Registers the robot interfaces: pushes a table type name -> interface object, and sets the
 /// globals the prelude reads from `native` (clock, interface names).
 void push_interfaces(lua_State* L);
+/// The method names of every interface type (pose:get, puck_detector:nearest, ...), each once:
+/// for the "did you mean" of a misspelt method.
+std::vector<std::string> interface_method_names();
 
 }  // namespace llsf::lua

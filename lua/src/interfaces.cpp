@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: MIT
 // The robot interfaces skills declare in depends_interfaces (the simulated Fawkes blackboard),
 // bound to RobotApi: every read goes to the robot at call time; commands take effect at once.
+#include <algorithm>
 #include <cmath>
 #include <exception>
 #include <limits>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -641,7 +643,16 @@ void light_constants(lua_State* L) {
 
 }  // namespace
 
-void push_interfaces(lua_State* L) {
+namespace {
+
+struct InterfaceEntry {
+  const char* type;
+  const luaL_Reg* methods;
+  void (*extra)(lua_State*);
+};
+
+// Every interface type with its methods (the interface objects' metatables serve these).
+std::span<const InterfaceEntry> interface_entries() {
   static const luaL_Reg pose[] = {{"x", pose_x},         {"y", pose_y},
                                   {"theta", pose_theta}, {"ori", pose_theta},
                                   {"get", pose_get},     {"is_valid", pose_is_valid},
@@ -689,28 +700,39 @@ void push_interfaces(lua_State* L) {
   static const luaL_Reg sym[] = {{"active", sym_active}, {"travel", sym_travel},
                                  {"move", sym_move},     {"pick", sym_pick},
                                  {"drop", sym_drop},     {nullptr, nullptr}};
+
+  static const InterfaceEntry entries[] = {{"Position3DInterface", pose, nullptr},
+                                           {"NavigatorInterface", navigator, nullptr},
+                                           {"MotorInterface", motor, nullptr},
+                                           {"RobotinoSensorInterface", sensor, nullptr},
+                                           {"RobotinoLightInterface", light, light_constants},
+                                           {"PuckVisionInterface", pucks, nullptr},
+                                           {"Laser360Interface", laser, nullptr},
+                                           {"ColourPuckInterface", colour_pucks, nullptr},
+                                           {"RescueInterface", rescue, nullptr},
+                                           {"SymbolicInterface", sym, nullptr}};
+  return entries;
+}
+
+}  // namespace
+
+std::vector<std::string> interface_method_names() {
+  std::vector<std::string> out;
+  for (const InterfaceEntry& en : interface_entries()) {
+    for (const luaL_Reg* m = en.methods; m->name != nullptr; ++m) {
+      if (std::find(out.begin(), out.end(), m->name) == out.end()) out.emplace_back(m->name);
+    }
+  }
+  return out;
+}
+
+void push_interfaces(lua_State* L) {
   static const luaL_Reg clock[] = {
       {"now", clock_now}, {"now_ns", clock_now_ns}, {nullptr, nullptr}};
-
-  struct Entry {
-    const char* type;
-    const luaL_Reg* methods;
-    void (*extra)(lua_State*);
-  };
-  const Entry entries[] = {{"Position3DInterface", pose, nullptr},
-                           {"NavigatorInterface", navigator, nullptr},
-                           {"MotorInterface", motor, nullptr},
-                           {"RobotinoSensorInterface", sensor, nullptr},
-                           {"RobotinoLightInterface", light, light_constants},
-                           {"PuckVisionInterface", pucks, nullptr},
-                           {"Laser360Interface", laser, nullptr},
-                           {"ColourPuckInterface", colour_pucks, nullptr},
-                           {"RescueInterface", rescue, nullptr},
-                           {"SymbolicInterface", sym, nullptr}};
   // native (at -1).interfaces = {Type = object, ...}; native.interface_names = "A, B, ..."
   lua_newtable(L);
   std::string names;
-  for (const Entry& en : entries) {
+  for (const InterfaceEntry& en : interface_entries()) {
     push_object(L, en.type, en.methods, en.extra);
     lua_setfield(L, -2, en.type);
     if (!names.empty()) names += ", ";

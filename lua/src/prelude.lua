@@ -327,12 +327,6 @@ local function undeclared(h, k, env)
     return "undeclared global 'fsm': create the state machine first: " ..
            "fsm = SkillHSM:new{name=name, start=\"STATE\"}"
   end
-  -- A state used before fsm:define_states{...} made it (states are globals it exports).
-  local fsm = env and rawget(env, "fsm")
-  if type(k) == "string" and fsms[fsm] and #fsm.state_list <= 2 and k:find("^[%u_][%u%d_]*$") then
-    return fmt("undeclared global '%s': no state is defined yet: call fsm:define_states{...} " ..
-               "before using a state (function %s:init() ...)", k, k)
-  end
   local candidates = {}
   if env then
     for name in next, env do candidates[#candidates + 1] = name end
@@ -341,7 +335,17 @@ local function undeclared(h, k, env)
   for name in pairs(h.bindings) do candidates[#candidates + 1] = name end
   for name in pairs(conventional_vars) do candidates[#candidates + 1] = name end
   for name in pairs(handles) do candidates[#candidates + 1] = name end
-  return fmt("undeclared global '%s'%s", tostring(k), did_you_mean(k, candidates))
+  local meant = did_you_mean(k, candidates)
+  -- An upper-case name before fsm:define_states{...} made any state (states are globals it
+  -- exports) may be a state used too early, or a constant or typo: say both.
+  local fsm = env and rawget(env, "fsm")
+  if type(k) == "string" and meant == "" and fsms[fsm] and #fsm.state_list <= 2 and
+     k:find("^[%u_][%u%d_]*$") then
+    return fmt("undeclared global '%s': if it is a state, no state is defined yet: call " ..
+               "fsm:define_states{...} before using it (function %s:init() ...); otherwise " ..
+               "define it before this line (local %s = ...)", k, k, k)
+  end
+  return fmt("undeclared global '%s'%s", tostring(k), meant)
 end
 
 -- The environment of one skill module: declarations are checked as they are assigned, reads of
@@ -495,6 +499,7 @@ function SkillHSM:define_states(spec)
       error(fmt("define_states: state '%s': class must be JumpState or SkillJumpState", name), 2)
     end
     local st = new_state(self, name, class.kind)
+    st.where = where(2)
     if class == SkillJumpState then
       if type(e.skills) ~= "table" or #e.skills == 0 then
         error(fmt("SkillJumpState '%s' needs skills={{skill}, ...}", name), 2)
@@ -541,7 +546,15 @@ local function compile_cond(fsm, c, what, loc, lvl)
   if type(c) ~= "string" then error(fmt("%s must be a function, a string or true", what), lvl) end
   local f, err = load("local self, vars, fsm = ...; return (" .. c .. ")",
                       "=" .. loc .. " " .. what, "t", fsm.cond_env)
-  if not f then error(fmt("bad %s \"%s\": %s", what, c, err), lvl) end
+  if not f then
+    -- A lone `=` (an assignment, not a comparison) is the usual cause: say so, not "')' expected".
+    local bare = (" " .. c .. " "):gsub("[=~<>]=", "  ")
+    if bare:find("=", 1, true) then
+      error(fmt("bad %s \"%s\": `=` assigns; a condition compares with `==` (or `~=`)", what, c),
+            lvl)
+    end
+    error(fmt("bad %s \"%s\": %s", what, c, err), lvl)
+  end
   return f
 end
 
@@ -634,7 +647,8 @@ local function enter(fsm, st, now)
       fsm.running = st
       if holds(tr.precond, st, fsm) then
         if tr.to == fsm.failed and not fsm.error then
-          fsm.error = tr.error or fmt("%s: precondition %s", st.name, tr.label)
+          -- A function precondition may have said why (self.fsm.error): keep its words.
+          fsm.error = fsm.error or tr.error or fmt("%s: precondition %s", st.name, tr.label)
         end
         if fsm.debug then log(0, fmt("%s: %s -> %s (precond)", fsm.name, st.name, tr.to.name)) end
         st = tr.to
@@ -749,6 +763,7 @@ local function fsm_step(fsm)
     path[#path + 1] = st.name
   end
   if trs or fsm.spin ~= nil then watch_spin(fsm, now, path, trs, progress) end
+  fsm.passed = path  -- the states this step went through (nil: it stayed), for skill_state
   if st.kind == "final" then return S_FINAL end
   if st.kind == "failed" then
     fsm.error = fsm.error or "FAILED"
@@ -766,7 +781,11 @@ local function step(h)
   if h.fsm then return fsm_step(h.fsm), h.fsm.error end
   local s, err = h.env.execute(h.vars)
   if s ~= S_RUNNING and s ~= S_FINAL and s ~= S_FAILED then
-    error(fmt("execute() returned %s, expected S_RUNNING, S_FINAL or S_FAILED", tostring(s)))
+    -- At the skill's execute (where the `return` is missing or wrong), not at this line.
+    local info = debug_getinfo(h.env.execute, "S")
+    error(fmt("%s:%d: %s: execute() returned %s, expected S_RUNNING, S_FINAL or S_FAILED%s",
+              info.short_src, info.linedefined, h.name, tostring(s),
+              s == nil and " (a path through execute() without a `return`?)" or ""), 0)
   end
   return s, err
 end
@@ -792,6 +811,7 @@ reset_skill = function(h)
   end
   if h.fsm then
     h.fsm.current, h.fsm.error, h.fsm.result, h.fsm.vars = nil, nil, nil, {}
+    h.fsm.passed = nil
     h.fsm.spin = nil
     for _, st in ipairs(h.fsm.state_list) do st.visit = 0 end
   end
@@ -936,6 +956,19 @@ function E.finish_module(name)
                 unknown_state(fsm, fsm.start)), 0)
     end
     h.fsm = fsm
+    -- A state nothing leaves (no transition, timeout, precondition or sub-skill, no transition
+    -- of every state) would only show as "still running" at the end: warn at load.
+    if #fsm.defaults == 0 then
+      for _, st in ipairs(fsm.state_list) do
+        if st.kind ~= "final" and st.kind ~= "failed" and not st.skills and
+           #st.transitions == 0 and #st.preconds == 0 then
+          log(2, fmt("%s: %s: state '%s' has no way out: no transition, timeout or sub-skill " ..
+                     "leaves it, so the skill would stay there; add one (fsm:add_transitions" ..
+                     "{{\"%s\", \"STATE\", cond=...}} or timeout=SECS)", st.where or at, h.name,
+                     st.name, st.name))
+        end
+      end
+    end
   elseif type(rawget(env, "execute")) ~= "function" then
     fail("the skill has no state machine: add fsm = SkillHSM:new{name=name, start=\"STATE\"} " ..
          "and its fsm:define_states{...} (or an execute() function)")
@@ -975,10 +1008,15 @@ function E.skill_info(name)
          h.documentation or "", concat(h.depends, ",")
 end
 
--- Only the state (SkillBrain asks it in every cycle while a state listener is set).
+-- Only the state (SkillBrain asks it in every cycle while a state listener is set), the states
+-- the last step went through ("GO,NEXT,GO"; nil if it stayed in one), so that states passed
+-- within one cycle are seen too, and that step's number (a step not taken reports nothing new).
 function E.skill_state(name)
   local h = handles[name]
-  return h and h.fsm and h.fsm.current and h.fsm.current.name or ""
+  local fsm = h and h.fsm
+  if not fsm then return "" end
+  return fsm.current and fsm.current.name or "", fsm.passed and concat(fsm.passed, ",") or nil,
+         fsm.step_id
 end
 
 local string_env = setmetatable({}, {

@@ -21,6 +21,7 @@
 #include "llsf/core/assert.h"
 #include "llsf/core/error.h"
 #include "llsf/core/input_file.h"
+#include "llsf/core/text.h"
 
 namespace llsf::lua {
 
@@ -378,6 +379,21 @@ int SkillEngine::Impl::protected_call(int nargs, int nresults) {
 }
 
 std::string SkillEngine::Impl::explain(std::string msg) const {
+  // A misspelt interface method (`puck_detector:nearst()`): Lua says "attempt to call a nil
+  // value (method 'nearst')"; name the method meant.
+  if (const std::size_t m = msg.find("(method '"); m != std::string::npos) {
+    const std::size_t begin = m + 9;
+    const std::size_t end = msg.find('\'', begin);
+    if (end != std::string::npos) {
+      static const std::vector<std::string> methods = interface_method_names();
+      const std::string name = msg.substr(begin, end - begin);
+      if (std::find(methods.begin(), methods.end(), name) == methods.end()) {
+        if (const auto meant = core::closest_match(name, methods)) {
+          msg.insert(end + 2, " (did you mean '" + *meant + "'?)");
+        }
+      }
+    }
+  }
   if (!heap.exhausted && !heap.limit_hit) return msg;
   const std::string_view oom = "not enough memory";
   std::size_t at = msg.find(oom);
@@ -718,6 +734,26 @@ std::string SkillEngine::skill_state(std::string_view skill) const {
   if (e.call_entry("skill_state", 1, 1) == LUA_OK) {
     const char* s = lua_tostring(e.L, -1);
     if (s != nullptr) out = s;
+  }
+  lua_settop(e.L, 0);
+  return out;
+}
+
+SkillEngine::StatePath SkillEngine::skill_state_path(std::string_view skill) const {
+  Impl& e = *impl_;
+  lua_pushlstring(e.L, skill.data(), skill.size());
+  StatePath out;
+  if (e.call_entry("skill_state", 1, 3) == LUA_OK) {
+    if (const char* p = lua_tostring(e.L, -2); p != nullptr) {
+      const std::string_view path(p);
+      std::size_t b = 0;
+      while (b <= path.size()) {
+        const std::size_t c = std::min(path.find(',', b), path.size());
+        out.states.emplace_back(path.substr(b, c - b));
+        b = c + 1;
+      }
+    }
+    out.step = static_cast<std::int64_t>(lua_tointeger(e.L, -1));
   }
   lua_settop(e.L, 0);
   return out;

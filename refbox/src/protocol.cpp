@@ -363,9 +363,11 @@ void RefboxProtocol::client_connected(int client) {
   if (std::find(clients_.begin(), clients_.end(), client) != clients_.end()) return;
   clients_.push_back(client);
   new_clients_.push_back(client);
-  // Spec §9.6: the periodic messages a controller needs go out at once.
-  for (Timer* t : {&game_state_, &robot_info_stream_, &robot_info_peer_, &machine_info_robot_,
-                   &machine_info_controller_, &puck_info_, &order_info_}) {
+  // Spec §9.6: the periodic messages a controller needs go out at once; the peers-only ones
+  // (RobotInfo and MachineInfo to robots) keep their rhythm, as in 0.6.1 (a controller
+  // reconnecting in a loop must not flood the robots).
+  for (Timer* t :
+       {&game_state_, &robot_info_stream_, &machine_info_controller_, &puck_info_, &order_info_}) {
     t->due = std::min(t->due, now_);
     t->restart = true;
   }

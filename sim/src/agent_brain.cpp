@@ -30,6 +30,7 @@ AgentBrain::AgentBrain(Game& game, int index, AgentBrainConfig config, clips::Lo
   core::RandomStream seed = game.rng().stream("clips/" + ac.robot_name);
   ac.seed = seed.next_u64();
   ac.max_rules_per_cycle = config.max_rules_per_cycle;
+  max_runaway_cycles_ = config.max_runaway_cycles;
   ac.sandbox = config.sandbox;
   ac.config = std::move(config.config);
   if (config.locks) {
@@ -117,6 +118,9 @@ AgentBrain::Reload AgentBrain::reload_if_changed() {
     errors_before_reload_ += agent_->runtime_errors();
     agent_ = std::move(fresh);
     if (trace_sink_) agent_->set_trace(trace_options_, trace_sink_);
+    // New rules: a halted agent gets another chance.
+    rule_loops_ = budget_stops_ = 0;
+    halt_.reset();
     r.reloaded = true;
     r.text = "agent reloaded (" + which + "); it restarts with its new rules";
   } catch (const clips::AgentLoadError& e) {
@@ -136,12 +140,29 @@ void AgentBrain::set_trace(clips::TraceOptions options, clips::TraceSink sink) {
 void AgentBrain::on_skill_cycle(lua::RobotApi& robot) { skills_->on_skill_cycle(robot); }
 
 void AgentBrain::on_agent_cycle(lua::RobotApi& robot, RobotRadio& radio) {
+  if (halt_) return;  // halted: no cycle (the game clears the inbox)
   const lua::PoseEstimate pose = robot.pose();
   if (pose.valid) agent_->set_pose(pose.pose);
   for (Received& r : radio.inbox()) {
     if (r.message) agent_->receive(std::move(r.message), r.from, r.from_id, r.at);
   }
-  agent_->cycle(robot.now());
+  const clips::CycleResult c = agent_->cycle(robot.now());
+  // A runaway agent is halted after a bounded number of runaway cycles: each costs a whole
+  // budget of CPU (10,000 firings or 10^6 steps), and the game would crawl on for hours.
+  if (c.limit_reached) ++rule_loops_;
+  if (c.budget_exceeded) ++budget_stops_;
+  if (max_runaway_cycles_ <= 0 || rule_loops_ + budget_stops_ < max_runaway_cycles_) return;
+  skills_->engine().stop();  // aborts the skill string and stops the robot
+  Halt h;
+  h.time = robot.now();
+  h.rule_loops = rule_loops_;
+  h.budget_stops = budget_stops_;
+  h.text = "agent halted after " + std::to_string(rule_loops_ + budget_stops_) +
+           " runaway cycles (" + std::to_string(rule_loops_) + " cut by the rule firing limit, " +
+           std::to_string(budget_stops_) +
+           " stopped by the work budget; the issues before name the rules): it cycles no more "
+           "and the robot stops for the rest of the game";
+  halt_ = std::move(h);
 }
 
 void AgentBrain::exec(std::string_view skill_string) { skills_->exec(skill_string); }

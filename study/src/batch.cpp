@@ -381,6 +381,11 @@ BatchResult run_batch(const ScenarioFile& file, const std::string& scenario_hash
       ++result.played;
       ++progress.done;
       progress.failed += d.result.passed() ? 0 : 1;
+      if (options.fail_fast && !result.agent_error && d.result.agent_error()) {
+        result.agent_error = (d.result.variant.empty() ? "" : d.result.variant + " ") + "seed " +
+                             std::to_string(d.result.seed);
+        stop_workers = true;  // no new game; the running ones finish and are stored
+      }
       progress.elapsed_s =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       if (hooks.stored) hooks.stored(d.result, progress);

@@ -158,6 +158,21 @@ std::string to_csv(const BatchReport& r) {
 }
 
 namespace {
+/// `v` with `digits` decimals as the HTML report shows it (JavaScript's toFixed, Math.round): the
+/// nearest, and an exact tie away from zero -- printf would round it to even (2.25 -> "2.2"
+/// beside the page's "2.3", 62.5 % -> 62 beside 63).
+std::string fixed(double v, int digits) {
+  if (std::isfinite(v)) {
+    // An exact tie (|v| * 10^digits ends in .5 exactly) is a dyadic |v| = m / 2^(digits+1), m odd.
+    const double t = std::ldexp(std::fabs(v), digits + 1);
+    if (t < 9007199254740992.0 && t == std::floor(t) && std::fmod(t, 2.0) == 1.0) {
+      v = std::nextafter(v, v > 0.0 ? HUGE_VAL : -HUGE_VAL);
+    }
+  }
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
+  return buf;
+}
 
 /// The games a difference rests on: "30 pairs", "30 vs 28 games", and the runs left out.
 std::string games_text(const Comparison& c) {
@@ -183,9 +198,14 @@ std::string games_needed_text(const Comparison& c) {
 /// One line of the differences: value, interval, star, and what the runs allow.
 std::string difference_line(const Difference& d) {
   const Comparison& c = d.comparison;
+  // Rounded as the HTML page rounds (fixed()), no "-0.0".
+  auto sign = [](double x) {
+    if (x == 0.0) x = 0.0;
+    return (x >= 0.0 ? "+" : "") + fixed(x, 1);
+  };
   char numbers[96];
-  std::snprintf(numbers, sizeof numbers, " %+8.1f  [%+.1f, %+.1f]%s  (", d.diff, d.ci_low,
-                d.ci_high, d.separated ? "  *" : "");
+  std::snprintf(numbers, sizeof numbers, " %8s  [%s, %s]%s  (", sign(d.diff).c_str(),
+                sign(d.ci_low).c_str(), sign(d.ci_high).c_str(), d.separated ? "  *" : "");
   std::string out = d.variant;
   if (out.size() < 28) out.resize(28, ' ');
   out += numbers + games_text(c);
@@ -211,10 +231,13 @@ std::string to_text(const BatchReport& r) {
     const StatSummary* p = v.find("points");
     StatSummary none;
     if (p == nullptr) p = &none;
-    std::snprintf(line, sizeof line, "%-28s %5d %5.0f%%  %7.1f %7.1f %7.1f %7.1f %7.0f %7.0f\n",
+    // The pass rate as the page computes it: pass_rate (passed / runs) times 100.
+    const double rate = v.runs > 0 ? static_cast<double>(v.passed) / v.runs * 100.0 : 0.0;
+    std::snprintf(line, sizeof line, "%-28s %5d %5s%%  %7s %7s %7s %7s %7s %7s\n",
                   v.variant.empty() ? "(no matrix)" : v.variant.c_str(), v.runs,
-                  v.runs > 0 ? 100.0 * v.passed / v.runs : 0.0, p->mean, p->median, p->q1, p->q3,
-                  p->min, p->max);
+                  fixed(rate, 0).c_str(), fixed(p->mean, 1).c_str(), fixed(p->median, 1).c_str(),
+                  fixed(p->q1, 1).c_str(), fixed(p->q3, 1).c_str(), fixed(p->min, 0).c_str(),
+                  fixed(p->max, 0).c_str());
     out += line;
   }
   bool header = false;

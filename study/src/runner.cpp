@@ -351,6 +351,12 @@ void check_trace_requests(const Scenario& scenario, const std::vector<TraceReque
   }
 }
 
+bool RunResult::agent_error() const {
+  if (agent_runtime_errors > 0) return true;
+  return std::any_of(issues.begin(), issues.end(),
+                     [](const RunIssue& i) { return i.kind == "agent-halted"; });
+}
+
 bool RunResult::passed() const {
   for (const TestVerdict& t : tests) {
     if (!t.passed) return false;
@@ -370,8 +376,11 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   int skill_failures = 0;
   std::vector<RunIssue> issues;
   int issues_dropped = 0;
-  auto add_issue = [&issues, &issues_dropped](RunIssue i) {
-    if (issues.size() < RunResult::kMaxIssues) {
+  int mistakes = 0;  // every one, kept or not
+  auto add_issue = [&issues, &issues_dropped, &mistakes](RunIssue i) {
+    if (i.is_mistake()) ++mistakes;
+    // A halt (at most one per robot) is always kept: RunResult::agent_error() reads it.
+    if (issues.size() < RunResult::kMaxIssues || i.kind == "agent-halted") {
       issues.push_back(std::move(i));
     } else {
       ++issues_dropped;
@@ -501,12 +510,19 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
         d << value << " collisions";
         break;
       case TestCase::Kind::kNoAgentErrors: {
+        // Runtime errors, and halted agents (a rule loop cut by the firing limit is no runtime
+        // error, but an agent halted for it is).
         int errors = 0;
+        int halts = 0;
         for (int k = 0; k < game.robot_count(); ++k) {
-          if (const sim::AgentBrain* b = driver.agent(k)) errors += b->runtime_errors();
+          if (const sim::AgentBrain* b = driver.agent(k)) {
+            errors += b->runtime_errors();
+            halts += b->halt() ? 1 : 0;
+          }
         }
-        value = errors;
+        value = errors + halts;
         d << errors << " agent runtime errors";
+        if (halts > 0) d << ", " << halts << " agent(s) halted";
         break;
       }
       case TestCase::Kind::kSkillFailureStreakAtMost:
@@ -549,7 +565,36 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   if (storage_min == 0) storage_empty_game_s = 0.0;
   core::SimTime next_storage_sample = core::SimTime::from_sec(1);
   core::SimTime next_reload_check = core::SimTime::from_sec(1);
+  // Halted agents (sim::AgentBrain::halt), each reported once as an issue and a note; the
+  // first agent error (runtime error or halt) for hooks.stop_at_agent_error.
+  std::vector<bool> halt_reported(static_cast<std::size_t>(game.robot_count()), false);
+  std::vector<std::string> halted;  // "robot1 at 12.3 s"
+  std::optional<std::string> first_agent_error;
+  auto check_agents = [&]() {
+    for (int k = 0; k < game.robot_count(); ++k) {
+      const sim::AgentBrain* b = driver.agent(k);
+      if (b == nullptr) continue;
+      const std::string robot(game.robot(k).name());
+      if (!first_agent_error && (b->runtime_errors() > 0 || b->halt())) {
+        first_agent_error = robot + " at " + fmt_s(game.time().seconds()) + " s";
+      }
+      const auto& h = b->halt();
+      if (!h || halt_reported[static_cast<std::size_t>(k)]) continue;
+      halt_reported[static_cast<std::size_t>(k)] = true;
+      halted.push_back(robot + " at " + fmt_s(h->time.seconds()) + " s");
+      RunIssue issue;
+      issue.time_s = h->time.seconds();
+      issue.robot = robot;
+      issue.kind = "agent-halted";
+      issue.text = h->text;
+      add_issue(std::move(issue));
+      if (recorder) recorder->note(h->time, robot, h->text);
+      if (hooks.note) hooks.note(h->time, robot, h->text);
+    }
+  };
   driver.run_until(end, [&](const sim::Game&) {
+    check_agents();
+    if (hooks.stop_at_agent_error && first_agent_error) return true;
     if (hooks.reload_agents && game.time() >= next_reload_check) {
       next_reload_check += core::SimTime::from_sec(1);
       for (int k = 0; k < game.robot_count(); ++k) {
@@ -681,6 +726,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
                    [](const RunIssue& a, const RunIssue& b) { return a.time_s < b.time_s; });
   r.issues = std::move(issues);
   r.issues_dropped = issues_dropped;
+  r.mistakes = mistakes;
   r.role_changes = role_changes;
   r.first_role_change_game_s = first_role_change_game_s;
   r.storage_min = storage_min;
@@ -705,14 +751,32 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   }
   if (scenario.strict) {
     // Strict (scenario key `strict`, `run --strict`): any agent mistake fails the run.
-    int mistakes = 0;
-    for (const RunIssue& i : r.issues) mistakes += i.is_mistake() ? 1 : 0;
+    // The complete count (r.mistakes), not the kept issues': skill failures are no mistakes.
     TestVerdict v;
     v.name = "strict: no agent mistakes";
-    v.passed = mistakes == 0 && r.issues_dropped == 0;
-    v.detail = std::to_string(mistakes) +
-               " mistakes (runtime errors, rule loops, locks held over 300 s, unknown skills; "
-               "the issue lines name them)";
+    v.passed = r.mistakes == 0;
+    v.detail = std::to_string(r.mistakes) +
+               " mistakes (runtime errors, rule loops, locks held over 300 s, unknown skills, "
+               "halted agents; the issue lines name them)";
+    v.at_s = r.game_time_s;
+    verdicts.push_back(std::move(v));
+  }
+  if (!halted.empty()) {
+    // A halted agent played no game worth its points: the run fails whatever its test cases.
+    std::string who;
+    for (const std::string& robot : halted) who += (who.empty() ? "" : ", ") + robot;
+    TestVerdict v;
+    v.name = "no agent halted";
+    v.passed = false;
+    v.detail = "halted for running away: " + who + " (the agent-halted issue says why)";
+    v.at_s = r.game_time_s;
+    verdicts.push_back(std::move(v));
+  }
+  if (hooks.stop_at_agent_error && first_agent_error) {
+    TestVerdict v;
+    v.name = "fail-fast: no agent error";
+    v.passed = false;
+    v.detail = "stopped at the first agent error: " + *first_agent_error;
     v.at_s = r.game_time_s;
     verdicts.push_back(std::move(v));
   }
@@ -807,6 +871,7 @@ std::string to_json(const RunResult& r) {
   }
   j["issues"] = std::move(issues);
   j["issues_dropped"] = r.issues_dropped;
+  j["mistakes"] = r.mistakes;
   if (r.hackathon) {
     const sim::HackathonScore& h = *r.hackathon;
     j["hackathon"] = {{"points", h.points},

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "llsf/study/scenario.h"
 
+#include <algorithm>
 #include <array>
 #include <charconv>
 #include <cstdlib>
@@ -13,6 +14,7 @@
 #include <string_view>
 #include <system_error>
 #include <utility>
+#include <vector>
 
 #include "llsf/comm/hub_config.h"
 #include "llsf/core/error.h"
@@ -397,6 +399,26 @@ Scenario read_scenario(const core::ConfigNode& root, const std::string& file) {
   root.read("description", s.description);
   s.seeds = read_seeds(root);
   if (const core::ConfigNode n = root["refbox"]; n.defined()) {
+    // The teams the refbox knows (GameInfo.known_teams: the 2013 shell's team menu), as
+    // 0.6.1's llsfrb/game/teams; the protocol's, not the engine's, so read here.
+    if (n.is_map() && n["known_teams"].defined()) {
+      const core::ConfigNode teams = n["known_teams"];
+      if (!teams.is_sequence()) teams.fail("a list of team names, e.g. [Carologistics, Solidus]");
+      constexpr int kMaxTeams = 64;
+      if (teams.size() > kMaxTeams) {
+        teams.fail("at most " + std::to_string(kMaxTeams) + " teams (got " +
+                   std::to_string(teams.size()) + ")");
+      }
+      for (const core::ConfigNode& t : teams.elements()) {
+        std::string team = t.as_string();
+        if (team.empty() || team.size() > 64) t.fail("a team name has 1 to 64 characters");
+        if (std::find(s.game.protocol.known_teams.begin(), s.game.protocol.known_teams.end(),
+                      team) != s.game.protocol.known_teams.end()) {
+          t.fail("'" + team + "' is listed twice");
+        }
+        s.game.protocol.known_teams.push_back(std::move(team));
+      }
+    }
     s.game.refbox = refbox::load_refbox_config(n);
   }
   // The robot profile first: world, navigation and levels keys override its figures.
@@ -515,6 +537,19 @@ ScenarioFile load_scenario(const std::string& path) {
   ScenarioFile out;
   out.file = path;
   const core::ConfigNode first = core::ConfigNode::parse(text, path);
+  // An experiment file (docs/experiments.md) given where a scenario is expected: say so, not
+  // "unknown key 'batches'".
+  // (By its keys: looking a key up would mark it as read for the unknown-key check.)
+  const auto has_key = [&first](const char* k) {
+    const std::vector<std::string> keys = first.keys();
+    return std::find(keys.begin(), keys.end(), k) != keys.end();
+  };
+  if (first.is_map() && has_key("batches") && !has_key("robots")) {
+    first["batches"].fail(
+        "this is an experiment file (it has `batches`), not a scenario: play it with "
+        "`llsfsim experiment " +
+        path + "`; `llsfsim check` takes the scenario files its batches name");
+  }
   const core::ConfigNode matrix = first["matrix"];
   if (!matrix.defined()) {
     out.variants.push_back(read_scenario(first, path));

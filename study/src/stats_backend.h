@@ -96,6 +96,7 @@ class StatsBackend {
   virtual void require_writable() const = 0;
   virtual std::int64_t open_batch(const BatchKey& key) = 0;
   virtual void finish_batch(std::int64_t batch_id) = 0;
+  virtual void remove_empty_batch(std::int64_t batch_id) = 0;
   virtual std::vector<StoredBatch> batches() const = 0;
   virtual std::optional<StoredBatch> batch(std::int64_t batch_id) const = 0;
   virtual std::int64_t add_run(std::int64_t batch_id, const RunResult& r, bool replace) = 0;

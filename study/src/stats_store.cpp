@@ -144,6 +144,9 @@ const std::string& StatsStore::path() const { return backend_->path(); }
 void StatsStore::require_writable() const { backend_->require_writable(); }
 std::int64_t StatsStore::open_batch(const BatchKey& key) { return backend_->open_batch(key); }
 void StatsStore::finish_batch(std::int64_t batch_id) { backend_->finish_batch(batch_id); }
+void StatsStore::remove_empty_batch(std::int64_t batch_id) {
+  backend_->remove_empty_batch(batch_id);
+}
 std::vector<StoredBatch> StatsStore::batches() const { return backend_->batches(); }
 std::optional<StoredBatch> StatsStore::batch(std::int64_t batch_id) const {
   return backend_->batch(batch_id);

@@ -274,6 +274,14 @@ class PostgresBackend final : public StatsBackend {
     });
   }
 
+  void remove_empty_batch(std::int64_t batch_id) override {
+    with_retry("removing an empty batch", [&](pqxx::connection& c) {
+      pqxx::work w(c);
+      w.exec_prepared("remove_empty_batch", batch_id);
+      w.commit();
+    });
+  }
+
   std::optional<StoredBatch> batch(std::int64_t batch_id) const override {
     const std::vector<StoredBatch> b = read_batches(" WHERE id = " + std::to_string(batch_id));
     if (b.empty()) return std::nullopt;
@@ -543,6 +551,9 @@ class PostgresBackend final : public StatsBackend {
               "RETURNING id");
     c.prepare("finish_batch", std::string("UPDATE batches SET finished = ") + kCreated +
                                   " WHERE id = $1 AND finished IS NULL");
+    c.prepare("remove_empty_batch",
+              "DELETE FROM batches WHERE id = $1 AND NOT EXISTS (SELECT 1 FROM runs WHERE "
+              "batch_id = $1)");
     c.prepare("find_run",
               "SELECT id, result_hash FROM runs WHERE batch_id = $1 AND variant = $2 AND "
               "seed = $3");

@@ -124,11 +124,15 @@ using sqlite::exec;
 using sqlite::Statement;
 using sqlite::Transaction;
 
-// The store's directory is created if missing (a failure shows when SQLite opens the file).
-const std::string& with_parent_dir(const std::string& path) {
+// The store's folder must exist: a typo in `--db` (or a path meant for another machine) is the
+// user's error, not a folder to create (docs/llsfsim.md; a folder made at `/` by a run as root).
+const std::string& in_existing_dir(const std::string& path) {
   const std::filesystem::path dir = std::filesystem::path(path).parent_path();
   std::error_code ec;
-  if (!dir.empty()) std::filesystem::create_directories(dir, ec);
+  if (!dir.empty() && !std::filesystem::is_directory(dir, ec)) {
+    throw StatsError(path + ": cannot open the statistics store: the folder " + dir.string() +
+                     " does not exist");
+  }
   return path;
 }
 
@@ -136,7 +140,7 @@ const std::string& with_parent_dir(const std::string& path) {
 
 class SqliteBackend final : public StatsBackend {
  public:
-  explicit SqliteBackend(const std::string& p) : path_(with_parent_dir(p)) {
+  explicit SqliteBackend(const std::string& p) : path_(in_existing_dir(p)) {
     sqlite3* raw = nullptr;
     const int rc =
         sqlite3_open_v2(path_.c_str(), &raw, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
@@ -194,6 +198,10 @@ class SqliteBackend final : public StatsBackend {
   }
 
   void finish_batch(std::int64_t batch_id) override { finish_batch_->start().bind(batch_id).run(); }
+
+  void remove_empty_batch(std::int64_t batch_id) override {
+    remove_empty_batch_->start().bind(batch_id).bind(batch_id).run();
+  }
 
   std::optional<StoredBatch> batch(std::int64_t batch_id) const override {
     Statement& q = *get_batch_;
@@ -439,6 +447,8 @@ class SqliteBackend final : public StatsBackend {
     finish_batch_ = prep(
         "UPDATE batches SET finished = strftime('%Y-%m-%dT%H:%M:%SZ', 'now') "
         "WHERE id = ? AND finished IS NULL");
+    remove_empty_batch_ = prep(
+        "DELETE FROM batches WHERE id = ? AND NOT EXISTS (SELECT 1 FROM runs WHERE batch_id = ?)");
     get_batch_ = prep(
         "SELECT id, kind, created, coalesce(finished, ''), scenario_file, scenario_name, "
         "scenario_hash, runs_per_variant, variants, seeds FROM batches WHERE id = ?");
@@ -495,9 +505,10 @@ class SqliteBackend final : public StatsBackend {
   std::string path_;
   DbHandle db_;
   // Prepared once, used for every run.
-  std::unique_ptr<Statement> find_batch_, insert_batch_, finish_batch_, get_batch_, list_batches_,
-      find_run_, delete_run_, insert_run_, insert_stat_, insert_order_, insert_test_, insert_award_,
-      insert_event_, select_runs_, select_run_, select_stats_, select_awards_;
+  std::unique_ptr<Statement> find_batch_, insert_batch_, finish_batch_, remove_empty_batch_,
+      get_batch_, list_batches_, find_run_, delete_run_, insert_run_, insert_stat_, insert_order_,
+      insert_test_, insert_award_, insert_event_, select_runs_, select_run_, select_stats_,
+      select_awards_;
 };
 
 }  // namespace

@@ -40,9 +40,11 @@ TEST_CASE("check warns on unknown skills, unread confvals and a lock switch the 
             "a.clp:3: (skill-call drve_to ...): the skill library has no skill 'drve_to' "
             "(did you mean 'drive_to'?)"));
   CHECK_FALSE(has(r.out, "in_a_comment"));
+  // The near path the agent reads, with its file and line; no direction (either may be wrong).
   CHECK(has(r.out,
-            "robots.config: the agent reads no confval /clips-agent/rols (did you mean "
-            "/clips-agent/roles?)"));
+            "robots.config: the agent reads no confval /clips-agent/rols; it reads "
+            "/clips-agent/roles ("));
+  CHECK(has(r.out, "a.clp:4): one of the two is misspelt"));
   CHECK(has(r.out, "robots.locks is on, but the agent uses no lock facts"));
   CHECK(has(r.out, "ok   "));
 }
@@ -57,4 +59,52 @@ TEST_CASE("an agent that uses lock facts with the locks switch off: the error na
   CHECK(has(r.err,
             "hint: the agent uses the host's lock facts, which exist only with the lock "
             "protocol on: set `robots.locks: true`"));
+}
+
+TEST_CASE("check warns on a skill-call argument the skill does not document") {
+  const TempDir dir;
+  write(dir, "agent/a.clp",
+        "(defrule go (time $?) (not (went))\n"
+        "  => (assert (went)) (skill-call drive_to plac \"M1\" ori (+ 1 2)))\n"
+        "(defrule fine (time $?) (place ?p) (not (fine))\n"
+        "  => (assert (fine)) (skill-call drive_to x 1.0 y (* 2 1.5) place ?p))\n");
+  write(dir, "s.yaml", "name: c\nrobots:\n  count: 1\n  agent: [agent]\n");
+  const auto r = llsfsim({"check", dir.file("s.yaml")});
+  INFO(r.out, r.err);
+  CHECK(r.code == 0);
+  CHECK(has(r.out,
+            "a.clp:2: (skill-call drive_to plac ...): drive_to has no argument 'plac' (did "
+            "you mean 'place'? its arguments: place, x, y, ori, forward_only, timeout)"));
+  CHECK(r.out.find("has no argument") == r.out.rfind("has no argument"));  // ori, x, y: known
+}
+
+TEST_CASE("check: the shipped scenarios get no warning") {
+  for (const char* name : {"default", "auction-vs-roles", "packet-loss", "thesis-two-robots",
+                           "thesis-three-robots", "hackathon"}) {
+    CAPTURE(name);
+    const auto r = llsfsim({"check", std::string(LLSF_SOURCE_DIR "/scenarios/") + name + ".yaml"});
+    CHECK(r.code == 0);
+    CHECK_FALSE(has(r.out, "warn "));
+  }
+}
+
+TEST_CASE(
+    "run shows a confval nobody reads and the sandbox switched off; check notes the sandbox") {
+  const TempDir dir;
+  write(dir, "agent/a.clp", "(defrule roles (confval (path \"/clips-agent/roles\")) => )\n");
+  write(dir, "s.yaml",
+        "name: c\nduration_s: 1\nrobots:\n  count: 1\n  sandbox: false\n  agent: [agent]\n"
+        "  config: {rols: [P3]}\n");
+  const auto r = llsfsim({"run", dir.file("s.yaml"), "--no-db", "--no-record"});
+  INFO(r.out, r.err);
+  CHECK(r.code == 0);
+  CHECK(has(r.err,
+            "llsfsim run: warn: robots.config: the agent reads no confval "
+            "/clips-agent/rols; it reads /clips-agent/roles ("));
+  CHECK(has(r.err, "llsfsim run: note: robots.sandbox is off"));
+  CHECK_FALSE(has(r.err, "at its defaults"));  // check's notes stay check's
+  const auto c = llsfsim({"check", dir.file("s.yaml")});
+  CHECK(has(c.out, "note " + dir.file("s.yaml") + ": robots.sandbox is off"));
+  // -q: nothing.
+  CHECK(llsfsim({"run", dir.file("s.yaml"), "--no-db", "--no-record", "-q"}).err.empty());
 }

@@ -84,6 +84,24 @@ TEST_CASE("exercise: each mistake gets its own message at the participant's file
       {"result_table.lua", "02", kExitFailed,
        "fsm.result must be a string (e.g. \"1.20 3.40\") or a number, not a table",
        "report text, not a table"},
+      // At the skill's execute, not the prelude's line; not the syntax-error hint.
+      {"execute_nil.lua", "01", kExitFailed,
+       "drive_to_point: execute() returned nil, expected S_RUNNING, S_FINAL or S_FAILED (a path "
+       "through execute() without a `return`?)",
+       "execute() must return S_RUNNING, S_FINAL or S_FAILED on every path"},
+      // The method meant; not the syntax-error hint ("nearst" has "near" in it).
+      {"typo_method.lua", "02", kExitFailed,
+       "attempt to call a nil value (method 'nearst') (did you mean 'nearest'?)",
+       "the interface has no such method"},
+      {"assign_in_cond.lua", "01", kExitBadInput,
+       "bad cond \"vars.x = 1\": `=` assigns; a condition compares with `==` (or `~=`)",
+       "in a cond string write `==` to compare"},
+      // Not taken for a state only: a constant used too early is named as such too.
+      {"early_constant.lua", "01", kExitBadInput,
+       "undeclared global 'MAX_SPEED': if it is a state, no state is defined yet: call "
+       "fsm:define_states{...} before using it (function MAX_SPEED:init() ...); otherwise define "
+       "it before this line (local MAX_SPEED = ...)",
+       "a name the file uses before defining it"},
   };
   for (const Mistake& m : mistakes) {
     const std::string path = kMistakes + m.file;
@@ -99,6 +117,38 @@ TEST_CASE("exercise: each mistake gets its own message at the participant's file
   }
 }
 
+TEST_CASE("exercise: drive_to with string coordinates says what was wrong, not to retry") {
+  const std::string path = kMistakes + "string_coordinates.lua";
+  const Run r = llsfsim({"exercise", "01", "--skill", path, "-q"});
+  INFO(r.out, r.err);
+  CHECK(r.code == llsf::app::kExitFailed);
+  CHECK(has(r.out,
+            "drive_to needs place=<name> or x=, y=: x= and y= must be numbers (got "
+            "x=\"1.5\" (a string), y=\"2\" (a string))"));
+  CHECK(has(r.out, "hint     the arguments your skill gave drive_to are wrong"));
+  CHECK_FALSE(has(r.out, "try again"));
+}
+
+TEST_CASE("exercise 02: the verdict's why names what the wrong position is") {
+  struct Wrong {
+    const char* file;
+    const char* why;  ///< follows "why      "
+  };
+  const Wrong wrongs[] = {
+      {"find_robot_frame.lua",
+       "the position is the red puck's in the robot's frame (ahead, left): turn the sighting "
+       "into field coordinates"},
+      {"find_wrong_colour.lua", "the position is a green puck's (puck "},
+      {"find_robot_position.lua", "the position is the robot's own (pose:get()), not the puck's"},
+  };
+  for (const Wrong& w : wrongs) {
+    const Run r = llsfsim({"exercise", "02", "--skill", kMistakes + w.file, "-q"});
+    INFO(w.file, "\n", r.out, r.err);
+    CHECK(r.code == llsf::app::kExitFailed);
+    CHECK(has(r.out, std::string("why      ") + w.why));
+  }
+}
+
 TEST_CASE("exercise: silent mistakes are warnings with the line; a load-time print is shown") {
   struct Warning {
     const char* file;
@@ -110,6 +160,9 @@ TEST_CASE("exercise: silent mistakes are warnings with the line; a load-time pri
       {"args_ignored.lua",
        "drive_to_point: state 'DRIVE' sets self.args[\"drive_to\"], but it runs no sub-skill (it "
        "is a JumpState), so the arguments are ignored"},
+      {"no_way_out.lua",
+       "drive_to_point: state 'WAIT' has no way out: no transition, timeout or sub-skill leaves "
+       "it, so the skill would stay there"},
   };
   for (const Warning& w : warnings) {
     const std::string path = kMistakes + w.file;

@@ -97,3 +97,82 @@ TEST_CASE("every command's help names its exit codes") {
   CHECK(has(agent.out, "3 internal error"));
   CHECK(has(llsfsim({"--help"}).out, "3 internal error"));
 }
+
+TEST_CASE("a mistyped command or option: exit code 2 with a did-you-mean") {
+  Run r = llsfsim({"rnu", kDefault});
+  CHECK(r.code == llsf::app::kExitBadInput);
+  CHECK(has(r.err, "llsfsim: unknown command 'rnu'; did you mean 'run'?"));
+  CHECK(!has(r.err, "A subcommand is required"));
+  r = llsfsim({"--verison"});
+  CHECK(r.code == llsf::app::kExitBadInput);
+  CHECK(has(r.err, "llsfsim: unknown option --verison; did you mean --version?"));
+  r = llsfsim({"run", kDefault, "--sede", "3", "--no-db", "--no-record"});
+  CHECK(r.code == llsf::app::kExitBadInput);
+  CHECK(has(r.err, "llsfsim run: unknown option --sede; did you mean --seed?"));
+  CHECK(has(r.err, "Run 'llsfsim run --help' for its options."));
+  r = llsfsim({"batch", "stauts", "--db=x.db", "--no-such-option"});
+  CHECK(r.code == llsf::app::kExitBadInput);
+  CHECK(has(r.err, "llsfsim batch: unknown option --no-such-option\n"));
+  // Far from every name: no guess, the commands are listed by --help.
+  r = llsfsim({"zzzzzz"});
+  CHECK(r.code == llsf::app::kExitBadInput);
+  CHECK(has(r.err, "llsfsim: unknown command 'zzzzzz'\n"));
+  CHECK(has(r.err, "Run 'llsfsim --help' for the commands."));
+}
+
+TEST_CASE("counts and seeds out of range: a readable error, no wrap-around") {
+  const TempDir dir;
+  Run r = llsfsim({"batch", kDefault, "--runs", "0", "--db", dir.file("s.db")});
+  CHECK(r.code == llsf::app::kExitBadInput);
+  CHECK(has(r.err, "--runs: must be greater than 0, not 0"));
+  CHECK(r.err.size() < 200);  // no range up to the largest double
+  r = llsfsim({"run", kDefault, "--seed", "-3", "--no-db", "--no-record"});
+  CHECK(r.code == llsf::app::kExitBadInput);
+  CHECK(has(r.err, "a seed is a whole number from 0 to 18446744073709551615, not '-3'"));
+  r = llsfsim({"skill", "--seed=-1", "ppgoto{place=\"M1\"}"});
+  CHECK(r.code == llsf::app::kExitBadInput);
+  CHECK(has(r.err, "not '-1'"));
+  r = llsfsim({"run", kDefault, "--seed", "18446744073709551616", "--no-db", "--no-record"});
+  CHECK(r.code == llsf::app::kExitBadInput);
+  CHECK(has(r.err, "a seed is a whole number"));
+}
+
+TEST_CASE("run --variant on a scenario without a matrix says there are no variants") {
+  const Run r = llsfsim({"run", kDefault, "--variant", "nope", "--no-db", "--no-record"});
+  CHECK(r.code == llsf::app::kExitBadInput);
+  CHECK(has(r.err, "has no matrix, so no variant 'nope': play it without --variant"));
+  CHECK(!has(r.err, "its variants:"));
+}
+
+TEST_CASE("batch --help: every exclusion names its options") {
+  const Run r = llsfsim({"batch", "--help"});
+  CHECK(r.code == llsf::app::kExitOk);
+  for (std::size_t p = r.out.find("Excludes:"); p != std::string::npos;
+       p = r.out.find("Excludes:", p + 1)) {
+    const std::string after = r.out.substr(p + 9, r.out.find('\n', p) - p - 9);
+    CAPTURE(after);
+    CHECK(after.find_first_not_of(' ') != std::string::npos);
+  }
+}
+
+TEST_CASE("batch --task (the job script's) with --slurm is refused") {
+  const Run r = llsfsim({"batch", kDefault, "--slurm", "--task", "0"});
+  CHECK(r.code == llsf::app::kExitBadInput);
+  CHECK(has(r.err, "--task is what a Slurm array task runs; it cannot be given with --slurm"));
+}
+
+TEST_CASE("check or run on an experiment file: exit code 2 and a hint to use `experiment`") {
+  const std::vector<std::vector<std::string>> commands = {
+      {"check", kExperiment},
+      {"run", kExperiment, "--no-db", "--no-record"},
+  };
+  for (const std::vector<std::string>& args : commands) {
+    CAPTURE(args[0]);
+    const Run r = llsfsim(args);
+    CHECK(r.code == llsf::app::kExitBadInput);
+    CHECK(has(r.err,
+              "this is an experiment file (it has `batches`), not a scenario: play it with "
+              "`llsfsim experiment " +
+                  kExperiment + "`"));
+  }
+}

@@ -250,6 +250,18 @@ TEST_CASE("hackathon: workers play submissions on hidden seeds; ranked; seeds ne
     REQUIRE(board["entries"].size() == 2);
     CHECK(board["entries"][0]["team"] == "good");
     CHECK(board["entries"][1]["team"] == "weak");
+    // The page shows why a played submission failed: its first run not passed, no seed.
+    for (const json& s : board["recent"]) {
+      CAPTURE(s.dump());
+      if (s["team"] == "weak") {
+        REQUIRE(s.contains("reason"));
+        CHECK(s["reason"].get<std::string>().starts_with("run 1 of 2: "));
+        CHECK(s["reason"].get<std::string>().find("not solved yet") != std::string::npos);
+        CHECK(s["reason"].get<std::string>().find("1001") == std::string::npos);
+      } else {
+        CHECK_FALSE(s.contains("reason"));
+      }
+    }
     r.path = {"api", "hackathon", "submissions", std::to_string(good)};
     const std::string shown = server.route(r)->body;
     CHECK(shown.find("1001") == std::string::npos);
@@ -378,6 +390,13 @@ TEST_CASE("exercise --submit: queued over HTTP; refusals, bad URLs and a closed 
   r = llsf::test::llsfsim({"exercise", "01", "--skill", big, "--submit", url, "--team", "t"});
   CHECK(r.code == 2);
   CHECK(llsf::test::has(r.err, "(HTTP 413): the skill file is 3000 bytes; at most 2000 bytes"));
+  // Over the server's request body limit: its 413 is read, not "Broken pipe".
+  const std::string huge = tmp.file("huge.lua");
+  std::ofstream(huge) << std::string(4 << 20, '-');
+  r = llsf::test::llsfsim({"exercise", "01", "--skill", huge, "--submit", url, "--team", "t"});
+  CHECK(r.code == 2);
+  CHECK(llsf::test::has(r.err, "refused the submission (HTTP 413): the request body is larger"));
+  CHECK_FALSE(llsf::test::has(r.err, "cannot reach"));
   const std::string latin1 = tmp.file("latin1.lua");
   std::ofstream(latin1) << "-- gr\xfc\xdf\n";
   r = llsf::test::llsfsim({"exercise", "01", "--skill", latin1, "--submit", url, "--team", "t"});

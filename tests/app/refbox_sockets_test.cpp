@@ -27,7 +27,9 @@
 #include "llsf/comm/stream.h"
 #include "llsf/refbox/wire_time.h"
 #include "llsf/sim/driver.h"
+#include "llsf/study/runner.h"
 #include "llsf/study/scenario.h"
+#include "refbox_sockets.h"
 #include "support/temp_dir.h"
 
 namespace {
@@ -160,6 +162,20 @@ TEST_CASE("run --refbox-sockets: bad socket configs are refused before the game"
     CHECK(r.code == llsf::app::kExitBadInput);
     CHECK(has(r.err, "nothing.yaml"));
   }
+  SUBCASE("argument order: the optional value takes what follows") {
+    // Without a sockets file before the scenario: the scenario became the sockets file.
+    const Run r = llsfsim({"run", "--refbox-sockets", scenario, "--no-db", "--no-record"});
+    CHECK(r.code == llsf::app::kExitBadInput);
+    CHECK(has(r.err, "scenario is required"));
+    CHECK(has(r.err, "hint: --refbox-sockets took '" + scenario +
+                         "' as its sockets file (its value is optional): put it after the "
+                         "scenario"));
+    // With a sockets file, before the scenario works (docs/llsfsim.md).
+    dir.write("sockets.yaml", "stream: {port: 0}\n");
+    const Run ok = llsfsim({"run", "--refbox-sockets", dir.file("sockets.yaml"), scenario,
+                            "--no-db", "--no-record", "--speed", "1000", "-q"});
+    CHECK(ok.code == 0);
+  }
   SUBCASE("an unknown key, named with its line") {
     const Run r = run_with("stream: {port: 0}\nudp_peer: []\n");
     CHECK(r.code == llsf::app::kExitBadInput);
@@ -177,7 +193,9 @@ TEST_CASE("run --refbox-sockets: bad socket configs are refused before the game"
     const int port = taken.local_endpoint().port();
     const Run r = run_with("stream: {port: " + std::to_string(port) + "}\n");
     CHECK(r.code == llsf::app::kExitBadInput);
-    CHECK(has(r.err, "cannot listen for controllers on 127.0.0.1:" + std::to_string(port)));
+    CHECK(has(r.err, "llsfsim run: --refbox-sockets " + dir.file("sockets.yaml") +
+                         ": cannot listen for controllers on 127.0.0.1:" + std::to_string(port)));
+    CHECK(!has(r.err, "--refbox-sockets: --refbox-sockets"));  // the prefix once
   }
 }
 
@@ -350,4 +368,56 @@ TEST_CASE("run --refbox-sockets: a controller and a UDP peer play a served game"
   CHECK(has(served.result.out,
             "refbox sockets: controllers: tcp 127.0.0.1:" + std::to_string(tcp_port)));
   CHECK(has(served.result.out, "udp peer ext1 (channel team)"));
+}
+
+TEST_CASE("refbox sockets with radio lock_messages 2013: the peers' lock messages in 2013 form") {
+  const llsf::test::TempDir dir("llsf_app_sockets_2013");
+  // One robot with the lock protocol (it announces its master every 0.5 s) and an agent that
+  // does nothing else; 3 s of game, unpaced.
+  dir.write("agent.clp", "(defrule idle (time $?) (not (idle)) => (assert (idle)))\n");
+  dir.write("s.yaml",
+            "name: locks2013\nstart: production\nduration_s: 3\nradio: {lock_messages: 2013}\n"
+            "robots: {count: 1, locks: true, agent: [" +
+                dir.file("agent.clp") + "]}\n");
+  boost::asio::io_context io;
+  llsf::comm::test::Endpoint peer(io);
+  llsf::comm::SocketConfig sc;
+  sc.stream_enabled = false;
+  llsf::comm::UdpPeerConfig p;
+  p.name = "ext1";
+  p.channel = "team";
+  p.send_port = 0;
+  p.recv_port = peer.port();
+  sc.udp_peers.push_back(p);
+  llsf::study::Scenario scenario = llsf::study::load_scenario(dir.file("s.yaml")).variants.at(0);
+  llsf::app::RefboxSockets sockets(sc, scenario.game.hub.lock_messages, [](std::string_view) {});
+  scenario.game.external_peers = sockets.external_peers();
+  // The 2013 tools' registry: LockMessage (2000, 1337), LockMasterAnnounce (2000, 1338).
+  llsf::comm::MessageRegistry tools;
+  llsf::sim::add_refbox_messages(tools);
+  llsf::comm::add_agent_messages(tools, llsf::comm::LockNumbering::k2013);
+  // What the peer says: a 2013 LockMessage, sent before the first tick.
+  peer.send(tools.encode(llsf::comm::test::lock(1)), sockets.udp_port(0));
+  llsf::comm::PeerCounters from_peer;
+  llsf::study::RunHooks hooks;
+  hooks.attach = [&sockets](llsf::sim::Game& g) { sockets.attach(g); };
+  hooks.tick = [&](const llsf::sim::Game& g) {
+    sockets.send_tick();
+    sockets.receive();
+    from_peer = g.hub().peer_counters(g.external_peer(0));
+  };
+  (void)llsf::study::run_game(scenario, 1, hooks);
+  // It was taken as a lock message, not refused as an unknown type.
+  CHECK(from_peer.broadcasts == 1);
+  CHECK(from_peer.malformed_total() == 0);
+  // The robot's master announcements reach the peer as (2000, 1338).
+  int announces = 0;
+  for (const std::vector<std::uint8_t>& d : peer.drain()) {
+    const auto m = tools.decode_datagram(d);
+    if (m.error == llsf::comm::FrameError::kNone &&
+        m.message->GetTypeName() == "llsf_agent_msgs.LockMasterAnnounce") {
+      ++announces;
+    }
+  }
+  CHECK(announces >= 1);
 }

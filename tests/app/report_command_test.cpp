@@ -94,3 +94,30 @@ TEST_CASE("report --html into a directory that does not exist: exit code 2") {
   CHECK(r.code == 2);
   CHECK(has(r.err, "cannot write"));
 }
+
+TEST_CASE("report --list: the single games of `llsfsim run` are neither finished nor unfinished") {
+  TempDir dir;
+  const std::string db = make_store(dir);
+  {
+    llsf::study::StatsStore store(db);
+    llsf::study::BatchKey key;
+    key.kind = llsf::study::BatchKey::Kind::kRun;
+    key.scenario_file = "tiny.yaml";
+    key.scenario_name = "tiny";
+    key.scenario_hash = "00000000000000aa";
+    key.variants = 2;
+    key.seeds = {1};
+    const std::int64_t b = store.open_batch(key);
+    for (const std::uint64_t seed : {3, 4, 5}) {
+      llsf::study::RunResult r;
+      r.scenario = "tiny";
+      r.variant = "config=P3-P3";
+      r.seed = seed;
+      store.add_run(b, r, /*replace=*/true);
+    }
+  }
+  const Run r = llsfsim({"report", "--db", db, "--list"});
+  CHECK(r.code == 0);
+  CHECK(has(r.out, "1  batch  tiny  tiny.yaml  2 variant(s) x 2 run(s)  unfinished\n"));
+  CHECK(has(r.out, "2  run  tiny  tiny.yaml  2 variant(s), 3 game(s) of llsfsim run\n"));
+}

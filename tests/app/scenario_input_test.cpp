@@ -132,6 +132,22 @@ TEST_CASE("run: a store in a read-only folder is refused before the game") {
   fs::permissions(folder, fs::perms::all);  // for TempDir's clean-up
 }
 
+TEST_CASE("--db into a folder that does not exist: exit code 2, no folder created") {
+  const llsf::test::TempDir dir("llsf_app_missing_db_dir");
+  const std::string scenario = write_scenario(dir.path, 30);
+  const fs::path missing = dir.path / "no" / "such";
+  const std::string db = (missing / "x.db").string();
+  const fs::path recording = dir.path / "r.jsonl.gz";
+  for (const char* command : {"run", "batch"}) {
+    CAPTURE(command);
+    const Run r = llsfsim({command, scenario, "--db", db, "--no-record", "-q"});
+    INFO(r.err);
+    CHECK(r.code == llsf::app::kExitBadInput);
+    CHECK(has(r.err, "the folder " + missing.string() + " does not exist"));
+    CHECK_FALSE(fs::exists(dir.path / "no"));
+  }
+}
+
 TEST_CASE("run: a recording folder that cannot be written is refused before the game") {
   const llsf::test::TempDir dir("llsf_app_ro_recording");
   fs::permissions(dir.path, fs::perms::all);

@@ -40,3 +40,60 @@ TEST_CASE("run --strict fails on an agent's runtime error and names the rule and
   CHECK(keyed.code == 1);
   CHECK(has(keyed.out, "FAIL  strict: no agent mistakes"));
 }
+
+TEST_CASE("run --strict counts every mistake, also past the 200 issues kept; skill failures none") {
+  const TempDir dir;
+  std::filesystem::create_directories(dir.file("unknown"));
+  std::filesystem::create_directories(dir.file("failing"));
+  // A skill-call every cycle (10 Hz) for 30 s: 300 issues, more than the 200 kept.
+  std::ofstream(dir.file("unknown/a.clp"))
+      << "(defrule again (time $?) => (skill-call no_such_skill))\n";
+  std::ofstream(dir.file("failing/a.clp"))
+      << "(defrule again (time $?) => (skill-call drive_to place \"NOWHERE\"))\n";
+  for (const char* agent : {"unknown", "failing"}) {
+    std::ofstream(dir.file(std::string(agent) + ".yaml"))
+        << "name: strict\nduration_s: 30\nstart: production\n"
+           "robots: {count: 1, agent: ["
+        << agent << "]}\n";
+  }
+  const auto unknown =
+      llsfsim({"run", dir.file("unknown.yaml"), "--no-db", "--no-record", "--strict"});
+  INFO(unknown.out);
+  CHECK(unknown.code == 1);
+  CHECK(has(unknown.out, "test       FAIL  strict: no agent mistakes: 300 mistakes"));
+  CHECK(has(unknown.out, "issue      ... and 290 more mistakes, 300 in all"));
+  CHECK(has(unknown.out, "issue      100 more issues not kept (the first 200 are)"));
+  const auto failing =
+      llsfsim({"run", dir.file("failing.yaml"), "--no-db", "--no-record", "--strict"});
+  INFO(failing.out);
+  CHECK(failing.code == 0);  // skill failures are no mistakes, however many
+  CHECK(has(failing.out, "test       PASS  strict: no agent mistakes: 0 mistakes"));
+  CHECK(has(failing.out, "more issues not kept"));
+}
+
+TEST_CASE("run and batch --fail-fast stop at the first agent error") {
+  const TempDir dir;
+  std::filesystem::create_directories(dir.file("agent"));
+  std::ofstream(dir.file("agent/one.clp"))
+      << "(defrule oops (time ?s ?) (test (>= ?s 2)) (not (oops))\n"
+         "  => (assert (oops)) (eval \"(no-such-fn 1)\"))\n";
+  std::ofstream(dir.file("s.yaml")) << "name: ff\nduration_s: 20\nstart: production\n"
+                                       "seeds: {first: 1, count: 4}\n"
+                                       "robots: {count: 1, agent: [agent]}\n";
+  const auto run = llsfsim({"run", dir.file("s.yaml"), "--no-db", "--no-record", "--fail-fast"});
+  INFO(run.out, run.err);
+  CHECK(run.code == 1);
+  CHECK(has(run.out,
+            "FAIL  fail-fast: no agent error: stopped at the first agent error: robot1 "
+            "at 2."));
+  const auto batch = llsfsim({"batch", dir.file("s.yaml"), "--db", dir.file("b.db"), "--no-record",
+                              "--fail-fast", "-j", "1"});
+  INFO(batch.out, batch.err);
+  CHECK(batch.code == 1);
+  CHECK(has(batch.err,
+            "llsfsim batch: --fail-fast: stopped at the first run with an agent error "
+            "(seed 1 of "));
+  const auto list = llsfsim({"report", "--db", dir.file("b.db"), "--list"});
+  CHECK(has(list.out, "1 variant(s) x 4 run(s)  unfinished"));  // 3 seeds never played
+  CHECK(llsfsim({"batch", dir.file("s.yaml"), "--slurm", "--fail-fast"}).code == 2);
+}

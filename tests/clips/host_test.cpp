@@ -434,3 +434,28 @@ TEST_CASE("fact-by-slot finds the fact a do-for-fact query would, or FALSE") {
   CHECK(f.logged("fact-by-slot: deftemplate m has no slot nosuch"));
   CHECK(f.logged("fact-by-slot: deftemplate m has a multislot l: use a single-field slot"));
 }
+
+TEST_CASE("a misspelt function or slot gets the name meant, at load and at run time") {
+  AgentFixture f;
+  const std::string fn = load_error(f, "(defrule a (x) => (pritnout t \"hi\" crlf))\n", "fn.clp");
+  CHECK(fn.find("fn.clp:1: [EXPRNPSR3] Missing function declaration for pritnout (did you mean "
+                "'printout'?)") == 0);
+  const std::string slot = load_error(f,
+                                      "(deftemplate job (slot place) (slot state))\n"
+                                      "(defrule b (job (plac M1)) => (assert (y)))\n",
+                                      "slot.clp");
+  CHECK(slot.find("plac") != std::string::npos);
+  CHECK(slot.find("(did you mean 'place'?)") != std::string::npos);
+  // A deffunction of the agent counts too; a name far from all gets no guess.
+  f.load(
+      "(deffunction double-it (?x) (* 2 ?x))\n"
+      "(defrule c (go) => (eval \"(doubel-it 2)\"))\n"
+      "(defrule d (go) => (eval \"(zzzzzz 1)\"))\n",
+      "run.clp");
+  f.step();  // (reset)
+  f.assert_fact("(go)");
+  f.step();
+  CHECK(f.logged("Missing function declaration for doubel-it (did you mean 'double-it'?)"));
+  CHECK(f.logged("Missing function declaration for zzzzzz"));
+  CHECK_FALSE(f.logged("zzzzzz (did you mean"));
+}

@@ -293,3 +293,23 @@ TEST_CASE("rule tests: test files are found by name in directories") {
   CHECK(files[1] == (d.path / "sub" / "c_test.yaml").string());
   CHECK_THROWS_AS(find_rule_test_files({(d.path / "nope").string()}), core::UserError);
 }
+
+TEST_CASE("rule tests: a failed expectation shows the runtime errors before it, without -v") {
+  const Dir d(R"yaml(agent: agent.clp
+tests:
+  - name: error first
+    given: ["(job (place M1))"]
+    steps:
+      - eval: (no-such-function 1)
+      - step: 1
+      - expect: (job (place M2))
+)yaml");
+  const RuleTestResult r = RuleTestFile::load(d.file(), registry()).run(0);
+  CHECK_FALSE(r.passed);
+  REQUIRE_FALSE(r.failure.empty());
+  CHECK(r.failure[0].find(":8: test error first: expected a fact (job (place M2))") !=
+        std::string::npos);
+  const std::string all = joined(r);
+  CHECK(all.find("the agent had 1 runtime error (a likely cause):") != std::string::npos);
+  CHECK(all.find("no-such-function") != std::string::npos);
+}

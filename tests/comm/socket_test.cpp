@@ -14,6 +14,9 @@
 #include <chrono>
 #include <cmath>
 #include <set>
+#include <string>
+#include <string_view>
+#include <vector>
 
 #include "comm/loopback.h"
 #include "llsf/comm/stream.h"
@@ -150,7 +153,10 @@ TEST_CASE("UDP: a port that is taken is refused with a clear error") {
 
 TEST_CASE("TCP: a client that sends a frame one byte at a time; server -> client") {
   const MessageRegistry reg = registry();
-  StreamServer server(reg, StreamServerOptions{"127.0.0.1", 0});
+  std::vector<std::string> logged;
+  StreamServerOptions options{"127.0.0.1", 0};
+  options.log = [&logged](std::string_view line) { logged.emplace_back(line); };
+  StreamServer server(reg, options);
   REQUIRE(server.port() > 0);
 
   asio::io_context io;
@@ -200,6 +206,23 @@ TEST_CASE("TCP: a client that sends a frame one byte at a time; server -> client
   CHECK(dynamic_cast<const llsf_agent_msgs::LockMessage&>(*events[1].message).resource() == "M3");
   CHECK(server.counters(client).malformed_by(FrameError::kUnknownType) == 1);
   CHECK(server.counters(client).frames_in == 3);
+  // ... and logged with its numbers and why.
+  REQUIRE(logged.size() == 1);
+  CHECK(logged[0].find(": dropped a frame (component 2100, type 77, ") != std::string::npos);
+  CHECK(logged[0].find("unknown_type: no message type is registered under these numbers") !=
+        std::string::npos);
+  events.clear();
+
+  // A flood of bad frames: the first 10 are logged, then one line says the rest are not.
+  std::vector<std::uint8_t> flood;
+  for (int i = 0; i < 20; ++i) flood.insert(flood.end(), unknown.begin(), unknown.end());
+  flood.insert(flood.end(), third.begin(), third.end());
+  asio::write(raw, asio::buffer(flood));
+  pump_until([&] { return !events.empty(); });
+  REQUIRE(events.size() == 1);
+  CHECK(server.counters(client).malformed_by(FrameError::kUnknownType) == 21);
+  REQUIRE(logged.size() == 11);
+  CHECK(logged[10].find("more frames dropped; they are counted, not logged") != std::string::npos);
   events.clear();
 
   // Server -> raw client.

@@ -150,13 +150,15 @@ TEST_CASE("an undeclared global names the nearest known name, if one is near") {
   CHECK(far.run() == SkillStatus::kFailed);
   CHECK(contains(far.error(), "mine.lua:7: undeclared global 'completely_unknown_thing'"));
   CHECK_FALSE(contains(far.error(), "did you mean"));
-  // A state used before fsm:define_states made it.
+  // A state used before fsm:define_states made it -- or a constant used before it is defined:
+  // the message names both.
   Engine early(
       "name = 's'\nfsm = SkillHSM:new{name=name, start='GO'}\ndocumentation = 'x'\n"
       "function GO:init() end\n");
   CHECK(contains(early.load_error(),
-                 "mine.lua:4: undeclared global 'GO': no state is defined "
-                 "yet: call fsm:define_states{...} before using a state"));
+                 "mine.lua:4: undeclared global 'GO': if it is a state, no state is defined "
+                 "yet: call fsm:define_states{...} before using it (function GO:init() ...); "
+                 "otherwise define it before this line (local GO = ...)"));
 }
 
 TEST_CASE("states that do not exist: the nearest and the list") {

@@ -1042,3 +1042,25 @@ TEST_CASE("protocol: master/slave: InitiateSync, SyncInfo, GameState between the
   CHECK(slave.receive(robot_beacon(t, "R", 1), Origin::master()).status ==
         ReceiveStatus::kRejected);
 }
+
+TEST_CASE("protocol: a controller connecting keeps the peers' RobotInfo and MachineInfo rhythm") {
+  Harness h;
+  start_in(h, llsf_msgs::GameState::PRODUCTION);
+  h.run_s(1.0);
+  const auto peers_robot_info = h.times<llsf_msgs::RobotInfo>(Kind::kAllPeers);
+  const auto peers_machine_info = h.times<llsf_msgs::MachineInfo>(Kind::kAllPeers);
+  REQUIRE(!peers_robot_info.empty());
+  // A controller reconnecting in a loop, every 0.2 s, for 1 s (the peers' RobotInfo is due at
+  // 2.5 s).
+  for (int i = 0; i < 5; ++i) {
+    h.p.client_connected(i + 1);
+    h.run_s(0.2);
+    h.p.client_disconnected(i + 1);
+  }
+  // No RobotInfo to the peers since (next due 2.5 s after the first), and the MachineInfo burst
+  // (0.5 s) went on at its own pace: one per 0.5 s, not one per connection.
+  CHECK(h.times<llsf_msgs::RobotInfo>(Kind::kAllPeers) == peers_robot_info);
+  CHECK(h.times<llsf_msgs::MachineInfo>(Kind::kAllPeers).size() <= peers_machine_info.size() + 2);
+  // The controllers' own messages did restart for each connection.
+  CHECK(h.times<llsf_msgs::RobotInfo>(Kind::kAllClients).size() >= 5);
+}

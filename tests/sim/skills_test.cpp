@@ -265,6 +265,11 @@ TEST_CASE("skill failures name their reason: bad arguments, unknown places, empt
   };
   failed_with("drive_to{place=\"M11\"}", "unknown place 'M11'");
   failed_with("drive_to{}", "drive_to needs place=<name> or x=, y=");
+  // What was wrong with the arguments, not only what is needed.
+  failed_with("drive_to{x=\"1.5\", y=2}",
+              "drive_to needs place=<name> or x=, y=: x= and y= must be numbers (got x=\"1.5\" "
+              "(a string), y=2)");
+  failed_with("drive_to{place=3}", "place= must be a place name, not 3");
   failed_with("finish_puck_at{place=\"M3\"}", "no puck in the holder");
   failed_with("deliver{}", "deliver: no puck in the holder");
   failed_with("get_s0{place=\"NOWHERE\"}", "get_s0: unknown place 'NOWHERE'");

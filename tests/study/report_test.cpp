@@ -259,3 +259,37 @@ TEST_CASE("the report's stars are corrected for many comparisons (Holm)") {
   CHECK(to_text(r).find("after Holm's correction for 5 comparisons") != std::string::npos);
   std::filesystem::remove(path);
 }
+
+TEST_CASE("the text report rounds as the HTML page does: an exact tie away from zero") {
+  BatchReport r;
+  r.batch.id = 1;
+  r.batch.scenario_name = "x";
+  VariantReport v;
+  v.variant = "a";
+  v.runs = 8;
+  v.passed = 5;  // 62.5 %: the page's Math.round shows 63
+  StatSummary p;
+  p.name = "points";
+  p.n = 8;
+  p.mean = 2.25;    // exact in binary: toFixed(1) "2.3", printf "%.1f" "2.2"
+  p.median = 0.35;  // not a tie in binary (0.34999...): "0.3" in both
+  p.q1 = -2.25;     // "-2.3"
+  p.q3 = 10.75;     // "10.8"
+  p.min = 2.5;      // "3" with no decimals
+  p.max = 3.5;      // "4"
+  v.stats.push_back(p);
+  r.variants.push_back(v);
+  Difference d;
+  d.variant = "b";
+  d.baseline = "a";
+  d.statistic = "points";
+  d.diff = 0.25;
+  d.ci_low = -0.25;
+  d.ci_high = 0.75;
+  r.differences.push_back(d);
+  const std::string text = to_text(r);
+  INFO(text);
+  CHECK(text.find("a                                8    63%      2.3     0.3    -2.3    10.8      "
+                  " 3       4\n") != std::string::npos);
+  CHECK(text.find("b                                +0.3  [-0.3, +0.8]") != std::string::npos);
+}

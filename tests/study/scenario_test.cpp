@@ -207,3 +207,21 @@ TEST_CASE("radio lock_messages: 2013 changes the numbers on the wire, not the ga
                            "(expected llsfsim: component 2100, or 2013: component 2000, types "
                            "1337 and 1338)");
 }
+
+TEST_CASE("scenario: refbox.known_teams fills GameInfo's known teams; bad lists are refused") {
+  const ScenarioFile f = load_scenario(scenario_file(
+      "t1.yaml",
+      "name: t\nrefbox: {team: Carologistics, known_teams: [Carologistics, Solidus]}\n"));
+  const std::vector<std::string> want = {"Carologistics", "Solidus"};
+  CHECK(f.variants.at(0).game.protocol.known_teams == want);
+  CHECK(f.variants.at(0).game.refbox.team == "Carologistics");
+  CHECK(load_scenario(scenario_file("t2.yaml", "name: t\n"))
+            .variants.at(0)
+            .game.protocol.known_teams.empty());
+  std::string p = scenario_file("t3.yaml", "name: t\nrefbox: {known_teams: Solidus}\n");
+  CHECK(error_of(p).find("refbox.known_teams: a list of team names") != std::string::npos);
+  p = scenario_file("t4.yaml", "name: t\nrefbox: {known_teams: [A, B, A]}\n");
+  CHECK(error_of(p).find("'A' is listed twice") != std::string::npos);
+  p = scenario_file("t5.yaml", "name: t\nrefbox: {known_teams: [\"\"]}\n");
+  CHECK(error_of(p).find("a team name has 1 to 64 characters") != std::string::npos);
+}

@@ -455,8 +455,12 @@ TEST_CASE("StatsStore (SQLite) refuses files that are not a statistics store") {
   const TempDir dir;
   { std::ofstream(dir.file("text.db")) << "not a database, just text that is long enough......"; }
   CHECK_THROWS_AS(StatsStore(dir.file("text.db")), StatsError);
-  // A missing directory is created; one that cannot be (below a file) is an error.
-  CHECK_NOTHROW(StatsStore(dir.file("missing/dir/x.db")));
+  // A missing directory is an error naming it (it is not created: docs/llsfsim.md), as is a
+  // "directory" that is a file.
+  const std::string missing = "the folder " + dir.file("missing/dir") + " does not exist";
+  CHECK_THROWS_WITH_AS(StatsStore(dir.file("missing/dir/x.db")), doctest::Contains(missing.c_str()),
+                       StatsError);
+  CHECK_FALSE(std::filesystem::exists(dir.file("missing")));
   CHECK_THROWS_AS(StatsStore(dir.file("text.db/x.db")), StatsError);
   // Another program's database.
   sqlite3* h = nullptr;

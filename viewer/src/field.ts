@@ -489,10 +489,16 @@ export function drawField(
     ctx.moveTo(X(x), Y(y));
     ctx.lineTo(X(x) + Math.cos(th) * rr, Y(y) - Math.sin(th) * rr);
     ctx.stroke();
+    // The labels go above (name) and below (skill) the robot, clear of a held puck that sticks
+    // out there (it used to be drawn over the skill label when the robot faced down).
+    let nameY = Y(y) - rr - 2;
+    let skillY = Y(y) + rr + 2;
     if (heldId > 0) {
       const hx = X(x) + Math.cos(th) * (rr + pr * 0.6);
       const hy = Y(y) - Math.sin(th) * (rr + pr * 0.6);
       drawPuck(ctx, hx, hy, pr, look(heldId), heldId, fontPx);
+      nameY = Math.min(nameY, hy - pr - 2);
+      skillY = Math.max(skillY, hy + pr + 2);
     }
     // A radio drop from this robot in the last second: a red flash on its rim.
     if (rs && time - rs.dropT >= 0 && time - rs.dropT < 1) {
@@ -512,7 +518,7 @@ export function drawField(
     ctx.textBaseline = "bottom";
     ctx.fillStyle = color;
     const jersey = header.jerseys?.[i];
-    ctx.fillText(jersey !== undefined ? `${name} #${jersey}` : name, X(x), Y(y) - rr - 2);
+    ctx.fillText(jersey !== undefined ? `${name} #${jersey}` : name, X(x), nameY);
     if (rs && rs.skill) {
       const short = rs.skill.length > 34 ? rs.skill.slice(0, 33) + "…" : rs.skill;
       ctx.font = `${fontPx - 1}px sans-serif`;
@@ -520,7 +526,7 @@ export function drawField(
       ctx.fillStyle =
         rs.status === "FAILED" ? "#c0392b" : rs.status === "FINAL" ? "#2e7d32" : "#333";
       const st = rs.skillState && rs.status === "RUNNING" ? ` · ${rs.skillState}` : "";
-      ctx.fillText(`${short} ${rs.status}${st}`, X(x), Y(y) + rr + 2);
+      ctx.fillText(`${short} ${rs.status}${st}`, X(x), skillY);
     }
     stats.robots++;
   });

@@ -28,6 +28,7 @@ interface SubmissionView {
   total?: number;
   value?: number | null;
   verdict?: string;
+  reason?: string;
   error?: string;
   rank?: number;
   submissions?: number;
@@ -150,9 +151,11 @@ function renderBoard(b: Board): void {
     tr.append(el("td", s.status === "done" ? `${s.passed} / ${s.total}` : "–"));
     tr.append(el("td", formatTime(s.received)));
     recent.append(tr);
-    if (s.error && s.status !== "done") {
+    // Why it failed: the worker's error, or the first run a played submission did not pass.
+    const why = s.status === "done" ? s.verdict !== "PASS" ? s.reason : undefined : s.error;
+    if (why) {
       const er = el("tr");
-      const td = el("td", s.error, "error");
+      const td = el("td", why, "error");
       td.colSpan = 5;
       er.append(td);
       recent.append(er);

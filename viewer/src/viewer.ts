@@ -125,7 +125,8 @@ function batchesPage(signal: AbortSignal): void {
         b.scenario_file,
         b.variants,
         b.runs_per_variant,
-        b.finished ? "yes" : "running",
+        // The single games of `llsfsim run` are never finished, nor running (docs/statistics.md).
+        b.kind === "run" ? "single games" : b.finished ? "yes" : "running",
       ]);
       root.append(
         batches.length === 0

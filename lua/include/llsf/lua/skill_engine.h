@@ -133,6 +133,13 @@ class SkillEngine {
   std::string skill_error(std::string_view skill) const;
   /// The state a skill's state machine is in ("" if inactive or not an FSM skill).
   std::string skill_state(std::string_view skill) const;
+  /// The states a skill's last step went through, first to last ("GO", "NEXT", "GO"), and that
+  /// step's number (it counts the skill's steps; the same number: no step since).
+  struct StatePath {
+    std::vector<std::string> states;  ///< empty if the step stayed in its state
+    std::int64_t step = 0;
+  };
+  StatePath skill_state_path(std::string_view skill) const;
 
   /// Every skill file found, in name order.
   std::vector<SkillInfo> skills() const;

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,11 @@ struct AgentBrainConfig {
   lua::SkillEngineConfig skills;
   /// Rule firings per agent cycle before the run is cut.
   std::int64_t max_rules_per_cycle = 10'000;
+  /// Runaway cycles (cut by the firing limit or stopped by the work budget) after which the
+  /// agent is halted for the rest of the game: it cycles no more and its robot stops
+  /// (docs/clips.md, "Budgets"). A runaway agent otherwise costs a budget's worth of CPU at
+  /// every cycle. 0: never halted.
+  int max_runaway_cycles = 10;
   /// Team name for ?*TEAM-NAME* (empty: the game's team or the refbox's).
   std::string team;
   /// The lock protocol over the radio (clips::AgentConfig::locks, docs/locks.md); also sets the
@@ -63,6 +69,16 @@ class AgentBrain final : public RobotBrain, private clips::SkillRunner {
   const clips::AgentHost& agent() const { return *agent_; }
   /// Runtime errors of this robot's agent since the game started (over reloads).
   int runtime_errors() const { return errors_before_reload_ + agent_->runtime_errors(); }
+
+  /// Why the agent was halted (AgentBrainConfig::max_runaway_cycles).
+  struct Halt {
+    core::SimTime time;    ///< the cycle that halted it
+    int rule_loops = 0;    ///< runaway cycles cut by the rule firing limit
+    int budget_stops = 0;  ///< runaway cycles stopped by the work budget
+    std::string text;      ///< for people: what happened and what it means
+  };
+  /// Set once the agent is halted (until a reload brings new files).
+  const std::optional<Halt>& halt() const { return halt_; }
 
   /// What reload_if_changed() did.
   struct Reload {
@@ -113,6 +129,10 @@ class AgentBrain final : public RobotBrain, private clips::SkillRunner {
   clips::AgentIo host_io_;
   std::vector<FileStamp> loaded_;  // the files as last loaded
   int errors_before_reload_ = 0;
+  int max_runaway_cycles_ = 10;
+  int rule_loops_ = 0;  // runaway cycles of the current agent
+  int budget_stops_ = 0;
+  std::optional<Halt> halt_;
   clips::TraceOptions trace_options_;  // set_trace(), for reloaded agents
   clips::TraceSink trace_sink_;
   std::unique_ptr<clips::AgentHost> agent_;

@@ -4,6 +4,7 @@
 // robot's skill level. Agents (or tools such as `llsfsim skill`) send it skill strings.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <string_view>
@@ -79,8 +80,9 @@ class SkillBrain final : public RobotBrain {
   lua::SkillStatus last_ = lua::SkillStatus::kInactive;
   std::string last_string_;
   std::function<void(const SkillStateChange&)> state_listener_;
-  std::string state_skill_;  ///< the skill whose state was last reported
-  std::string state_;        ///< its state as last reported
+  std::string state_skill_;       ///< the skill whose state was last reported
+  std::string state_;             ///< its state as last reported
+  std::int64_t state_step_ = -1;  ///< the skill's step whose states were last reported
 };
 
 }  // namespace llsf::sim

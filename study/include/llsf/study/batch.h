@@ -60,6 +60,9 @@ struct BatchOptions {
   /// (variant, seed) pairs stored elsewhere (the main store, for a task writing a shard): not
   /// played, counted as skipped.
   std::set<std::pair<std::string, std::uint64_t>> stored_elsewhere;
+  /// `--fail-fast`: after the first stored run with an agent error (RunResult::agent_error) no
+  /// new game starts; the running ones finish and are stored (as on Ctrl-C).
+  bool fail_fast = false;
 };
 
 /// The seed list of `--seeds`: comma-separated seeds and inclusive ranges A-B ("1,5,9-12"),
@@ -124,10 +127,12 @@ struct VariantSummary {
 /// What a batch did and what the store holds for it afterwards.
 struct BatchResult {
   std::int64_t batch_id = 0;
-  int total = 0;                         ///< variants x seeds
-  int skipped = 0;                       ///< already stored before this call
-  int played = 0;                        ///< played and stored by this call
-  bool interrupted = false;              ///< stopped before every run was stored
+  int total = 0;             ///< variants x seeds
+  int skipped = 0;           ///< already stored before this call
+  int played = 0;            ///< played and stored by this call
+  bool interrupted = false;  ///< stopped before every run was stored
+  /// With BatchOptions::fail_fast: the first stored run with an agent error ("variant seed N").
+  std::optional<std::string> agent_error;
   std::vector<VariantSummary> variants;  ///< over all stored runs, in matrix order
   bool all_passed() const;
   bool complete() const { return skipped + played == total; }

@@ -56,7 +56,8 @@ struct RunIssue {
   /// "rule-loop" (the firing limit of a cycle was reached), "skill-failure" (a skill string
   /// ended FAILED: `text` is the skill string and its error), "unknown-skill" (it failed because
   /// the library has no such skill), "lock-hold" (one robot held one lock longer than
-  /// RunIssue::kLongLockHold_s, not counting a jammed robot's).
+  /// RunIssue::kLongLockHold_s, not counting a jammed robot's), "agent-halted" (the agent ran
+  /// away for sim::AgentBrainConfig::max_runaway_cycles cycles and was halted; its robot stops).
   std::string kind;
   std::string rule;   ///< the CLIPS rule, if known
   std::string place;  ///< "file:line" of the rule, if known
@@ -128,14 +129,18 @@ struct RunResult {
   std::vector<std::pair<std::string, double>> time_split;
   std::vector<RunAward> awards;  ///< every points award, in order
   /// The run's issues in time order: the first kMaxIssues kept, `issues_dropped` counts the rest
-  /// (the counts above are complete).
+  /// (the counts above are complete); "agent-halted" issues are always kept.
   std::vector<RunIssue> issues;
   int issues_dropped = 0;
+  /// Every issue that is a mistake (RunIssue::is_mistake), kept in `issues` or dropped.
+  int mistakes = 0;
   static constexpr std::size_t kMaxIssues = 200;
   std::string recording;  ///< RunHooks::record_path if the game was recorded
   /// The hackathon score at the end (scenarios with `hackathon:` only).
   std::optional<sim::HackathonScore> hackathon;
   bool passed() const;
+  /// An agent made a runtime error or was halted (`--fail-fast` stops at the first).
+  bool agent_error() const;
 };
 
 /// What `run --trace ROBOT[:KINDS]` asks for (docs/llsfsim.md): a robot's name or "all", and
@@ -189,7 +194,11 @@ struct RunHooks {
   /// (sim::AgentBrain::reload_if_changed); what happened goes to `note` and the recording
   /// (a `note` line).
   bool reload_agents = false;
-  /// Messages about the game for the user (agent reloads), with the robot they concern.
+  /// Stop the game at the first agent error (a runtime error or a halted agent; `--fail-fast`):
+  /// the run then fails with the verdict "fail-fast: no agent error".
+  bool stop_at_agent_error = false;
+  /// Messages about the game for the user (agent reloads, halted agents), with the robot they
+  /// concern.
   std::function<void(core::SimTime t, const std::string& robot, const std::string& text)> note;
 };
 

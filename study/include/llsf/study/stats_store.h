@@ -99,9 +99,9 @@ class StatsStore {
 
   /// Opens the store `path` names: a PostgreSQL database for a `postgresql://` or `postgres://`
   /// URL (what it leaves out comes from the PG* environment variables, as for psql), else a
-  /// SQLite file (created if missing). Creates the schema in a new store and migrates an older
-  /// one. Throws StatsError if the store cannot be opened or reached, or holds a newer schema
-  /// version or other tables.
+  /// SQLite file (created if missing; its folder must exist). Creates the schema in a new store and
+  /// migrates an older one. Throws StatsError if the store cannot be opened or reached, or holds a
+  /// newer schema version or other tables.
   explicit StatsStore(const std::string& path);
   ~StatsStore();
   StatsStore(const StatsStore&) = delete;
@@ -124,6 +124,9 @@ class StatsStore {
   std::int64_t open_batch(const BatchKey& key);
   /// Marks a batch complete (sets `finished` to now, once).
   void finish_batch(std::int64_t batch_id);
+  /// Removes the batch `batch_id` if it holds no run (a submission that failed after opening
+  /// it); does nothing otherwise.
+  void remove_empty_batch(std::int64_t batch_id);
   /// Every batch (and stored single run's batch), by id.
   std::vector<StoredBatch> batches() const;
   /// The batch `batch_id`, if it exists.
