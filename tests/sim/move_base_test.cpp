@@ -110,29 +110,28 @@ TEST_CASE("move_base-2013: a pose at a machine is reached by move_base, then a s
   CHECK((p.position() - m4->pose.position()).norm() <= 0.03);
 }
 
-TEST_CASE("move_base-2013: two robots meet head-on between M8 and M4 (0.87 m)") {
-  // The gap between M8 (x <= 1.78) and M4 (x >= 2.65); each wants the other's start.
-  const core::Pose2D a{2.215, 0.95, core::kPi / 2};
-  const core::Pose2D b{2.215, 2.45, -core::kPi / 2};
-  GameConfig c = two_robots(a, b);
-  Game g(c);
-  const Run r = play(g, b, &a, 240.0);
-  report("head-on between M8 and M4", r);
-  // Both navigations end: arrived, or aborted after move_base's recovery sequence.
-  CHECK(r.a != planner::NavOutcome::kRunning);
-  CHECK(r.b != planner::NavOutcome::kRunning);
-}
-
-TEST_CASE("move_base-2013: two robots meet head-on beside a machine") {
-  // Along M5's front (x = 2.8 - 0.1 - ...), one from below, one from above.
-  const core::Pose2D a{2.2, 2.0, core::kPi / 2};
-  const core::Pose2D b{2.2, 3.5, -core::kPi / 2};
-  GameConfig c = two_robots(a, b);
-  Game g(c);
-  const Run r = play(g, b, &a, 240.0);
-  report("head-on beside M5", r);
-  CHECK(r.a != planner::NavOutcome::kRunning);
-  CHECK(r.b != planner::NavOutcome::kRunning);
+TEST_CASE("move_base-2013: two robots meet head-on, each going to the other's start") {
+  struct Meeting {
+    const char* where;
+    core::Pose2D a;
+    core::Pose2D b;
+  };
+  const Meeting meetings[] = {
+      // The 0.87 m gap between M8 (x <= 1.78) and M4 (x >= 2.65).
+      {"between M8 and M4", {2.215, 0.95, core::kPi / 2}, {2.215, 2.45, -core::kPi / 2}},
+      // Along M5's front, one from below, one from above.
+      {"beside M5", {2.2, 2.0, core::kPi / 2}, {2.2, 3.5, -core::kPi / 2}},
+  };
+  for (const Meeting& m : meetings) {
+    CAPTURE(std::string(m.where));
+    GameConfig c = two_robots(m.a, m.b);
+    Game g(c);
+    const Run r = play(g, m.b, &m.a, 240.0);
+    report(std::string("head-on ") + m.where, r);
+    // Both navigations end: arrived, or aborted after move_base's recovery sequence.
+    CHECK(r.a != planner::NavOutcome::kRunning);
+    CHECK(r.b != planner::NavOutcome::kRunning);
+  }
 }
 
 TEST_CASE("move_base-2013: a parked robot in the gap is seen, marked and driven round") {
