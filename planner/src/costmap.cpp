@@ -31,6 +31,12 @@ Costmap::Costmap(Vec2 origin, int nx, int ny, double resolution_m, const MoveBas
   // figures (0.275 and 0.30 m) every cell within 0.30 m is inscribed, at 0.05 m and at 0.1 m.
   const int inscribed = static_cast<int>(std::ceil(config.robot_radius_m / res_ - 1e-9));
   const int r = static_cast<int>(std::ceil(config.inflation_radius_m / res_ - 1e-9));
+  struct KernelCell {
+    int di;
+    int dj;
+    std::uint8_t cost;
+  };
+  std::vector<KernelCell> kernel;
   for (int dj = -r; dj <= r; ++dj) {
     for (int di = -r; di <= r; ++di) {
       const double d = std::hypot(static_cast<double>(di), static_cast<double>(dj));
@@ -45,20 +51,20 @@ Costmap::Costmap(Vec2 origin, int nx, int ny, double resolution_m, const MoveBas
             (kInscribed - 1) *
             std::exp(-config.cost_scaling_factor * (d * res_ - config.robot_radius_m)));
       }
-      if (c > 0) kernel_.push_back({di, dj, c});
+      if (c > 0) kernel.push_back({di, dj, c});
     }
   }
   // The same kernel as row spans (zeros inside a span are harmless under max).
   for (int dj = -r; dj <= r; ++dj) {
     int lo = r + 1, hi = -r - 1;
-    for (const KernelCell& k : kernel_) {
+    for (const KernelCell& k : kernel) {
       if (k.dj != dj) continue;
       lo = std::min(lo, k.di);
       hi = std::max(hi, k.di);
     }
     if (lo > hi) continue;
     KernelRow row{dj, lo, std::vector<std::uint8_t>(static_cast<std::size_t>(hi - lo + 1), 0)};
-    for (const KernelCell& k : kernel_) {
+    for (const KernelCell& k : kernel) {
       if (k.dj == dj) row.costs[static_cast<std::size_t>(k.di - lo)] = k.cost;
     }
     rows_.push_back(std::move(row));
@@ -130,7 +136,8 @@ void Costmap::recenter(const Vec2& center) {
   const int si = static_cast<int>(std::floor((wanted.x() - origin_.x()) / res_));
   const int sj = static_cast<int>(std::floor((wanted.y() - origin_.y()) / res_));
   if (si == 0 && sj == 0) return;
-  std::vector<std::uint8_t> moved(obstacle_.size(), 0);
+  std::vector<std::uint8_t>& moved = scratch_;
+  moved.assign(obstacle_.size(), 0);
   for (int j = 0; j < ny_; ++j) {
     const int oj = j + sj;
     if (oj < 0 || oj >= ny_) continue;
@@ -142,11 +149,6 @@ void Costmap::recenter(const Vec2& center) {
   }
   obstacle_.swap(moved);
   origin_ = Vec2(origin_.x() + si * res_, origin_.y() + sj * res_);
-}
-
-void Costmap::update(const Vec2& origin, std::span<const Vec2> hits) {
-  mark_and_clear(origin, hits);
-  inflate();
 }
 
 void Costmap::update(const Vec2& origin, std::span<const Vec2> hits, const Vec2& robot,
@@ -248,15 +250,6 @@ void Costmap::reset_outside(const Vec2& center, double size_m) {
     }
   }
   inflate();
-}
-
-void Costmap::clear_obstacles() {
-  std::fill(obstacle_.begin(), obstacle_.end(), 0);
-  inflate();
-}
-
-int Costmap::obstacle_count() const {
-  return static_cast<int>(std::count(obstacle_.begin(), obstacle_.end(), 1));
 }
 
 void Costmap::inflate() {

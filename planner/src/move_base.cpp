@@ -273,11 +273,11 @@ VelocityCommand MoveBaseNavigator::update(SimTime now, const Pose2D& pose,
     return command_;
   }
   if (state_ == MoveBaseState::kApproach) {
-    command_ = approach(pose, dt);
+    command_ = approach(pose);
     return command_;
   }
   if (state_ == MoveBaseState::kClearing && rotating_) {
-    command_ = run_recovery(now, pose, velocity);
+    command_ = run_recovery(now, pose);
     return command_;
   }
   if (now < next_control_) return command_;
@@ -308,7 +308,7 @@ VelocityCommand MoveBaseNavigator::update(SimTime now, const Pose2D& pose,
           stopped) {
         if (needs_approach_) {
           state_ = MoveBaseState::kApproach;
-          command_ = approach(pose, dt);
+          command_ = approach(pose);
         } else {
           finish(NavOutcome::kArrived, {});
         }
@@ -388,13 +388,12 @@ void MoveBaseNavigator::start_recovery(SimTime now, const Pose2D& pose) {
   }
 }
 
-bool MoveBaseNavigator::rotation_free(const Pose2D& pose, double /*angle*/) const {
+bool MoveBaseNavigator::rotation_free(const Pose2D& pose) const {
   // A circular footprint: every heading at this position costs the same.
   return local_.cost_at(pose.position(), false) < Costmap::kInscribed;
 }
 
-VelocityCommand MoveBaseNavigator::run_recovery(SimTime now, const Pose2D& pose,
-                                                const VelocityCommand& /*velocity*/) {
+VelocityCommand MoveBaseNavigator::run_recovery(SimTime now, const Pose2D& pose) {
   const double current =
       core::normalize_angle(core::normalize_angle(pose.theta) + rotate_start_offset_);
   const double left = core::kPi - current;
@@ -404,7 +403,7 @@ VelocityCommand MoveBaseNavigator::run_recovery(SimTime now, const Pose2D& pose,
     next_control_ = now;
     return VelocityCommand{};
   };
-  if (!rotation_free(pose, left)) return done();
+  if (!rotation_free(pose)) return done();
   if (current < 0.0) rotate_got_180_ = true;
   if (rotate_got_180_ && current >= -config_.yaw_goal_tolerance_rad) return done();
   double vel = std::sqrt(2.0 * config_.acc_lim_th * left);
@@ -414,7 +413,7 @@ VelocityCommand MoveBaseNavigator::run_recovery(SimTime now, const Pose2D& pose,
 
 // --- the final approach --------------------------------------------------------------------
 
-VelocityCommand MoveBaseNavigator::approach(const Pose2D& pose, double /*dt*/) {
+VelocityCommand MoveBaseNavigator::approach(const Pose2D& pose) {
   bool arrived = false;
   const VelocityCommand c = straight_to(pose, goal_, arrived);
   if (arrived) finish(NavOutcome::kArrived, {});

@@ -131,9 +131,9 @@ class Costmap {
   /// Moves a rolling window so that `center` is in its middle cell; cells that enter are free.
   void recenter(const Vec2& center);
   /// One sensor update: clear the cells along every beam from `origin` to its hit (within
-  /// raytrace range), mark the hits within obstacle range, then inflate.
-  void update(const Vec2& origin, std::span<const Vec2> hits);
-  /// update() and clear_footprint() in one inflation.
+  /// raytrace range), mark the hits within obstacle range, then, as costmap_2d's
+  /// clearRobotFootprint(), forget the laser obstacles within `radius_m` of `robot`; then
+  /// inflate.
   void update(const Vec2& origin, std::span<const Vec2> hits, const Vec2& robot, double radius_m);
   /// costmap_2d's clearRobotFootprint(), after every update and before every controller cycle:
   /// laser obstacle cells within `radius_m` of `center` (the robot's inscribed circle) are
@@ -142,10 +142,6 @@ class Costmap {
   /// ClearCostmapRecovery: laser obstacles outside the square of side `size_m` around `center`
   /// are forgotten (the static map remains).
   void reset_outside(const Vec2& center, double size_m);
-  /// Forgets every laser obstacle.
-  void clear_obstacles();
-  /// Laser obstacle cells now marked.
-  int obstacle_count() const;
 
  private:
   std::size_t idx(int i, int j) const {
@@ -164,13 +160,8 @@ class Costmap {
   std::vector<std::uint8_t> static_cost_;    // inflated static layer
   std::vector<std::uint8_t> obstacle_;       // 1 = laser obstacle
   std::vector<std::uint8_t> cost_;           // combined, inflated
-  struct KernelCell {
-    int di;
-    int dj;
-    std::uint8_t cost;
-  };
-  std::vector<KernelCell> kernel_;
-  struct KernelRow {  // the kernel by rows: costs of cells di0, di0 + 1, ... of row dj
+  std::vector<std::uint8_t> scratch_;        // recenter()'s moved obstacles (kept to reuse)
+  struct KernelRow {  // the inflation kernel by rows: costs of cells di0, di0 + 1, ... of row dj
     int dj;
     int di0;
     std::vector<std::uint8_t> costs;
@@ -249,10 +240,10 @@ class MoveBaseNavigator {
   Traj create_trajectories(const Pose2D& pose, const VelocityCommand& vel);
   void generate(const Pose2D& pose, const VelocityCommand& vel, double vx_s, double vy_s,
                 double vth_s, Traj& t) const;
-  bool rotation_free(const Pose2D& pose, double angle) const;
+  bool rotation_free(const Pose2D& pose) const;
   void start_recovery(core::SimTime now, const Pose2D& pose);
-  VelocityCommand run_recovery(core::SimTime now, const Pose2D& pose, const VelocityCommand& vel);
-  VelocityCommand approach(const Pose2D& pose, double dt);
+  VelocityCommand run_recovery(core::SimTime now, const Pose2D& pose);
+  VelocityCommand approach(const Pose2D& pose);
   VelocityCommand straight_to(const Pose2D& pose, const Pose2D& target, bool& arrived) const;
   void add_stats(double dt);
 
