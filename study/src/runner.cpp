@@ -574,13 +574,15 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
     for (int k = 0; k < game.robot_count(); ++k) {
       const sim::AgentBrain* b = driver.agent(k);
       if (b == nullptr) continue;
-      const std::string robot(game.robot(k).name());
+      // Every tick: no string is built unless something is to be reported.
       if (!first_agent_error && (b->runtime_errors() > 0 || b->halt())) {
-        first_agent_error = robot + " at " + fmt_s(game.time().seconds()) + " s";
+        first_agent_error =
+            std::string(game.robot(k).name()) + " at " + fmt_s(game.time().seconds()) + " s";
       }
       const auto& h = b->halt();
       if (!h || halt_reported[static_cast<std::size_t>(k)]) continue;
       halt_reported[static_cast<std::size_t>(k)] = true;
+      const std::string robot(game.robot(k).name());
       halted.push_back(robot + " at " + fmt_s(h->time.seconds()) + " s");
       RunIssue issue;
       issue.time_s = h->time.seconds();
