@@ -125,23 +125,39 @@ void MoveBaseNavigator::go_to(const Pose2D& goal, bool forward) {
     return planner_->clearance(p).distance_m >= config_.standoff_m();
   };
   if (!clear(goal.position())) {
-    // The first pose back along the heading at the standoff; where two obstacles leave less
-    // room (M4's input faces M3 across 0.92 m), the pose of most clearance on that line.
+    // The first pose back along the heading at the standoff. Where two obstacles leave less
+    // room on that line (M4's input faces M3 across 0.92 m, M10's faces M7's side across
+    // 0.87 m), the pose of most clearance on it, on either side of the goal, as long as the
+    // line stays out of the obstacles.
     const double step = 0.01;
-    double best_clearance = -1.0;
     Vec2 best = goal.position();
+    double best_clearance = planner_->clearance(best).distance_m;
+    bool found = false;
     for (double d = step; d <= 1.5; d += step) {
       const Vec2 p = goal.position() + back * d;
       const double c = planner_->clearance(p).distance_m;
       if (c >= config_.standoff_m()) {
         best = p;
+        found = true;
         break;
       }
-      if (c > best_clearance + 1e-9) {
+      if (c <= 0.0 || c < best_clearance - 0.1) break;  // past the room between the obstacles
+      if (c > best_clearance) {
         best_clearance = c;
         best = p;
-      } else if (c < best_clearance - 0.1) {
-        break;  // past the room between the obstacles
+      }
+    }
+    for (double d = step; !found && d <= 1.5; d += step) {
+      const Vec2 p = goal.position() - back * d;
+      const double c = planner_->clearance(p).distance_m;
+      if (c <= 0.0 || c < best_clearance - 0.1) break;  // towards the machine ahead
+      if (c >= config_.standoff_m()) {
+        best = p;
+        break;
+      }
+      if (c > best_clearance) {
+        best_clearance = c;
+        best = p;
       }
     }
     base_goal_ = Pose2D{best.x(), best.y(), goal.theta};
@@ -239,17 +255,33 @@ VelocityCommand MoveBaseNavigator::update(SimTime now, const Pose2D& pose,
     if (!clear(pose.position())) {
       const double step = 0.01;
       bool found = false;
+      // Where no point within reach has the standoff (between M10 and M7's side, 0.87 m
+      // apart), the point of most clearance, if it gains at least a cell of the local map.
+      double best_clearance =
+          planner_->clearance(pose.position()).distance_m + config_.local_resolution_m;
+      Pose2D best;
+      bool better = false;
       for (double d = step; d <= config_.depart_max_m && !found; d += step) {
         for (int k = 0; k < 16 && !found; ++k) {
           // Straight back, then alternately 22.5 degrees more to either side.
           const double ang =
               pose.theta + core::kPi + ((k + 1) / 2) * (core::kPi / 8.0) * (k % 2 ? 1 : -1);
           const Vec2 p = pose.position() + Vec2(std::cos(ang), std::sin(ang)) * d;
-          if (clear(p)) {
-            depart_to_ = Pose2D{p.x(), p.y(), forward_ ? core::normalize_angle(ang) : pose.theta};
+          const double c = planner_->clearance(p).distance_m;
+          const Pose2D to{p.x(), p.y(), forward_ ? core::normalize_angle(ang) : pose.theta};
+          if (c >= config_.standoff_m()) {
+            depart_to_ = to;
             found = true;
+          } else if (c > best_clearance) {
+            best_clearance = c;
+            best = to;
+            better = true;
           }
         }
+      }
+      if (!found && better) {
+        depart_to_ = best;
+        found = true;
       }
       if (found) state_ = MoveBaseState::kDepart;
     }
@@ -415,7 +447,18 @@ VelocityCommand MoveBaseNavigator::run_recovery(SimTime now, const Pose2D& pose)
 
 VelocityCommand MoveBaseNavigator::approach(const Pose2D& pose) {
   bool arrived = false;
-  const VelocityCommand c = straight_to(pose, goal_, arrived);
+  Pose2D target = goal_;
+  if (forward_) {
+    // Carrying a puck, the straight move never backs off (the holder would lose the puck):
+    // a goal behind the approach pose -- where the pose of most clearance lies beyond it, as
+    // a pre-pose of M10's input facing M7 -- is reached by turning to its heading where the
+    // robot stands.
+    const Vec2 heading(std::cos(goal_.theta), std::sin(goal_.theta));
+    if ((goal_.position() - pose.position()).dot(heading) < 0.0) {
+      target = Pose2D{pose.x, pose.y, goal_.theta};
+    }
+  }
+  const VelocityCommand c = straight_to(pose, target, arrived);
   if (arrived) finish(NavOutcome::kArrived, {});
   return c;
 }
