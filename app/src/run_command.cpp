@@ -685,6 +685,8 @@ int check(const std::vector<std::string>& files, std::ostream& out, std::ostream
           c.skills = s.skills;
           c.locks = spec.locks;
           c.sandbox = spec.sandbox;
+          c.fawkes = spec.fawkes;
+          c.agent_dir = spec.agent_dir;
           const sim::AgentBrain& brain = driver.plug_agent(i, c);
           for (const std::string& e : brain.skills().engine().load_errors()) {
             throw core::ConfigError("skill file error: " + e);

@@ -10,6 +10,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -46,6 +47,9 @@ struct HostState {
   };
   std::vector<Received> inbox;
   int live_messages = 0;  ///< maintained by the protobuf feature
+  /// A Fawkes-style agent broadcasts and receives only once it enabled its peer
+  /// (pb-peer-enable / pb-peer-create); llsfsim's agents always do.
+  bool peer_enabled = false;
 
   /// Emits one log line at `now` (set by the host).
   std::function<void(LogLevel, std::string_view)> log;
@@ -77,6 +81,10 @@ std::unique_ptr<Feature> make_protobuf_feature(HostState& state);
 /// Always registered, inactive unless AgentConfig::locks (the host then skips locks.clp). Runs
 /// before the protobuf feature: it takes the lock messages out of the inbox.
 std::unique_ptr<Feature> make_locks_feature(HostState& state);
+/// ff-feature-request and the feature facts (Fawkes-style agents), motor-enable/-disable.
+std::unique_ptr<Feature> make_fawkes_feature(HostState& state);
+/// The features a Fawkes-style agent finds as (ff-feature X) facts and may request.
+std::span<const std::string_view> fawkes_features();
 
 /// Formats a value as printout does: symbols and strings bare, numbers as CLIPS prints them.
 std::string print_form(const Value& v);
