@@ -514,8 +514,21 @@ class ProtobufFeature final : public Feature {
     // registry: take them from protobuf's generated pool, once a registered type is loaded.
     const Descriptor* d =
         google::protobuf::DescriptorPool::generated_pool()->FindMessageTypeByName(name);
-    if (d == nullptr) return nullptr;
-    const Message* proto = google::protobuf::MessageFactory::generated_factory()->GetPrototype(d);
+    const Message* proto = nullptr;
+    if (d != nullptr) {
+      proto = google::protobuf::MessageFactory::generated_factory()->GetPrototype(d);
+    } else {
+      // Or a type of an agent's own .proto files (comm::ProtoLibrary) that is used inside a
+      // registered one: from that one's pool and factory.
+      for (int i = 0; i < reg.size() && proto == nullptr; ++i) {
+        const Message* p = reg.prototype(reg.key_at(i));
+        const google::protobuf::DescriptorPool* pool = p->GetDescriptor()->file()->pool();
+        if (pool == google::protobuf::DescriptorPool::generated_pool()) continue;
+        if (const Descriptor* own = pool->FindMessageTypeByName(name))
+          proto = p->GetReflection()->GetMessageFactory()->GetPrototype(own);
+      }
+    }
+    if (proto == nullptr) return nullptr;
     by_name_[name] = proto;
     nested_types_ += 1;
     return proto;

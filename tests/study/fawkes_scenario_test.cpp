@@ -96,10 +96,11 @@ constexpr const char* kNet = R"clp(
   (modify ?t (time ?now))
   (bind ?m (pb-create "demo_msgs.Ping"))
   (pb-set-field ?m "agent" ?*NAME*)
-  (bind ?s (pb-field-value ?m "stamp"))
+  (bind ?s (pb-create "demo_msgs.Stamp"))
   (pb-set-field ?s "sec" (nth$ 1 ?now))
   (pb-set-field ?s "usec" (nth$ 2 ?now))
   (pb-set-field ?m "stamp" ?s)
+  (pb-destroy ?s)
   (pb-broadcast ?m)
   (pb-destroy ?m))
 
@@ -179,6 +180,7 @@ TEST_CASE("a Fawkes-style agent's scenario: the host's locks off, paths inside, 
                        doctest::Contains("the host's lock protocol is off for a Fawkes-style"),
                        core::ConfigError);
   a.dir.write("bad.yaml", R"yaml(
+name: escape
 robots:
   agent: {fawkes: agents, entry: ../s.yaml}
 )yaml");

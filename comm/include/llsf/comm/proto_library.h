@@ -18,7 +18,8 @@ class MessageRegistry;
 
 /// The message types of the .proto files of some directories, parsed at load time. A type that
 /// protobuf's generated pool has too (e.g. llsf_msgs.GameState, compiled into llsfsim) is the
-/// generated one, after a check that both declare the same fields; the others are built as
+/// generated one, after a check that it has every field of the file's type (number, name, type,
+/// label); the others are built as
 /// dynamic messages. Immutable after load(); shared by the games of a batch (thread-safe).
 class ProtoLibrary {
  public:
