@@ -157,6 +157,7 @@ struct AgentHost::Impl {
     features.push_back(detail::make_locks_feature(state));  // before protobuf: takes lock messages
     features.push_back(detail::make_protobuf_feature(state));
     features.push_back(detail::make_fawkes_feature(state));
+    features.push_back(detail::make_blackboard_feature(state));
     for (auto& f : features) f->define(env);
     if (state.config.fawkes) define_fawkes_functions();
     for (int i = 0; i < detail::kBuiltinCodeCount; ++i) {
@@ -738,6 +739,14 @@ void AgentHost::set_pose(const core::Pose2D& pose) {
   if (s.pose && s.pose->x == pose.x && s.pose->y == pose.y && s.pose->theta == pose.theta) return;
   s.pose = pose;
   s.pose_dirty = true;
+}
+
+void AgentHost::write_interface(std::string_view type, std::string_view id,
+                                std::vector<std::pair<std::string, Value>> fields) {
+  auto& d = impl_->state.blackboard[{std::string(type), std::string(id)}];
+  d.time = impl_->state.now;
+  d.fields = std::move(fields);
+  ++d.serial;
 }
 
 void AgentHost::receive(std::unique_ptr<google::protobuf::Message> message, std::string_view from,

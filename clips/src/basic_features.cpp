@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Small features: logging functions, seeded random, robot identity and pose, confval facts.
 #include <array>
+#include <cmath>
 
 #include "feature.h"
 #include "llsf/core/rng.h"
@@ -120,12 +121,31 @@ class RobotFeature final : public Feature {
     env.release(pose_fact_);  // the reset retracted it
     s_.pose_dirty = s_.pose.has_value();
   }
+  // A Fawkes-style agent reads the pose from the blackboard: Position3DInterface "Pose", written
+  // at every cycle as the 2013 localization wrote it at its rate (the map frame; the yaw as the
+  // quaternion (0 0 sin(a/2) cos(a/2)); visibility_history counts the updates).
+  void write_pose_interface() {
+    auto& d = s_.blackboard[{"Position3DInterface", "Pose"}];
+    d.time = s_.now;
+    const double h = s_.pose->theta / 2.0;
+    d.fields = {
+        {"frame", Value::string("/map")},
+        {"visibility_history", Value::integer_value(static_cast<std::int64_t>(d.serial) + 1)},
+        {"rotation",
+         Value::multifield({Value::float_value(0.0), Value::float_value(0.0),
+                            Value::float_value(std::sin(h)), Value::float_value(std::cos(h))})},
+        {"translation",
+         Value::multifield({Value::float_value(s_.pose->x), Value::float_value(s_.pose->y),
+                            Value::float_value(0.0)})}};
+    ++d.serial;
+  }
   void set_globals(Environment& env) {
     env.set_global("ROBOT-NAME", Value::symbol(s_.config.robot_name));
     env.set_global("ROBOT-NUMBER", Value::integer_value(s_.config.robot_number));
     env.set_global("TEAM-NAME", Value::string(s_.config.team_name));
   }
   void before_run(Environment& env) override {
+    if (s_.config.fawkes && s_.pose) write_pose_interface();
     if (!s_.pose_dirty) return;
     s_.pose_dirty = false;
     env.retract(pose_fact_);

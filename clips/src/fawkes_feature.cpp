@@ -10,9 +10,10 @@
 namespace llsf::clips::detail {
 
 std::span<const std::string_view> fawkes_features() {
-  // What a Fawkes-style agent may request: config-load, the pb-* functions, the motor switch.
-  static constexpr std::array<std::string_view, 3> kFeatures = {"config", "motor-switch",
-                                                                "protobuf"};
+  // What a Fawkes-style agent may request: the blackboard (the interfaces of
+  // blackboard_feature.cpp), config-load, the pb-* functions, the motor switch.
+  static constexpr std::array<std::string_view, 4> kFeatures = {"blackboard", "config",
+                                                                "motor-switch", "protobuf"};
   return kFeatures;
 }
 

@@ -238,3 +238,45 @@ TEST_CASE("a nested message read from an unset field can be filled and set") {
     CHECK(m.incoming().action() == "FINISH");
   }
 }
+
+TEST_CASE("blackboard-open: interface facts from the pose and from written interfaces") {
+  AgentDir d;
+  d.write("demo/demo.clp", R"clp(
+(defrule use-blackboard
+  (ff-feature blackboard)
+  =>
+  (ff-feature-request "blackboard")
+  (blackboard-enable-time-read)
+  (blackboard-open "Position3DInterface" "Pose")
+  (blackboard-open "RobotinoLightInterface" "Light_State")
+  (blackboard-open "NoSuchInterface" "x")
+  (path-load demo/sense.clp))  ; its rules match the interface templates just defined
+)clp");
+  d.write("demo/sense.clp", R"clp(
+(defrule seen-pose
+  (Position3DInterface (id "Pose") (translation ?x ?y ?) (rotation $?q))
+  =>
+  (assert (seen-pose ?x ?y (nth$ 4 ?q))))
+(defrule seen-light
+  (RobotinoLightInterface (id "Light_State") (red ?r) (ready TRUE) (visibility_history ?v))
+  =>
+  (assert (seen-light ?r ?v)))
+)clp");
+  AgentFixture f(fawkes_config(d));
+  f.load_file(d.path("demo/demo.clp"));
+  CHECK(f.logged("blackboard-open: no interface type NoSuchInterface"));
+  f.agent().set_pose({1.5, 2.0, 0.0});
+  f.step();
+  CHECK(f.has("(seen-pose 1.5 2.0 1.0)"));
+  CHECK(f.facts("Position3DInterface").empty());     // retracted at the end of the cycle
+  CHECK(f.facts("RobotinoLightInterface").empty());  // nothing written yet
+  f.agent().write_interface("RobotinoLightInterface", "Light_State",
+                            {{"red", Value::symbol("ON")},
+                             {"yellow", Value::symbol("OFF")},
+                             {"green", Value::symbol("BLINKING")},
+                             {"visibility_history", Value::integer_value(25)},
+                             {"ready", Value::boolean(true)}});
+  f.step();
+  CHECK(f.has("(seen-light ON 25)"));
+  CHECK(f.agent().runtime_errors() == 0);
+}

@@ -188,6 +188,12 @@ class AgentHost {
 
   /// The robot's pose for the (pose (x) (y) (ori)) fact, updated at the next cycle if changed.
   void set_pose(const core::Pose2D& pose);
+  /// Writes a blackboard interface of a Fawkes-style agent (docs/fawkes.md): the fields of
+  /// interface `type` ("RobotinoLightInterface") with id `id` ("Light_State") by name, stamped
+  /// with the time of the last cycle. (blackboard-read) asserts it once per write. The pose
+  /// (set_pose) is written as Position3DInterface "Pose" by the host itself.
+  void write_interface(std::string_view type, std::string_view id,
+                       std::vector<std::pair<std::string, Value>> fields);
   /// A message received from peer `from` (name and id) at `at`; it becomes a protobuf-msg fact
   /// at the next cycle. The host takes ownership.
   void receive(std::unique_ptr<google::protobuf::Message> message, std::string_view from,
