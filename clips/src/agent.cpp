@@ -417,6 +417,7 @@ struct AgentHost::Impl {
     env.set_global("ROBOT-NAME", Value::symbol(state.config.robot_name));
     env.set_global("ROBOT-NUMBER", Value::integer_value(state.config.robot_number));
     env.set_global("TEAM-NAME", Value::string(state.config.team_name));
+    env.eval("(ff-feature-request \"config\")");  // as the clips-agent requested it
     env.assert_string("(agent-init)");
     env.eval("(config-load \"/clips-agent\")");
     flush_output();
@@ -425,6 +426,13 @@ struct AgentHost::Impl {
     run_rules(result);
     flush_output();
     load_failures_ = nullptr;
+    // /clips-agent/auto-start: the clips-agent asserted (start) once it had started (else when
+    // a switch interface enabled it, which llsfsim has not).
+    for (const ConfigEntry& c : state.config.config) {
+      if (c.path == "/clips-agent/auto-start" && !c.values.empty() &&
+          c.values.front() == Value::boolean(true))
+        env.assert_string("(start)");
+    }
     if (failures.empty()) return;
     std::string msg;
     for (const std::string& f : failures) {

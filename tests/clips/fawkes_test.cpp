@@ -95,12 +95,25 @@ TEST_CASE("a Fawkes-style entry file runs as Fawkes' clips-agent ran it") {
   CHECK(f.has("(state IDLE)"));
   CHECK(f.has("(ff-feature protobuf)"));
   CHECK(f.has("(ff-feature-loaded protobuf)"));
-  CHECK_FALSE(f.has("(agent-init)"));  // gone with the reset, as in Fawkes
+  CHECK(f.has("(ff-feature-loaded config)"));  // the clips-agent's own request
+  CHECK_FALSE(f.has("(agent-init)"));          // gone with the reset, as in Fawkes
   CHECK(f.has("(ready 4444)"));
   CHECK(f.find("confval", {{"path", Value::string("/other/value")}}).empty());
   CHECK(f.agent().eval("?*ROBOT-NAME*") == Value::string("R-1"));
   f.step();
   CHECK(f.agent().runtime_errors() == 0);
+}
+
+TEST_CASE("/clips-agent/auto-start asserts (start) once the agent has started") {
+  AgentDir d;
+  d.write("demo/demo.clp", "(defrule go (start) => (assert (going)))\n");
+  AgentConfig c = fawkes_config(d);
+  c.config.push_back(ConfigEntry::of("/clips-agent/auto-start", true));
+  AgentFixture f(c);
+  f.load_file(d.path("demo/demo.clp"));
+  CHECK(f.has("(start)"));
+  f.step();
+  CHECK(f.has("(going)"));
 }
 
 TEST_CASE("Fawkes' utility functions, (now) as (sec usec), timers start now") {
