@@ -293,3 +293,62 @@ TEST_CASE("blackboard-open: interface facts from the pose and from written inter
   CHECK(f.has("(seen-light ON 25)"));
   CHECK(f.agent().runtime_errors() == 0);
 }
+
+TEST_CASE("pb peers, clients and Fawkes' field answers") {
+  comm::MessageRegistry reg;
+  comm::add_agent_messages(reg);
+  AgentDir d;
+  d.write("demo/demo.clp", "(deffacts none)\n");
+  AgentConfig c = fawkes_config(d);
+  std::vector<std::string> sent_to_server;
+  int broadcasts = 0;
+  AgentIo io;
+  io.messages = &reg;
+  io.broadcast = [&broadcasts](const google::protobuf::Message&) { ++broadcasts; };
+  io.send = [&sent_to_server](const google::protobuf::Message& m) {
+    sent_to_server.push_back(m.GetTypeName());
+  };
+  AgentHost a(c, io);
+  a.load_file(d.path("demo/demo.clp"));
+  a.load_string("(defglobal ?*m* = (pb-create \"llsf_agent_msgs.LockMessage\"))", "g.clp");
+  a.eval("(pb-set-field ?*m* \"type\" GET)");
+  a.eval("(pb-set-field ?*m* \"agent\" \"R-1\")");
+  a.eval("(pb-set-field ?*m* \"resource\" \"M1\")");
+  // No peer yet: nothing goes out (a warning), and nothing is heard.
+  a.eval("(pb-broadcast ?*m*)");
+  CHECK(broadcasts == 0);
+  auto heard = std::make_unique<llsf_agent_msgs::WorldmodelChange>();
+  a.receive(std::move(heard), "robot2", 2, core::SimTime::from_ms(50));
+  a.load_string("(defrule heard (protobuf-msg) => (assert (heard)))", "r.clp");
+  a.cycle(core::SimTime::from_ms(100));
+  CHECK(a.facts("heard").empty());
+  // The peer: the radio; a second form of pb-broadcast with its id.
+  const Value peer = a.eval("(pb-peer-create \"172.26.255.255\" 4444)");
+  CHECK(peer == Value::integer_value(1));
+  a.eval("(pb-broadcast ?*m*)");
+  a.eval("(pb-broadcast 1 ?*m*)");
+  CHECK(broadcasts == 2);
+  a.receive(std::make_unique<llsf_agent_msgs::WorldmodelChange>(), "robot2", 2,
+            core::SimTime::from_ms(150));
+  a.cycle(core::SimTime::from_ms(200));
+  CHECK(a.facts("heard").size() == 1);
+  const int errors = a.runtime_errors();
+  a.eval("(pb-broadcast 7 ?*m*)");  // no such peer
+  CHECK(broadcasts == 2);
+  // A client of the game's stream server.
+  const Value client = a.eval("(pb-connect \"localhost\" 4444)");
+  REQUIRE(client.type == Value::Type::kInteger);
+  a.eval("(pb-send " + client.to_string() + " ?*m*)");
+  CHECK(sent_to_server == std::vector<std::string>{"llsf_agent_msgs.LockMessage"});
+  a.eval("(pb-send 99 ?*m*)");  // no such connection
+  CHECK(sent_to_server.size() == 1);
+  a.eval("(pb-disconnect " + client.to_string() + ")");
+  CHECK(a.eval("(any-factp ((?f protobuf-client-disconnected)) TRUE)") == Value::boolean(true));
+  // Fawkes' answers for fields.
+  CHECK(a.eval("(pb-field-type ?*m* \"agent\")") == Value::symbol("STRING"));
+  CHECK(a.eval("(pb-field-label ?*m* \"type\")") == Value::symbol("REQUIRED"));
+  CHECK(a.eval("(pb-field-value ?*m* \"no_field\")") == Value::symbol("DOES-NOT-EXIST"));
+  a.load_string("(defglobal ?*w* = (pb-create \"llsf_agent_msgs.WorldmodelChange\"))", "w.clp");
+  CHECK(a.eval("(pb-field-value ?*w* \"machine\")") == Value::symbol("NOT-SET"));
+  CHECK(a.runtime_errors() == errors + 2);  // the unknown peer and the unknown connection
+}
