@@ -63,7 +63,14 @@ void MoveBaseConfig::validate() const {
   core::require(p + "controller_patience_s", controller_patience_s, core::non_negative());
   core::require(p + "navgraph_direct_m", navgraph_direct_m, core::non_negative());
   core::require(p + "approach_speed_mps", approach_speed_mps, core::positive());
-  core::require(p + "approach_omega_rps", approach_omega_rps, core::positive());
+  core::require(p + "depart_speed_mps", depart_speed_mps, core::positive());
+  core::require(p + "motor_omega_rps", motor_omega_rps, core::positive());
+  core::require(p + "motor_gain_xy", motor_gain_xy, core::positive());
+  core::require(p + "motor_gain_th", motor_gain_th, core::positive());
+  core::require(p + "motor_min_speed_mps", motor_min_speed_mps, core::non_negative());
+  core::require(p + "motor_min_omega_rps", motor_min_omega_rps, core::non_negative());
+  core::require(p + "depart_tolerance_m", depart_tolerance_m, core::positive());
+  core::require(p + "depart_angle_tolerance_rad", depart_angle_tolerance_rad, core::positive());
   core::require(p + "approach_tolerance_m", approach_tolerance_m, core::positive());
   core::require(p + "approach_angle_tolerance_rad", approach_angle_tolerance_rad, core::positive());
 }
@@ -308,13 +315,15 @@ VelocityCommand MoveBaseNavigator::update(SimTime now, const Pose2D& pose,
   if (state_ == MoveBaseState::kDepart) {
     bool arrived = false;
     const double turn = core::angle_diff(depart_to_.theta, pose.theta);
-    if (forward_ && std::abs(turn) > config_.approach_angle_tolerance_rad) {
+    if (forward_ && std::abs(turn) > config_.depart_angle_tolerance_rad) {
       // Carrying a puck: turn towards the way out first (leave_IS: TURN, then MOTOR_MOVE).
-      command_ = {0.0, 0.0,
-                  std::clamp(1.5 * turn, -config_.approach_omega_rps, config_.approach_omega_rps)};
+      command_ =
+          straight_to(pose, Pose2D{pose.x, pose.y, depart_to_.theta}, config_.depart_speed_mps,
+                      config_.depart_tolerance_m, config_.depart_angle_tolerance_rad, arrived);
       return command_;
     }
-    command_ = straight_to(pose, depart_to_, arrived);
+    command_ = straight_to(pose, depart_to_, config_.depart_speed_mps, config_.depart_tolerance_m,
+                           config_.depart_angle_tolerance_rad, arrived);
     if (arrived) {
       state_ = MoveBaseState::kPlanning;
       last_valid_plan_ = now;
@@ -480,25 +489,34 @@ VelocityCommand MoveBaseNavigator::approach(const Pose2D& pose) {
       target = Pose2D{pose.x, pose.y, goal_.theta};
     }
   }
-  const VelocityCommand c = straight_to(pose, target, arrived);
+  const VelocityCommand c =
+      straight_to(pose, target, config_.approach_speed_mps, config_.approach_tolerance_m,
+                  config_.approach_angle_tolerance_rad, arrived);
   if (arrived) finish(NavOutcome::kArrived, {});
   return c;
 }
 
 VelocityCommand MoveBaseNavigator::straight_to(const Pose2D& pose, const Pose2D& target,
-                                               bool& arrived) const {
-  const Vec2 d = target.position() - pose.position();
-  const double dist = d.norm();
+                                               double speed, double tolerance_m,
+                                               double tolerance_rad, bool& arrived) const {
+  // motor_move: each axis of the robot frame on its own, no obstacle check, no timeout.
+  const Vec2 d = core::rotate(target.position() - pose.position(), -pose.theta);
   const double dth = core::angle_diff(target.theta, pose.theta);
-  arrived =
-      dist <= config_.approach_tolerance_m && std::abs(dth) <= config_.approach_angle_tolerance_rad;
-  if (arrived) return {};
-  // A straight relative move (Fawkes' motor_move): proportional, capped; no obstacle check.
-  const double v = std::min(config_.approach_speed_mps, 1.5 * dist);
-  Vec2 vf = dist > 1e-9 ? Vec2(d * (v / dist)) : Vec2(0.0, 0.0);
-  const Vec2 vr = core::rotate(vf, -pose.theta);
-  const double w = std::clamp(1.5 * dth, -config_.approach_omega_rps, config_.approach_omega_rps);
-  return {vr.x(), vr.y(), w};
+  const MoveBaseConfig& c = config_;
+  auto axis = [](double left, double tolerance, double gain, double lo, double hi) {
+    if (std::abs(left) <= tolerance) return 0.0;
+    return sign(left) * std::min(hi, std::max(lo, gain * std::abs(left)));
+  };
+  // Each axis stops within tolerance / sqrt(2) (motor_move's per-axis box, sized so that the
+  // move ends within `tolerance_m` of where its caller asked).
+  const double box = tolerance_m / std::sqrt(2.0);
+  const VelocityCommand v{
+      axis(d.x(), box, c.motor_gain_xy, c.motor_min_speed_mps, speed),
+      axis(d.y(), box, c.motor_gain_xy, c.motor_min_speed_mps, speed),
+      axis(dth, tolerance_rad, c.motor_gain_th, c.motor_min_omega_rps, c.motor_omega_rps)};
+  const bool at = v.vx_mps == 0.0 && v.vy_mps == 0.0;
+  arrived = at && std::abs(dth) <= tolerance_rad;
+  return v;
 }
 
 // --- ppgoto along the team's navigation graph ----------------------------------------------
