@@ -182,16 +182,21 @@ void MoveBaseNavigator::go_to(const Pose2D& goal, bool forward) {
   target_reached_ = false;
   state_ = MoveBaseState::kPlanning;
   depart_checked_ = false;
-  trigger_ = Trigger::kPlanning;
-  recovery_index_ = 0;
   rotating_ = false;
-  rotating_to_goal_ = false;
   escaping_ = false;
   stuck_left_ = stuck_right_ = stuck_left_strafe_ = stuck_right_strafe_ = false;
   rotating_left_ = rotating_right_ = strafe_left_ = strafe_right_ = false;
-  const SimTime now = has_last_update_ ? last_update_ : SimTime();
+  new_goal(has_last_update_ ? last_update_ : SimTime());
+}
+
+void MoveBaseNavigator::new_goal(SimTime now) {
+  // move_base's executeCb on a new goal: the recovery sequence and the patience timers start
+  // over, the controller plans afresh.
+  trigger_ = Trigger::kPlanning;
+  recovery_index_ = 0;
   last_valid_plan_ = now;
   last_valid_control_ = now;
+  rotating_to_goal_ = false;
   next_control_ = now;
 }
 
@@ -646,12 +651,7 @@ void MoveBaseNavigator::send_goal(SimTime now, const Pose2D& pose) {
     needs_approach_ = false;
   }
   sent_at_ = now;
-  trigger_ = Trigger::kPlanning;
-  recovery_index_ = 0;
-  last_valid_plan_ = now;
-  last_valid_control_ = now;
-  rotating_to_goal_ = false;
-  next_control_ = now;
+  new_goal(now);
   // Under way, the new plan is made at once and the robot keeps its speed until the next
   // controller cycle (move_base publishes nothing while it plans).
   const bool under_way = state_ == MoveBaseState::kControlling;

@@ -265,6 +265,7 @@ class MoveBaseNavigator {
     double end_x = 0.0, end_y = 0.0, end_th = 0.0;
   };
   void finish(NavOutcome outcome, std::string message);
+  void new_goal(core::SimTime now);
   bool make_plan(const Pose2D& pose);
   bool compute_velocity(const Pose2D& pose, const VelocityCommand& vel, VelocityCommand& cmd);
   void update_grids(const Pose2D& pose);
