@@ -758,13 +758,25 @@ bool MoveBaseNavigator::make_plan(const Pose2D& pose) {
     ++stats_.plan_failures;
     return false;
   }
+  // The potential reaches the start only through a passable 4-neighbour: a robot inside the
+  // inscribed cells has none, and there is no plan (the search below would find none after
+  // exploring every cell it can reach).
+  constexpr int kDi4[4] = {1, -1, 0, 0};
+  constexpr int kDj4[4] = {0, 0, 1, -1};
+  bool start_open = si == gi && sj == gj;
+  for (int e = 0; e < 4 && !start_open; ++e) {
+    const int a = si + kDi4[e], b = sj + kDj4[e];
+    start_open = a >= 0 && b >= 0 && a < nx && b < ny && passable(a, b);
+  }
+  if (!start_open) {
+    ++stats_.plan_failures;
+    return false;
+  }
   using Item = std::pair<float, std::size_t>;
   std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
   potential_[index(gi, gj)] = 0.0f;
   open.push({0.0f, index(gi, gj)});
   const std::size_t start = index(si, sj);
-  constexpr int kDi[4] = {1, -1, 0, 0};
-  constexpr int kDj[4] = {0, 0, 1, -1};
   while (!open.empty()) {
     const auto [p, k] = open.top();
     open.pop();
@@ -774,7 +786,7 @@ bool MoveBaseNavigator::make_plan(const Pose2D& pose) {
     const int i = static_cast<int>(k % static_cast<std::size_t>(nx));
     const int j = static_cast<int>(k / static_cast<std::size_t>(nx));
     for (int e = 0; e < 4; ++e) {
-      const int a = i + kDi[e], b = j + kDj[e];
+      const int a = i + kDi4[e], b = j + kDj4[e];
       if (a < 0 || b < 0 || a >= nx || b >= ny || !passable(a, b)) continue;
       const std::size_t kk = index(a, b);
       const float c = p + 50.0f + 0.8f * static_cast<float>(m.cost(a, b));
