@@ -10,6 +10,7 @@
 #include <unordered_map>
 
 #include "feature.h"
+#include "llsf/clips/source_check.h"
 #include "llsf/core/config.h"
 #include "llsf/core/input_file.h"
 #include "llsf/core/text.h"
@@ -118,6 +119,7 @@ struct AgentHost::Impl {
   std::unordered_map<std::string, std::string> function_places;  // deffunction -> "file:line"
   std::int64_t max_steps_seen = 0;
   std::unique_ptr<detail::Tracer> tracer;  // set_trace()
+  TimeReadCheck time_check;                // over the files in load order
 
   ~Impl() { env.observe(nullptr, false, false); }
   Impl(const Impl&) = delete;
@@ -346,7 +348,14 @@ struct AgentHost::Impl {
     note_rule_places(text, source);
     const auto errors = env.load(text);
     flush_output();
-    if (errors.empty()) return;
+    if (errors.empty()) {
+      // Loaded: what CLIPS takes without a word but that makes a rule misbehave.
+      for (const SourceWarning& w : time_check.scan(text)) {
+        emit(LogLevel::kWarn,
+             std::string(source) + ":" + std::to_string(w.line) + ": " + w.message);
+      }
+      return;
+    }
     std::string msg;
     for (const auto& e : errors) {
       if (!msg.empty()) msg += '\n';
