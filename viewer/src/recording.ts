@@ -155,7 +155,7 @@ export interface RescueState {
 
 export interface Marker {
   t: number;
-  kind: "award" | "failure" | "collision" | "rescue" | "log" | "nav";
+  kind: "award" | "failure" | "collision" | "rescue" | "log" | "nav" | "agent";
   label: string;
 }
 
@@ -481,6 +481,16 @@ export class Recording {
         t: line.t,
         kind: "failure",
         label: `${line.robot}: ${line.string ?? ""} failed: ${line.error ?? ""}`,
+      });
+    } else if (line.e === "issue" && line.kind !== "skill-failure") {
+      // An agent's mistake (docs/recording.md: a runtime error, a rule loop, a halted agent, an
+      // unknown skill, a lock held too long); skill failures have their own markers. A lock held
+      // too long is noticed at the end: its marker stands where it happened (time_s).
+      const where = line.rule ? ` rule ${line.rule}${line.place ? ` (${line.place})` : ""}` : "";
+      this.markers.push({
+        t: typeof line.time_s === "number" ? line.time_s : line.t,
+        kind: "agent",
+        label: `${line.robot ?? ""} ${line.kind ?? "issue"}${where}: ${line.text ?? ""}`,
       });
     } else if (line.e === "jam" && line.jammed) {
       // Robot profiles: a robot jammed at a device (docs/profiles.md).
