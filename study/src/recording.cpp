@@ -316,6 +316,7 @@ void Recorder::skill_state(const sim::SkillStateChange& c) {
   j["skill"] = c.skill;
   j["from"] = c.from;
   j["to"] = c.to;
+  if (!c.via.empty()) j["via"] = c.via;
   impl_->write(j);
 }
 
