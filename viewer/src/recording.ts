@@ -538,7 +538,9 @@ export class Recording {
     } else if (line.e === "skill_state") {
       const from = String(line.from ?? "") || "–";
       const to = String(line.to ?? "") || "–";
-      entry = {t: line.t, robot, kind: "state", level: "", text: `${String(line.skill ?? "")}: ${from} → ${to}`};
+      // `via` (exercise --trace): what took it there, the transition and its file:line.
+      const via = line.via ? `  (${String(line.via)})` : "";
+      entry = {t: line.t, robot, kind: "state", level: "", text: `${String(line.skill ?? "")}: ${from} → ${to}${via}`};
     } else {
       const where = line.place
         ? String(line.place)
