@@ -60,7 +60,7 @@ constexpr const char* kRules = R"clp(
 
 (defrule arrived
   ?s <- (state GOTO ?m)
-  ?sk <- (skill (name drive_to) (status FINAL|FAILED))
+  ?sk <- (skill (name "drive_to") (status FINAL|FAILED))
   ?mf <- (machine (name ?m) (loaded ?l))
   =>
   (retract ?s ?sk)

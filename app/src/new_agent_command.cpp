@@ -109,7 +109,7 @@ constexpr std::string_view kAgentClp =
 
 (defrule explore-read
   ?t <- (todo (machine ?m) (state EXPLORING))
-  ?s <- (skill (name explore_machine) (status FINAL) (result ?code))
+  ?s <- (skill (name "explore_machine") (status FINAL) (result ?code))
   =>
   (retract ?s)
   (modify ?t (state DONE))
@@ -122,7 +122,7 @@ constexpr std::string_view kAgentClp =
 
 (defrule explore-failed
   ?t <- (todo (machine ?m) (state EXPLORING))
-  ?s <- (skill (name explore_machine) (status FAILED) (error ?e))
+  ?s <- (skill (name "explore_machine") (status FAILED) (error ?e))
   =>
   (retract ?s)
   (modify ?t (state DONE))

@@ -554,7 +554,13 @@ std::vector<AgentWarning> agent_warnings(const study::RobotSpec& spec,
   auto note = [&warnings](std::string text, bool in_run = false) {
     warnings.push_back({AgentWarning::Kind::kNote, in_run, std::move(text)});
   };
-  const std::vector<AgentSource> sources = read_agent_sources(spec.agent);
+  // A Fawkes-style agent's files are those it path-loads: the entry file's directory.
+  const std::vector<AgentSource> sources =
+      read_agent_sources(spec.fawkes && !spec.agent.empty()
+                             ? std::vector<std::string>{std::filesystem::path(spec.agent.front())
+                                                            .parent_path()
+                                                            .string()}
+                             : spec.agent);
   std::vector<std::string> skills;
   std::map<std::string, std::vector<std::string>> params;  // skill -> its @param names
   if (brain != nullptr) {
@@ -622,7 +628,8 @@ std::vector<AgentWarning> agent_warnings(const study::RobotSpec& spec,
   };
   std::vector<std::string> set_paths;
   for (const clips::ConfigEntry& e : spec.config) {
-    if (e.path == "/clips-agent/use-locks") continue;  // the host's (robots.locks)
+    if (e.path == "/clips-agent/use-locks") continue;             // the host's (robots.locks)
+    if (spec.fawkes && e.path == "/clips-agent/agent") continue;  // the host's (its entry)
     set_paths.push_back(e.path);
     if (read_by_agent(e.path)) continue;
     // Either side may hold the typo: name the near path the agent reads and where, not a fix.
@@ -692,6 +699,8 @@ int check(const std::vector<std::string>& files, std::ostream& out, std::ostream
           c.skills = s.skills;
           c.locks = spec.locks;
           c.sandbox = spec.sandbox;
+          c.fawkes = spec.fawkes;
+          c.agent_dir = spec.agent_dir;
           const sim::AgentBrain& brain = driver.plug_agent(i, c);
           for (const std::string& e : brain.skills().engine().load_errors()) {
             throw core::ConfigError("skill file error: " + e);

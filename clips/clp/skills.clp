@@ -3,10 +3,11 @@
 ; string and asserts (skill (status IDLE)); the host updates the fact each cycle (RUNNING, FINAL,
 ; FAILED; `result` is what the skills reported, e.g. "DONE" or "M3 red=ON yellow=OFF green=OFF").
 ; Finished skill facts are retracted at very low salience, as in Fawkes: match
-; (skill (name ?n) (status FINAL|FAILED)) in the cycle in which it appears.
+; (skill (name "drive_to") (status FINAL|FAILED)) in the cycle in which it appears. The name is
+; a STRING, as in Fawkes' skills.clp, whether skill-call got a symbol or a string.
 
 (deftemplate skill
-  (slot name (type SYMBOL))
+  (slot name (type STRING))  ; as in Fawkes: (skill (name "drive_to") ...)
   (slot status (type SYMBOL) (allowed-values IDLE RUNNING FINAL FAILED) (default IDLE))
   (slot skill-string (type STRING))
   (slot error (type STRING) (default ""))

@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <cctype>
+#include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <unordered_map>
 
@@ -93,6 +95,7 @@ std::string one_line(std::string_view s) {
 }
 
 constexpr std::string_view kLocksClp = "builtin/locks.clp";
+constexpr std::string_view kFawkesClp = "builtin/fawkes.clp";
 
 LogLevel level_of(std::string_view logical_name) {
   if (logical_name == "debug" || logical_name == "wtrace") return LogLevel::kDebug;
@@ -120,6 +123,10 @@ struct AgentHost::Impl {
   std::int64_t max_steps_seen = 0;
   std::unique_ptr<detail::Tracer> tracer;  // set_trace()
   TimeReadCheck time_check;                // over the files in load order
+  // Fawkes' agent model (AgentConfig::fawkes).
+  bool fawkes_started_ = false;
+  std::vector<std::string>* load_failures_ = nullptr;  // while the entry file runs
+  std::string batch_place_;  // "entry.clp:LINE" of the command being evaluated
 
   ~Impl() { env.observe(nullptr, false, false); }
   Impl(const Impl&) = delete;
@@ -151,15 +158,290 @@ struct AgentHost::Impl {
     features.push_back(detail::make_skills_feature(state));
     features.push_back(detail::make_locks_feature(state));  // before protobuf: takes lock messages
     features.push_back(detail::make_protobuf_feature(state));
+    features.push_back(detail::make_fawkes_feature(state));
+    features.push_back(detail::make_blackboard_feature(state));
     for (auto& f : features) f->define(env);
+    if (state.config.fawkes) define_fawkes_functions();
     for (int i = 0; i < detail::kBuiltinCodeCount; ++i) {
       // Without locks the lock template stays free for the agent's own (e.g. a Fawkes lock.clp).
-      if (!state.config.locks && std::string_view(detail::kBuiltinCode[i].name) == kLocksClp)
-        continue;
-      load(detail::kBuiltinCode[i].text, detail::kBuiltinCode[i].name);
+      const std::string_view name = detail::kBuiltinCode[i].name;
+      if (!state.config.locks && name == kLocksClp) continue;
+      if (!state.config.fawkes && name == kFawkesClp) continue;
+      load(detail::kBuiltinCode[i].text, name);
     }
-    if (state.config.sandbox) detail::install_sandbox(env);
+    // A Fawkes-style agent may (reset): the host's own reset (define_fawkes_functions) replaces
+    // CLIPS', so that the host's facts come back after it.
+    static constexpr std::string_view kFawkesAllowed[] = {"reset"};
+    if (state.config.sandbox) {
+      detail::install_sandbox(env, state.config.fawkes
+                                       ? std::span<const std::string_view>(kFawkesAllowed)
+                                       : std::span<const std::string_view>());
+    }
     for (auto& f : features) f->bind(env);
+  }
+
+  // ---- Fawkes' agent model (docs/fawkes.md) ----------------------------------------------
+
+  // path-load, path-resolve and (reset) for Fawkes-style agents.
+  void define_fawkes_functions() {
+    // (path-load "dir/file.clp"): loads the constructs of a file of the agent directory, as
+    // Fawkes' path-load (load*) did: TRUE, or FALSE after an error (a load error before the
+    // game, a runtime error during it).
+    env.define_function("path-load", "11k", [this](detail::Args& a) {
+      std::string_view file;
+      a.text(0, file);
+      return Value::boolean(path_load(std::string(file)));
+    });
+    // (path-resolve "dir/file.clp"): the file's path if the agent directory has it, else FALSE.
+    env.define_function("path-resolve", "11k", [this](detail::Args& a) {
+      std::string_view file;
+      a.text(0, file);
+      std::string why;
+      const std::optional<std::string> p = resolve_agent_file(std::string(file), why);
+      return p ? Value::string(*p) : Value::boolean(false);
+    });
+    env.define_function("reset", "00", [this](detail::Args&) {
+      reset_env();
+      return Value{};
+    });
+  }
+
+  // `file` inside the agent directory (relative to it), or nullopt with the reason in `why`.
+  std::optional<std::string> resolve_agent_file(const std::string& file, std::string& why) const {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    const fs::path dir = fs::weakly_canonical(fs::path(state.config.agent_dir), ec);
+    if (ec || state.config.agent_dir.empty()) {
+      why = "the agent has no agent directory";
+      return std::nullopt;
+    }
+    const fs::path rel(file);
+    const fs::path p = fs::weakly_canonical(rel.is_absolute() ? rel : dir / rel, ec);
+    const auto [d_end, p_it] = std::mismatch(dir.begin(), dir.end(), p.begin(), p.end());
+    if (ec || d_end != dir.end()) {
+      why = file + " is outside the agent directory " + dir.string() +
+            " (the sandbox reads only the agent's own files; docs/security.md)";
+      return std::nullopt;
+    }
+    if (!fs::is_regular_file(p, ec)) {
+      why = "no file " + file + " in the agent directory " + dir.string();
+      return std::nullopt;
+    }
+    return p.string();
+  }
+
+  // Fawkes' own CLIPS files, which every Fawkes environment had loaded: llsfsim's built-in
+  // equivalents are loaded already, so a path-load of one of them loads nothing.
+  static bool fawkes_builtin_file(std::string_view file) {
+    static constexpr std::string_view kFiles[] = {"utils.clp",     "time.clp",   "path.clp",
+                                                  "ff-config.clp", "skills.clp", "init.clp",
+                                                  "protobuf.clp"};
+    return std::find(std::begin(kFiles), std::end(kFiles), file) != std::end(kFiles);
+  }
+
+  bool path_load(const std::string& file) {
+    std::string why;
+    const std::optional<std::string> p = resolve_agent_file(file, why);
+    if (!p) {
+      if (fawkes_builtin_file(file)) return true;
+      load_failure("path-load: " + why);
+      return false;
+    }
+    std::string error;
+    const auto text = core::try_read_input_file(*p, core::kMaxSourceBytes, "CLIPS file", error);
+    if (!text) {
+      load_failure("path-load: " + error);
+      return false;
+    }
+    const std::vector<std::string> errors = load_collect(*text, *p);
+    for (const std::string& e : errors) load_failure(e, /*located=*/true);
+    return errors.empty();
+  }
+
+  // An error of loading an agent file: collected while the entry file runs (AgentLoadError at
+  // its end), else a runtime error naming the rule that loaded it.
+  // `located`: the text names its own file and line (a load error of a loaded file); otherwise
+  // the place of the top-level command being run is put before it.
+  void load_failure(std::string text, bool located = false) {
+    if (load_failures_ != nullptr) {
+      load_failures_->push_back(batch_place_.empty() || located ? std::move(text)
+                                                                : batch_place_ + ": " + text);
+      return;
+    }
+    const std::string rule = env.executing_rule();
+    if (rule.empty()) {
+      emit(LogLevel::kError, "runtime error: " + text);
+    } else {
+      emit(LogLevel::kError,
+           "runtime error in rule " + rule + place_of(rule_places, rule) + ": " + text);
+    }
+    ++runtime_errors;
+  }
+
+  // CLIPS' (reset) for a Fawkes-style agent: the host's facts (ff-feature, robot-info, ...) are
+  // asserted again after it.
+  void reset_env() {
+    env.reset();
+    for (auto& f : features) f->after_reset(env);
+  }
+
+  // The top-level forms of a batch file: constructs and commands, with their first line.
+  struct Form {
+    std::size_t begin = 0, end = 0;
+    int line = 1;
+    bool construct = false;
+  };
+  static bool split_forms(const std::string& text, std::vector<Form>& out, std::string& error,
+                          int& error_line) {
+    static constexpr std::string_view kConstructs[] = {
+        "defrule",    "deftemplate", "deffacts", "defglobal",    "deffunction",       "defmodule",
+        "defgeneric", "defmethod",   "defclass", "definstances", "defmessage-handler"};
+    int line = 1;
+    std::size_t i = 0;
+    const std::size_t n = text.size();
+    while (i < n) {
+      const char c = text[i];
+      if (c == '\n') {
+        ++line;
+        ++i;
+      } else if (std::isspace(static_cast<unsigned char>(c)) != 0) {
+        ++i;
+      } else if (c == ';') {
+        while (i < n && text[i] != '\n') ++i;
+      } else if (c != '(') {
+        error = "expected a command or construct in parentheses";
+        error_line = line;
+        return false;
+      } else {
+        Form f;
+        f.begin = i;
+        f.line = line;
+        int depth = 0;
+        bool string = false;
+        for (; i < n; ++i) {
+          const char d = text[i];
+          if (d == '\n') ++line;
+          if (string) {
+            if (d == '\\' && i + 1 < n) {
+              if (text[i + 1] == '\n') ++line;
+              ++i;
+            } else if (d == '"') {
+              string = false;
+            }
+          } else if (d == '"') {
+            string = true;
+          } else if (d == ';') {
+            while (i + 1 < n && text[i + 1] != '\n') ++i;
+          } else if (d == '(') {
+            ++depth;
+          } else if (d == ')' && --depth == 0) {
+            break;
+          }
+        }
+        if (i >= n) {
+          error = "the form that starts here is not closed (a ')' is missing)";
+          error_line = f.line;
+          return false;
+        }
+        f.end = ++i;
+        std::size_t k = f.begin + 1;
+        while (k < f.end && std::isspace(static_cast<unsigned char>(text[k])) != 0) ++k;
+        std::size_t e = k;
+        while (e < f.end && std::isspace(static_cast<unsigned char>(text[e])) == 0 &&
+               text[e] != '(' && text[e] != ')')
+          ++e;
+        const std::string_view word(text.data() + k, e - k);
+        f.construct = std::find(std::begin(kConstructs), std::end(kConstructs), word) !=
+                      std::end(kConstructs);
+        out.push_back(f);
+      }
+    }
+    return true;
+  }
+
+  // Runs a batch file as CLIPS' batch* does: constructs are defined, commands evaluated, in
+  // order. Errors go to load_failure() with the file and line.
+  void batch(const std::string& text, const std::string& source) {
+    std::vector<Form> forms;
+    std::string error;
+    int error_line = 0;
+    const bool ok = split_forms(text, forms, error, error_line);
+    for (std::size_t i = 0; i < forms.size();) {
+      if (forms[i].construct) {
+        // Consecutive constructs load as one piece, padded to keep their line numbers.
+        std::size_t j = i;
+        while (j + 1 < forms.size() && forms[j + 1].construct) ++j;
+        std::string chunk(static_cast<std::size_t>(forms[i].line - 1), '\n');
+        chunk.append(text, forms[i].begin, forms[j].end - forms[i].begin);
+        for (std::string& e : load_collect(chunk, source)) load_failure(std::move(e), true);
+        i = j + 1;
+        continue;
+      }
+      flush_output();
+      batch_place_ = source + ":" + std::to_string(forms[i].line);
+      env.eval(text.substr(forms[i].begin, forms[i].end - forms[i].begin));
+      if (!werror.empty()) {
+        std::string msg = with_hint(one_line(werror));
+        werror.clear();
+        load_failure(std::move(msg));
+      }
+      batch_place_.clear();
+      flush_output();
+      env.clear_halt();
+      ++i;
+    }
+    if (!ok) load_failure(source + ":" + std::to_string(error_line) + ": " + error, true);
+  }
+
+  // The start of a Fawkes-style agent (AgentConfig::fawkes), as Fawkes' clips-agent did it:
+  // the feature facts, (agent-init), (config-load "/clips-agent"), the entry file as a batch
+  // file, then the rules run to quiescence at time 0. Throws AgentLoadError with every load
+  // error of the entry file and the files it path-loaded.
+  void fawkes_start(const std::string& path) {
+    if (fawkes_started_) {
+      throw AgentLoadError(path +
+                           ": a Fawkes-style agent has one entry file, which path-loads the "
+                           "others (docs/fawkes.md)");
+    }
+    fawkes_started_ = true;
+    std::string why;
+    const std::optional<std::string> entry = resolve_agent_file(path, why);
+    if (!entry) throw AgentLoadError(path + ": " + why);
+    std::string error;
+    const auto text = core::try_read_input_file(*entry, core::kMaxSourceBytes, "CLIPS file", error);
+    if (!text) throw AgentLoadError(error);
+
+    std::vector<std::string> failures;
+    load_failures_ = &failures;
+    env.start_budget(state.config.max_steps_per_cycle, state.config.max_cycle_wall_s,
+                     state.config.max_call_depth);
+    start(state.now);
+    env.set_global("ROBOT-NAME", Value::symbol(state.config.robot_name));
+    env.set_global("ROBOT-NUMBER", Value::integer_value(state.config.robot_number));
+    env.set_global("TEAM-NAME", Value::string(state.config.team_name));
+    env.eval("(ff-feature-request \"config\")");  // as the clips-agent requested it
+    env.assert_string("(agent-init)");
+    env.eval("(config-load \"/clips-agent\")");
+    flush_output();
+    batch(*text, *entry);
+    CycleResult result;
+    run_rules(result);
+    flush_output();
+    load_failures_ = nullptr;
+    // /clips-agent/auto-start: the clips-agent asserted (start) once it had started (else when
+    // a switch interface enabled it, which llsfsim has not).
+    for (const ConfigEntry& c : state.config.config) {
+      if (c.path == "/clips-agent/auto-start" && !c.values.empty() &&
+          c.values.front() == Value::boolean(true))
+        env.assert_string("(start)");
+    }
+    if (failures.empty()) return;
+    std::string msg;
+    for (const std::string& f : failures) {
+      if (!msg.empty()) msg += '\n';
+      msg += f;
+    }
+    throw AgentLoadError(msg);
   }
 
   void emit(LogLevel level, std::string_view text) {
@@ -345,27 +627,33 @@ struct AgentHost::Impl {
   }
 
   void load(const std::string& text, std::string_view source) {
+    std::string msg;
+    for (const std::string& e : load_collect(text, source)) {
+      if (!msg.empty()) msg += '\n';
+      msg += e;
+    }
+    if (!msg.empty()) throw AgentLoadError(msg);
+  }
+
+  // Loads constructs; returns the errors as "source:LINE: message".
+  std::vector<std::string> load_collect(const std::string& text, std::string_view source) {
     note_rule_places(text, source);
     const auto errors = env.load(text);
     flush_output();
+    std::vector<std::string> out;
     if (errors.empty()) {
       // Loaded: what CLIPS takes without a word but that makes a rule misbehave.
       for (const SourceWarning& w : time_check.scan(text)) {
         emit(LogLevel::kWarn,
              std::string(source) + ":" + std::to_string(w.line) + ": " + w.message);
       }
-      return;
+      return out;
     }
-    std::string msg;
     for (const auto& e : errors) {
-      if (!msg.empty()) msg += '\n';
-      msg.append(source)
-          .append(":")
-          .append(std::to_string(e.line))
-          .append(": ")
-          .append(with_hint(e.message));
+      out.push_back(std::string(source) + ":" + std::to_string(e.line) + ": " +
+                    with_hint(e.message));
     }
-    throw AgentLoadError(msg);
+    return out;
   }
 
   void start(core::SimTime now) {
@@ -386,7 +674,20 @@ struct AgentHost::Impl {
     for (auto& f : features) f->before_run(env);
     report_errors();  // e.g. a (test ...) that failed while facts were asserted
 
-    // Run to quiescence; an error stops CLIPS' run, so clear it and go on with the rest.
+    run_rules(result);
+    result.steps = env.budget_steps();
+    max_steps_seen = std::max(max_steps_seen, result.steps);
+    for (auto& f : features) f->after_run(env);
+    flush_output();
+    rules_fired += result.rules_fired;
+    result.runtime_errors = runtime_errors - errors_before;
+    if (tracer) tracer->cycle_end();
+    return result;
+  }
+
+  // Runs to quiescence within the firing limit; an error stops CLIPS' run, so it is reported,
+  // cleared, and the run goes on with the rest.
+  void run_rules(CycleResult& result) {
     std::int64_t remaining = state.config.max_rules_per_cycle;
     while (remaining > 0) {
       const std::int64_t fired = env.run(remaining);
@@ -419,14 +720,6 @@ struct AgentHost::Impl {
                " reached with rules still on the agenda (endless rule loop?); next: rule " + rule +
                place_of(rule_places, rule));
     }
-    result.steps = env.budget_steps();
-    max_steps_seen = std::max(max_steps_seen, result.steps);
-    for (auto& f : features) f->after_run(env);
-    flush_output();
-    rules_fired += result.rules_fired;
-    result.runtime_errors = runtime_errors - errors_before;
-    if (tracer) tracer->cycle_end();
-    return result;
   }
 };
 
@@ -444,6 +737,7 @@ AgentHost& AgentHost::operator=(AgentHost&& other) noexcept {
 }
 
 void AgentHost::load_file(const std::string& path) {
+  if (impl_->state.config.fawkes) return impl_->fawkes_start(path);
   std::string error;
   const auto text = core::try_read_input_file(path, core::kMaxSourceBytes, "CLIPS file", error);
   if (!text) throw AgentLoadError(error);
@@ -463,6 +757,14 @@ void AgentHost::set_pose(const core::Pose2D& pose) {
   if (s.pose && s.pose->x == pose.x && s.pose->y == pose.y && s.pose->theta == pose.theta) return;
   s.pose = pose;
   s.pose_dirty = true;
+}
+
+void AgentHost::write_interface(std::string_view type, std::string_view id,
+                                std::vector<std::pair<std::string, Value>> fields) {
+  auto& d = impl_->state.blackboard[{std::string(type), std::string(id)}];
+  d.time = impl_->state.now;
+  d.fields = std::move(fields);
+  ++d.serial;
 }
 
 void AgentHost::receive(std::unique_ptr<google::protobuf::Message> message, std::string_view from,

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Small features: logging functions, seeded random, robot identity and pose, confval facts.
 #include <array>
+#include <cmath>
 
 #include "feature.h"
 #include "llsf/core/rng.h"
@@ -78,10 +79,16 @@ class RandomFeature final : public Feature {
       }
       return Value::integer_value(rng_.uniform_int(lo, hi));
     });
+    // (seed n): the stream restarts from n mixed with this robot's own seed (AgentConfig::seed,
+    // from the scenario seed and the robot's name): the same n gives the same sequence in
+    // every game of the scenario seed, but different robots draw different sequences. Agents
+    // that seed from the clock, as the 2013 agent's lock election did ((seed (nth$ 2 ?now))),
+    // would otherwise draw one sequence on every robot of a lock-step simulation.
     env.define_function("seed", "11i", [this](Args& a) {
       std::int64_t s = 0;
       a.integer(0, s);
-      rng_ = core::RandomStream(static_cast<std::uint64_t>(s));
+      const auto n = static_cast<std::uint64_t>(s);
+      rng_ = core::RandomStream(core::fnv1a(&n, sizeof n, core::fnv1a(&seed_, sizeof seed_)));
       return Value{};
     });
   }
@@ -102,9 +109,10 @@ class RobotFeature final : public Feature {
     pose_ = env.find_template("pose");
   }
   void after_reset(Environment& env) override {
-    env.set_global("ROBOT-NAME", Value::symbol(s_.config.robot_name));
-    env.set_global("ROBOT-NUMBER", Value::integer_value(s_.config.robot_number));
-    env.set_global("TEAM-NAME", Value::string(s_.config.team_name));
+    // A Fawkes-style agent owns these globals (the 2013 agent defines and sets them from its
+    // config): a reset gives them back their defglobal values; the host sets them only before
+    // the entry file runs (AgentHost::load_file).
+    if (!s_.config.fawkes) set_globals(env);
     const Value v[] = {Value::symbol(s_.config.robot_name),
                        Value::integer_value(s_.config.robot_number),
                        Value::string(s_.config.team_name)};
@@ -113,7 +121,31 @@ class RobotFeature final : public Feature {
     env.release(pose_fact_);  // the reset retracted it
     s_.pose_dirty = s_.pose.has_value();
   }
+  // A Fawkes-style agent reads the pose from the blackboard: Position3DInterface "Pose", written
+  // at every cycle as the 2013 localization wrote it at its rate (the map frame; the yaw as the
+  // quaternion (0 0 sin(a/2) cos(a/2)); visibility_history counts the updates).
+  void write_pose_interface() {
+    auto& d = s_.blackboard[{"Position3DInterface", "Pose"}];
+    d.time = s_.now;
+    const double h = s_.pose->theta / 2.0;
+    d.fields = {
+        {"frame", Value::string("/map")},
+        {"visibility_history", Value::integer_value(static_cast<std::int64_t>(d.serial) + 1)},
+        {"rotation",
+         Value::multifield({Value::float_value(0.0), Value::float_value(0.0),
+                            Value::float_value(std::sin(h)), Value::float_value(std::cos(h))})},
+        {"translation",
+         Value::multifield({Value::float_value(s_.pose->x), Value::float_value(s_.pose->y),
+                            Value::float_value(0.0)})}};
+    ++d.serial;
+  }
+  void set_globals(Environment& env) {
+    env.set_global("ROBOT-NAME", Value::symbol(s_.config.robot_name));
+    env.set_global("ROBOT-NUMBER", Value::integer_value(s_.config.robot_number));
+    env.set_global("TEAM-NAME", Value::string(s_.config.team_name));
+  }
   void before_run(Environment& env) override {
+    if (s_.config.fawkes && s_.pose) write_pose_interface();
     if (!s_.pose_dirty) return;
     s_.pose_dirty = false;
     env.retract(pose_fact_);
@@ -128,13 +160,32 @@ class RobotFeature final : public Feature {
   FactHandle pose_fact_;
 };
 
-// ---- config: confval facts after each (reset) ----------------------------------------------
+// ---- config: confval facts after each (reset), or on (config-load PREFIX) -------------------
+// llsfsim's agents get every value after each (reset); Fawkes-style agents (AgentConfig::fawkes)
+// only those under the prefix they load, when they call (config-load "/clips-agent"), as
+// Fawkes' config feature asserted them.
 class ConfigFeature final : public Feature {
  public:
   explicit ConfigFeature(HostState& s) : s_(s) {}
+  void define(Environment& env) override {
+    env.define_function("config-load", "11k", [this, &env](Args& a) {
+      std::string_view prefix;
+      a.text(0, prefix);
+      assert_values(env, prefix);
+      return Value{};
+    });
+  }
   void bind(Environment& env) override { confval_ = env.find_template("confval"); }
   void after_reset(Environment& env) override {
+    if (!s_.config.fawkes) assert_values(env, {});
+  }
+
+ private:
+  // The values whose path starts with `prefix` (all for an empty prefix); an identical confval
+  // fact that exists already is not asserted twice (CLIPS refuses duplicates).
+  void assert_values(Environment& env, std::string_view prefix) {
     for (const auto& e : s_.config.config) {
+      if (!std::string_view(e.path).starts_with(prefix)) continue;
       Value v[5];
       v[0] = Value::string(e.path);
       v[1] = Value::symbol(to_string(e.type));
@@ -150,7 +201,6 @@ class ConfigFeature final : public Feature {
     }
   }
 
- private:
   HostState& s_;
   Template confval_;
 };

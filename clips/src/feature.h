@@ -8,8 +8,10 @@
 #include <google/protobuf/message.h>
 
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -46,6 +48,17 @@ struct HostState {
   };
   std::vector<Received> inbox;
   int live_messages = 0;  ///< maintained by the protobuf feature
+  /// The blackboard of a Fawkes-style agent (type, id) -> the interface's data, written by the
+  /// host (AgentHost::write_interface, the pose), read by (blackboard-read).
+  struct InterfaceData {
+    core::SimTime time;  ///< when it was written
+    std::vector<std::pair<std::string, Value>> fields;
+    std::uint64_t serial = 0;  ///< counts the writes (the reader asserts a fact per change)
+  };
+  std::map<std::pair<std::string, std::string>, InterfaceData> blackboard;
+  /// A Fawkes-style agent broadcasts and receives only once it enabled its peer
+  /// (pb-peer-enable / pb-peer-create); llsfsim's agents always do.
+  bool peer_enabled = false;
 
   /// Emits one log line at `now` (set by the host).
   std::function<void(LogLevel, std::string_view)> log;
@@ -77,6 +90,12 @@ std::unique_ptr<Feature> make_protobuf_feature(HostState& state);
 /// Always registered, inactive unless AgentConfig::locks (the host then skips locks.clp). Runs
 /// before the protobuf feature: it takes the lock messages out of the inbox.
 std::unique_ptr<Feature> make_locks_feature(HostState& state);
+/// blackboard-open, blackboard-enable-time-read, blackboard-read (Fawkes-style agents).
+std::unique_ptr<Feature> make_blackboard_feature(HostState& state);
+/// ff-feature-request and the feature facts (Fawkes-style agents), motor-enable/-disable.
+std::unique_ptr<Feature> make_fawkes_feature(HostState& state);
+/// The features a Fawkes-style agent finds as (ff-feature X) facts and may request.
+std::span<const std::string_view> fawkes_features();
 
 /// Formats a value as printout does: symbols and strings bare, numbers as CLIPS prints them.
 std::string print_form(const Value& v);

@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cstdint>
 #include <optional>
 #include <unordered_map>
@@ -46,6 +47,29 @@ class ProtobufFeature final : public Feature {
     env.define_function("pb-add-list", "33*", [this](Args& a) { return set(a, true); });
     env.define_function("pb-field-value", "22*", [this](Args& a) {
       Message* m = nullptr;
+      if (s_.config.fawkes) {
+        // As Fawkes' pb-field-value: the symbol DOES-NOT-EXIST for a field the type lacks,
+        // NOT-SET for a scalar field that is not set.
+        Entry* e = lookup(a, 0);
+        std::string_view name;
+        if (e == nullptr || !a.text(1, name)) return Value::symbol("INVALID-MESSAGE");
+        m = e->message;
+        const FieldDescriptor* f = find_field(m->GetDescriptor(), name);
+        if (f == nullptr) {
+          s_.log(LogLevel::kWarn, "pb-field-value: " + m->GetTypeName() + " has no field " +
+                                      std::string(name) + ": DOES-NOT-EXIST");
+          return Value::symbol("DOES-NOT-EXIST");
+        }
+        if (f->is_repeated()) {
+          a.env().error(a.function(), f->name() + " is repeated: use pb-field-list");
+          return Value::boolean(false);
+        }
+        if (f->cpp_type() != FieldDescriptor::CPPTYPE_MESSAGE &&
+            !m->GetReflection()->HasField(*m, f))
+          return Value::symbol("NOT-SET");
+        return_field(a, *m, f);
+        return Value{};
+      }
       const FieldDescriptor* f = field(a, m);
       if (f == nullptr) return Value::boolean(false);
       if (f->is_repeated()) {
@@ -96,16 +120,104 @@ class ProtobufFeature final : public Feature {
       return e == nullptr ? Value::boolean(false) : Value::string(e->message->ShortDebugString());
     });
     env.define_function("pb-unchanged", "2**", [this](Args& a) { return unchanged(a); });
-    env.define_function("pb-broadcast", "11a", [this](Args& a) {
-      Entry* e = lookup(a, 0);
-      if (e == nullptr) return Value{};
-      if (!e->message->IsInitialized()) {
-        a.env().error(a.function(), e->message->GetTypeName() + " lacks required fields: " +
-                                        e->message->InitializationErrorString());
+    // (pb-broadcast ?msg), or (pb-broadcast ?peer-id ?msg) for a peer of pb-peer-create: on the
+    // robot's radio. A Fawkes-style agent broadcasts only once its peer is enabled.
+    env.define_function("pb-broadcast", "12*", [this](Args& a) {
+      if (a.count() == 2 && !known_peer(a)) return Value{};
+      Entry* e = lookup(a, a.count() - 1);
+      if (e == nullptr || !complete(a, *e->message)) return Value{};
+      if (s_.config.fawkes && !s_.peer_enabled) {
+        s_.log(LogLevel::kWarn, "pb-broadcast: no peer enabled (pb-peer-enable): " +
+                                    e->message->GetTypeName() + " not sent");
         return Value{};
       }
       if (s_.io.broadcast) s_.io.broadcast(*e->message);
       return Value{};
+    });
+    // The radio peer (Fawkes' ProtobufBroadcastPeer): the robot's team radio, whatever the
+    // address and ports (the simulated radio has no addresses; docs/fawkes.md).
+    env.define_function("pb-peer-enable", "23*", [this](Args& a) {
+      if (!peer_arguments(a)) return Value{};
+      s_.peer_enabled = true;
+      return Value{};
+    });
+    env.define_function("pb-peer-disable", "00", [this](Args&) {
+      s_.peer_enabled = false;
+      return Value{};
+    });
+    // (pb-peer-create address port [recv-port]): the peer's id (later Fawkes versions).
+    env.define_function("pb-peer-create", "23*", [this](Args& a) {
+      if (!peer_arguments(a)) return Value::boolean(false);
+      s_.peer_enabled = true;
+      return Value::integer_value(kPeerId);
+    });
+    env.define_function("pb-peer-destroy", "11i", [this](Args& a) {
+      if (known_peer(a)) s_.peer_enabled = false;
+      return Value{};
+    });
+    // (pb-connect host port): a stream client to the game's server, the refbox; its id, and
+    // (protobuf-client-connected ID). (pb-send ID ?msg) sends to it, (pb-disconnect ID) ends it.
+    env.define_function("pb-connect", "22*", [this, &env](Args& a) {
+      std::string_view host;
+      std::int64_t port = 0;
+      if (!a.text(0, host) || !a.integer(1, port) || port <= 0 || port > 65535) {
+        a.env().error(a.function(), "expects a host name and a port (1..65535)");
+        return Value::boolean(false);
+      }
+      const std::int64_t id = ++last_client_;
+      clients_.push_back(id);
+      env.assert_string("(protobuf-client-connected " + std::to_string(id) + ")");
+      return Value::integer_value(id);
+    });
+    env.define_function("pb-disconnect", "11i", [this, &env](Args& a) {
+      std::int64_t id = 0;
+      a.integer(0, id);
+      if (std::erase(clients_, id) == 0) return Value{};
+      env.assert_string("(protobuf-client-disconnected " + std::to_string(id) + ")");
+      return Value{};
+    });
+    env.define_function("pb-send", "22*", [this](Args& a) {
+      std::int64_t id = 0;
+      if (!a.integer(0, id) || std::find(clients_.begin(), clients_.end(), id) == clients_.end()) {
+        a.env().error(a.function(), "no connection " + a.view(0).to_value().to_string() +
+                                        " (pb-connect returns the id)");
+        return Value{};
+      }
+      Entry* e = lookup(a, 1);
+      if (e == nullptr || !complete(a, *e->message)) return Value{};
+      if (s_.io.send) s_.io.send(*e->message);
+      return Value{};
+    });
+    // (pb-ref ?msg): keeps a received message beyond its cycle, until (pb-destroy ?msg).
+    env.define_function("pb-ref", "11a", [this](Args& a) {
+      Entry* e = lookup(a, 0);
+      if (e == nullptr) return Value::boolean(false);
+      if (e->kind == Kind::kReceived) e->kind = Kind::kCreated;
+      return Value::external(e->message);
+    });
+    env.define_function("pb-register-type", "11k", [this](Args& a) {
+      std::string_view type;
+      a.text(0, type);
+      return Value::boolean(s_.io.messages != nullptr && prototype(type) != nullptr);
+    });
+    // (pb-field-type ?msg field): DOUBLE, FLOAT, INT64, UINT64, INT32, FIXED64, FIXED32, BOOL,
+    // STRING, MESSAGE, BYTES, UINT32, ENUM, SFIXED32, SFIXED64, SINT32, SINT64 (protobuf's names).
+    env.define_function("pb-field-type", "22*", [this](Args& a) {
+      Message* m = nullptr;
+      const FieldDescriptor* f = field(a, m);
+      if (f == nullptr) return Value::symbol("INVALID-MESSAGE");
+      std::string t = FieldDescriptor::TypeName(f->type());
+      for (char& c : t) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+      return Value::symbol(t);
+    });
+    // (pb-field-label ?msg field): OPTIONAL, REQUIRED or REPEATED.
+    env.define_function("pb-field-label", "22*", [this](Args& a) {
+      Message* m = nullptr;
+      const FieldDescriptor* f = field(a, m);
+      if (f == nullptr) return Value::symbol("INVALID-MESSAGE");
+      return Value::symbol(f->is_repeated()   ? "REPEATED"
+                           : f->is_required() ? "REQUIRED"
+                                              : "OPTIONAL");
     });
   }
 
@@ -137,6 +249,9 @@ class ProtobufFeature final : public Feature {
     }
     // The slot values are rewritten in place (their strings and lists keep their capacity): no
     // allocation per message once the longest type name and peer name have been seen.
+    // A Fawkes-style agent hears nothing before it enabled its peer (Fawkes' peer was not
+    // there to receive).
+    if (s_.config.fawkes && !s_.peer_enabled) s_.inbox.clear();
     for (auto& r : s_.inbox) {
       Message* m = r.message.get();
       if (matched_ && !wanted(m->GetDescriptor())) continue;
@@ -183,6 +298,33 @@ class ProtobufFeature final : public Feature {
   }
 
  private:
+  static constexpr std::int64_t kPeerId = 1;  // the one radio peer (pb-peer-create)
+
+  // (pb-peer-enable address send-port [recv-port]): an address and ports.
+  static bool peer_arguments(Args& a) {
+    std::string_view address;
+    std::int64_t port = 0;
+    bool ok = a.text(0, address) && a.integer(1, port) && port > 0 && port <= 65535;
+    if (ok && a.count() == 3) ok = a.integer(2, port) && port >= 0 && port <= 65535;
+    if (!ok) a.env().error(a.function(), "expects an address and one or two ports (1..65535)");
+    return ok;
+  }
+
+  bool known_peer(Args& a) {
+    std::int64_t id = 0;
+    if (a.integer(0, id) && id == kPeerId && s_.peer_enabled) return true;
+    a.env().error(a.function(), "no peer " + a.view(0).to_value().to_string() +
+                                    " (pb-peer-create returns the id)");
+    return false;
+  }
+
+  static bool complete(Args& a, const Message& m) {
+    if (m.IsInitialized()) return true;
+    a.env().error(a.function(),
+                  m.GetTypeName() + " lacks required fields: " + m.InitializationErrorString());
+    return false;
+  }
+
   // Whether a message type can match a rule (matched_ set): decided once per type by name, then
   // found by its descriptor (a handful of types: a linear scan of pointers).
   bool wanted(const Descriptor* d) {
@@ -205,12 +347,11 @@ class ProtobufFeature final : public Feature {
     Kind kind;
     Message* message;
     const Message* root;             // the owning top-level message
-    bool read_only;                  // a default instance (unset nested field)
-    std::unique_ptr<Message> owned;  // for kCreated and kReceived
+    std::unique_ptr<Message> owned;  // for kCreated and kReceived, and a nested field's copy
   };
 
   void add(std::unique_ptr<Message> m, Kind kind, Message* raw) {
-    Entry e{kind, raw, raw, false, std::move(m)};
+    Entry e{kind, raw, raw, std::move(m)};
     entries_.emplace(raw, std::move(e));
     s_.live_messages = static_cast<int>(entries_.size());
   }
@@ -311,10 +452,9 @@ class ProtobufFeature final : public Feature {
       if (std::find(left_out.begin(), left_out.end(), f) == left_out.end()) left_out.push_back(f);
     }
     // The left-out fields are swapped into an empty message of the type while ?m is serialised
-    // and swapped back (a swap moves nested and repeated fields without copying them); a default
-    // instance (read-only) has none of them set.
+    // and swapped back (a swap moves nested and repeated fields without copying them).
     std::unique_ptr<Message>& aside = scratch_[d];
-    const bool swap = !left_out.empty() && !e->read_only;
+    const bool swap = !left_out.empty();
     if (swap) {
       if (!aside) aside.reset(m->New());
       m->GetReflection()->SwapFields(m, aside.get(), left_out);
@@ -374,8 +514,21 @@ class ProtobufFeature final : public Feature {
     // registry: take them from protobuf's generated pool, once a registered type is loaded.
     const Descriptor* d =
         google::protobuf::DescriptorPool::generated_pool()->FindMessageTypeByName(name);
-    if (d == nullptr) return nullptr;
-    const Message* proto = google::protobuf::MessageFactory::generated_factory()->GetPrototype(d);
+    const Message* proto = nullptr;
+    if (d != nullptr) {
+      proto = google::protobuf::MessageFactory::generated_factory()->GetPrototype(d);
+    } else {
+      // Or a type of an agent's own .proto files (comm::ProtoLibrary) that is used inside a
+      // registered one: from that one's pool and factory.
+      for (int i = 0; i < reg.size() && proto == nullptr; ++i) {
+        const Message* p = reg.prototype(reg.key_at(i));
+        const google::protobuf::DescriptorPool* pool = p->GetDescriptor()->file()->pool();
+        if (pool == google::protobuf::DescriptorPool::generated_pool()) continue;
+        if (const Descriptor* own = pool->FindMessageTypeByName(name))
+          proto = p->GetReflection()->GetMessageFactory()->GetPrototype(own);
+      }
+    }
+    if (proto == nullptr) return nullptr;
     by_name_[name] = proto;
     nested_types_ += 1;
     return proto;
@@ -405,20 +558,24 @@ class ProtobufFeature final : public Feature {
       case FieldDescriptor::CPPTYPE_STRING:
         return Value::string(rep ? r->GetRepeatedString(m, f, index) : r->GetString(m, f));
       case FieldDescriptor::CPPTYPE_MESSAGE: {
-        Message* sub = nullptr;
-        bool read_only = false;
-        if (rep) {
-          sub = r->MutableRepeatedMessage(&m, f, index);
-        } else if (r->HasField(m, f)) {
-          sub = r->MutableMessage(&m, f);
-        } else {  // the default instance: readable, never writable
-          sub = const_cast<Message*>(&r->GetMessage(m, f));
-          read_only = true;
-        }
         auto root_it = entries_.find(&m);
         const Message* root = root_it != entries_.end() ? root_it->second.root : &m;
-        auto [it, inserted] =
-            entries_.try_emplace(sub, Entry{Kind::kView, sub, root, read_only, {}});
+        // A field that is not set reads as a new empty message of its type, and a Fawkes-style
+        // agent always gets a copy (as Fawkes' pb-field-value made one): the agent may fill it
+        // and set it with pb-set-field. The copy lives as the views do (to the end of the cycle
+        // or its root's pb-destroy). llsfsim's agents read a set field in place (a view).
+        const bool set = rep || r->HasField(m, f);
+        if (!set || s_.config.fawkes) {
+          const Message& from = rep ? r->GetRepeatedMessage(m, f, index) : r->GetMessage(m, f);
+          std::unique_ptr<Message> copy(from.New());
+          if (set) copy->CopyFrom(from);
+          Message* raw = copy.get();
+          entries_.emplace(raw, Entry{Kind::kView, raw, root, std::move(copy)});
+          s_.live_messages = static_cast<int>(entries_.size());
+          return Value::external(raw);
+        }
+        Message* sub = rep ? r->MutableRepeatedMessage(&m, f, index) : r->MutableMessage(&m, f);
+        auto [it, inserted] = entries_.try_emplace(sub, Entry{Kind::kView, sub, root, {}});
         if (!inserted && it->second.kind == Kind::kView) it->second.root = root;
         s_.live_messages = static_cast<int>(entries_.size());
         return Value::external(sub);
@@ -460,10 +617,6 @@ class ProtobufFeature final : public Feature {
     Message* m = nullptr;
     const FieldDescriptor* f = field(a, m);
     if (f == nullptr) return Value{};
-    if (entries_.at(m).read_only) {
-      a.env().error(a.function(), "cannot modify the default instance of an unset field");
-      return Value{};
-    }
     if (f->is_repeated() != add_to_list) {
       a.env().error(a.function(), f->name() + (add_to_list ? " is not repeated: use pb-set-field"
                                                            : " is repeated: use pb-add-list"));
@@ -550,7 +703,8 @@ class ProtobufFeature final : public Feature {
         const Message& src = *it->second.message;
         if (src.GetDescriptor() != f->message_type())
           return fail(f->message_type()->full_name().c_str());
-        (add_to_list ? r->AddMessage(m, f) : r->MutableMessage(m, f))->CopyFrom(src);
+        Message* to = add_to_list ? r->AddMessage(m, f) : r->MutableMessage(m, f);
+        if (to != &src) to->CopyFrom(src);  // the field set from its own view: nothing to do
         return Value{};
       }
     }
@@ -588,6 +742,8 @@ class ProtobufFeature final : public Feature {
   std::unordered_map<const Descriptor*, std::unique_ptr<Message>> scratch_;
   std::vector<const FieldDescriptor*> fields_scratch_;
   std::string key_scratch_, bytes_scratch_;
+  std::vector<std::int64_t> clients_;  // pb-connect's open connections
+  std::int64_t last_client_ = 0;
 };
 
 }  // namespace

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "sandbox.h"
 
+#include <algorithm>
 #include <string>
 
 #include "environment.h"
@@ -30,8 +31,9 @@ constexpr std::string_view kFunctions[] = {
 
 std::span<const std::string_view> sandboxed_functions() { return kFunctions; }
 
-void install_sandbox(Environment& env) {
+void install_sandbox(Environment& env, std::span<const std::string_view> allowed) {
   for (const std::string_view name : kFunctions) {
+    if (std::find(allowed.begin(), allowed.end(), name) != allowed.end()) continue;
     env.forbid_function(std::string(name),
                         "not available in agents (the sandbox: no files, I/O, process control or "
                         "removal of constructs; docs/security.md)");

@@ -13,7 +13,8 @@ class Environment;
 /// facts, dribble, system and exit, clear/reset and the removal of constructs.
 std::span<const std::string_view> sandboxed_functions();
 
-/// Makes every sandboxed function unavailable in `env` (Environment::forbid_function).
-void install_sandbox(Environment& env);
+/// Makes every sandboxed function unavailable in `env` (Environment::forbid_function), except
+/// those in `allowed` (a Fawkes-style agent's (reset), which the host replaces by its own).
+void install_sandbox(Environment& env, std::span<const std::string_view> allowed = {});
 
 }  // namespace llsf::clips::detail

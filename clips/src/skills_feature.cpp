@@ -69,7 +69,7 @@ class SkillsFeature final : public Feature {
     env.define_function("skill-call", "1**", [this, &env](Args& a) {
       std::string_view name;
       if (!a.text(0, name)) {
-        env.error(a.function(), "the skill name must be a symbol");
+        env.error(a.function(), "the skill name must be a symbol or string");
         return Value{};
       }
       if (a.count() % 2 != 1) {
@@ -154,7 +154,7 @@ class SkillsFeature final : public Feature {
 
   void write_fact(Environment& env) {
     env.retract(fact_);
-    const Value v[] = {Value::symbol(name_), Value::symbol(to_string(status_)),
+    const Value v[] = {Value::string(name_), Value::symbol(to_string(status_)),
                        Value::string(skill_string_), Value::string(error_), Value::string(result_)};
     fact_ = env.assert_fact(skill_, v);
   }

@@ -15,9 +15,20 @@ class TimeFeature final : public Feature {
   explicit TimeFeature(HostState& s) : s_(s) {}
 
   void define(Environment& env) override {
-    // (now): seconds of simulated time as FLOAT.
-    env.define_function("now", "00",
-                        [this](Args&) { return Value::float_value(s_.now.seconds()); });
+    // (now): seconds of simulated time as FLOAT; in Fawkes-style agents (sec usec), as Fawkes'
+    // clips plugin returns it. (now-sec-usec) is (sec usec) in both (the timer's default).
+    auto sec_usec = [this](Args&) {
+      const std::int64_t ns = s_.now.ns();
+      return Value::multifield(
+          {Value::integer_value(ns / kNsPerSec), Value::integer_value((ns % kNsPerSec) / 1000)});
+    };
+    if (s_.config.fawkes) {
+      env.define_function("now", "00", sec_usec);
+    } else {
+      env.define_function("now", "00",
+                          [this](Args&) { return Value::float_value(s_.now.seconds()); });
+    }
+    env.define_function("now-sec-usec", "00", sec_usec);
     // (time-diff-sec ?t1 ?t2): t1 - t2 in seconds; times are (sec usec) or seconds.
     env.define_function("time-diff-sec", "22", [](Args& a) {
       double t1 = 0, t2 = 0;

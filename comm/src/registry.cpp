@@ -2,6 +2,8 @@
 // MessageRegistry: (component id, message type) <-> protobuf type, frame encoding and decoding.
 #include "llsf/comm/registry.h"
 
+#include <google/protobuf/descriptor.h>
+
 #include <llsf_agent_msgs/Auction.pb.h>
 #include <llsf_agent_msgs/LockMessage.pb.h>
 #include <llsf_agent_msgs/Worldmodel.pb.h>
@@ -183,7 +185,11 @@ void add_agent_messages(MessageRegistry& registry, LockNumbering locks) {
 
 bool is_agent_message(const MessageRegistry& registry, int index) {
   const google::protobuf::Message* p = registry.prototype(registry.key_at(index));
-  return p != nullptr && p->GetDescriptor()->file()->package() == "llsf_agent_msgs";
+  // Also a type read from an agent's own .proto files (comm::ProtoLibrary): not compiled into
+  // llsfsim, so not the refbox's, even in its package llsf_msgs (the 2013 agent's LockMessage).
+  return p != nullptr &&
+         (p->GetDescriptor()->file()->package() == "llsf_agent_msgs" ||
+          p->GetDescriptor()->file()->pool() != google::protobuf::DescriptorPool::generated_pool());
 }
 
 }  // namespace llsf::comm

@@ -2,7 +2,7 @@
 -- finish_puck_at: bring the held puck under a machine's RFID reader and read the outcome.
 name               = "finish_puck_at"
 fsm                = SkillHSM:new{name=name, start="APPROACH"}
-depends_skills     = {"drive_to", "motor_move", "leave_puck"}
+depends_skills     = {"drive_to", "motor_move", "leave_puck", "take_puck"}
 depends_interfaces = {
    {v = "navigator", type = "NavigatorInterface", id = "Navigator"},
    {v = "pose",      type = "Position3DInterface", id = "Pose"},
@@ -23,7 +23,13 @@ the skill's result:
 Fails: "finish_puck_at: no puck in the holder", "finish_puck_at: unknown place 'X'",
 "M3 is down (red)", "M3 rejected the puck (yellow blinking: invalid input)", "M3 did not react
 (the puck is not under its RFID reader?)", "M3: no final light within 90 s", "finish_puck_at:
-lost the puck", drive_to's failure. The puck stays in the holder unless the outcome was WAITING;
+lost the puck (...)", drive_to's or take_puck's failure.
+A puck lost on the way (the holder feels none for 0.3 s; e.g. the navigator backed off) is
+fetched again as the 2013 skill take_puck_to did (carologistics/fawkes-robotino 6cffc15f2,
+src/lua/skills/robotino/take_puck_to.lua: stop, wait 3 s, fetch_puck, go on; at most 3 times):
+the robot stops, waits 3 s, takes the nearest puck it sees within 0.5 m and drives on. The
+0.5 m is this skill's own limit (take_puck_to's fetch_puck took any puck its omni-vision saw),
+so that a robot does not cross the field for a stranger's puck. The puck stays in the holder unless the outcome was WAITING;
 then (and after a failure at the machine) the robot backs off 5 cm slowly (the holder keeps
 the puck below 0.02 m/s) so that it can turn away from the machine.
 ]==]
@@ -31,6 +37,9 @@ the puck below 0.02 m/s) so that it can turn away from the machine.
 local PRE = 0.30          -- the approach stops this far before the input place
 local REACT_S = 6.0       -- processing must show within this time (vision adds a delay)
 local LIMIT_S = 90.0      -- T3/T4 take up to 60 s
+local LOST_WAIT_S = 3.0   -- take_puck_to: WAIT -> SKILL_FETCH_PUCK after timeout=3
+local MAX_REFETCH = 3     -- take_puck_to: MAX_RETRIES = 3
+local REFETCH_RADIUS = 0.5
 
 local function bad(self, vars)
    if type(vars.place) ~= "string" then
@@ -100,14 +109,59 @@ local function watch(self, vars)
    return false
 end
 
-local function lost(self, vars)
+-- True once the holder has felt no puck for 0.3 s.
+local function gone(vars)
    if sensor:puck_in_holder() then
       vars.lost_since = nil
       return false
    end
    vars.lost_since = vars.lost_since or clock.now()
-   if clock.now() - vars.lost_since < 0.3 then return false end
+   return clock.now() - vars.lost_since >= 0.3
+end
+
+-- Lost at the machine (the light is watched): a failure.
+local function lost(self, vars)
+   if not gone(vars) then return false end
    self.fsm.error = "finish_puck_at: lost the puck"
+   return true
+end
+
+-- Lost on the way with tries left: fetch it again (LOST).
+local function lost_on_way(self, vars)
+   return (vars.refetches or 0) < MAX_REFETCH and gone(vars)
+end
+
+local function lost_for_good(self, vars)
+   if (vars.refetches or 0) < MAX_REFETCH or not gone(vars) then return false end
+   self.fsm.error = string.format("finish_puck_at: lost the puck (fetched again %d times)",
+                                  MAX_REFETCH)
+   return true
+end
+
+-- The nearest puck the robot sees within REFETCH_RADIUS (field x, y) or nil.
+local function nearest_puck()
+   local rx, ry, th = pose:get()
+   local c, s = math.cos(th), math.sin(th)
+   local best, bx, by = REFETCH_RADIUS, nil, nil
+   for i = 1, pucks:count() do
+      local px, py = pucks:puck(i)
+      local d = math.sqrt(px * px + py * py)
+      if d < best then best, bx, by = d, rx + c * px - s * py, ry + s * px + c * py end
+   end
+   return bx, by
+end
+
+-- After the wait: a puck to fetch?
+local function refetch_found(self, vars)
+   if clock.now() - vars.lost_at < LOST_WAIT_S then return false end
+   vars.fetch_x, vars.fetch_y = nearest_puck()
+   return vars.fetch_x ~= nil
+end
+
+local function nothing_to_fetch(self, vars)
+   if clock.now() - vars.lost_at < LOST_WAIT_S then return false end
+   self.fsm.error = string.format("finish_puck_at: lost the puck (none seen within %.1f m " ..
+                                  "to fetch again)", REFETCH_RADIUS)
    return true
 end
 
@@ -126,6 +180,9 @@ fsm:define_states{ export_to=_M,
    -- robot can turn away from the machine face with the puck.
    {"CLEAR",    SkillJumpState, skills={{motor_move}}, final_to="CLEARED", fail_to="CLEARED"},
    {"CLEARED",  JumpState},
+   -- A puck lost on the way: stand, then fetch it again and drive on (take_puck_to).
+   {"LOST",     JumpState},
+   {"REFETCH",  SkillJumpState, skills={{take_puck}}, final_to="APPROACH", fail_to="FAILED"},
 }
 
 fsm:add_transitions{
@@ -142,8 +199,12 @@ fsm:add_transitions{
       self.fsm.error = vars.fail
       return true
    end, desc="failed"},
-   {"APPROACH", "FAILED", cond=lost, desc="puck lost"},
-   {"INSERT", "FAILED", cond=lost, desc="puck lost"},
+   {"APPROACH", "FAILED", cond=lost_for_good, desc="puck lost again"},
+   {"APPROACH", "LOST", cond=lost_on_way, desc="puck lost"},
+   {"INSERT", "FAILED", cond=lost_for_good, desc="puck lost again"},
+   {"INSERT", "LOST", cond=lost_on_way, desc="puck lost"},
+   {"LOST", "REFETCH", cond=refetch_found, desc="puck seen: fetch it"},
+   {"LOST", "FAILED", cond=nothing_to_fetch, desc="no puck to fetch"},
 }
 
 function APPROACH:init()
@@ -151,6 +212,16 @@ function APPROACH:init()
    local px, py, pth = navigator:place(v.place .. "_input")
    self.args["drive_to"] = {x = px - math.cos(pth) * PRE, y = py - math.sin(pth) * PRE,
                             ori = pth, forward_only = true}
+end
+
+function LOST:init()
+   self.fsm.vars.refetches = (self.fsm.vars.refetches or 0) + 1
+   self.fsm.vars.lost_since = nil
+   self.fsm.vars.lost_at = clock.now()
+end
+
+function REFETCH:init()
+   self.args["take_puck"] = {x = self.fsm.vars.fetch_x, y = self.fsm.vars.fetch_y}
 end
 
 function LOOK_SIDES:exit()

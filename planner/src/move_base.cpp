@@ -5,6 +5,7 @@
 #include "llsf/planner/move_base.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <queue>
@@ -60,6 +61,7 @@ void MoveBaseConfig::validate() const {
   core::require(p + "controller_frequency_hz", controller_frequency_hz, core::in_range(1.0, 100.0));
   core::require(p + "planner_patience_s", planner_patience_s, core::non_negative());
   core::require(p + "controller_patience_s", controller_patience_s, core::non_negative());
+  core::require(p + "navgraph_direct_m", navgraph_direct_m, core::non_negative());
   core::require(p + "approach_speed_mps", approach_speed_mps, core::positive());
   core::require(p + "approach_omega_rps", approach_omega_rps, core::positive());
   core::require(p + "approach_tolerance_m", approach_tolerance_m, core::positive());
@@ -85,6 +87,8 @@ const char* to_string(MoveBaseState state) {
       return "approach";
     case MoveBaseState::kDepart:
       return "depart";
+    case MoveBaseState::kAborted:
+      return "aborted";
   }
   return "?";
 }
@@ -125,28 +129,50 @@ void MoveBaseNavigator::go_to(const Pose2D& goal, bool forward) {
     return planner_->clearance(p).distance_m >= config_.standoff_m();
   };
   if (!clear(goal.position())) {
-    // The first pose back along the heading at the standoff; where two obstacles leave less
-    // room (M4's input faces M3 across 0.92 m), the pose of most clearance on that line.
+    // The first pose back along the heading at the standoff. Where two obstacles leave less
+    // room on that line (M4's input faces M3 across 0.92 m, M10's faces M7's side across
+    // 0.87 m), the pose of most clearance on it, on either side of the goal, as long as the
+    // line stays out of the obstacles.
     const double step = 0.01;
-    double best_clearance = -1.0;
     Vec2 best = goal.position();
+    double best_clearance = planner_->clearance(best).distance_m;
+    bool found = false;
     for (double d = step; d <= 1.5; d += step) {
       const Vec2 p = goal.position() + back * d;
       const double c = planner_->clearance(p).distance_m;
       if (c >= config_.standoff_m()) {
         best = p;
+        found = true;
         break;
       }
-      if (c > best_clearance + 1e-9) {
+      if (c <= 0.0 || c < best_clearance - 0.1) break;  // past the room between the obstacles
+      if (c > best_clearance) {
         best_clearance = c;
         best = p;
-      } else if (c < best_clearance - 0.1) {
-        break;  // past the room between the obstacles
+      }
+    }
+    for (double d = step; !found && d <= 1.5; d += step) {
+      const Vec2 p = goal.position() - back * d;
+      const double c = planner_->clearance(p).distance_m;
+      if (c <= 0.0 || c < best_clearance - 0.1) break;  // towards the machine ahead
+      if (c >= config_.standoff_m()) {
+        best = p;
+        break;
+      }
+      if (c > best_clearance) {
+        best_clearance = c;
+        best = p;
       }
     }
     base_goal_ = Pose2D{best.x(), best.y(), goal.theta};
     needs_approach_ = true;
   }
+  final_goal_ = base_goal_;
+  final_needs_approach_ = needs_approach_;
+  route_.clear();
+  route_next_ = 0;
+  route_built_ = false;
+  target_reached_ = false;
   state_ = MoveBaseState::kPlanning;
   depart_checked_ = false;
   trigger_ = Trigger::kPlanning;
@@ -186,6 +212,9 @@ void MoveBaseNavigator::finish(NavOutcome outcome, std::string message) {
   totals_.plan_failures += stats_.plan_failures;
   totals_.control_failures += stats_.control_failures;
   totals_.escapes += stats_.escapes;
+  totals_.waypoints += stats_.waypoints;
+  totals_.resends += stats_.resends;
+  totals_.aborts += stats_.aborts;
   totals_.recoveries += stats_.recoveries;
   totals_.rotate_recoveries += stats_.rotate_recoveries;
   totals_.recovery_s += stats_.recovery_s;
@@ -205,8 +234,8 @@ VelocityCommand MoveBaseNavigator::update(SimTime now, const Pose2D& pose,
     scan_for_local_ = scan_for_global_ = true;
   }
   const bool active = state_ != MoveBaseState::kIdle;
-  // shutdown_costmaps: the costmaps are updated only while a goal is active.
-  if (active || !config_.shutdown_costmaps) {
+  // shutdown_costmaps: the costmaps are updated only while move_base has a goal.
+  if ((active && state_ != MoveBaseState::kAborted) || !config_.shutdown_costmaps) {
     if (now >= next_local_) {
       next_local_ = now + SimTime::period_of_hz(config_.local_update_hz);
       local_.recenter(pose.position());
@@ -239,20 +268,42 @@ VelocityCommand MoveBaseNavigator::update(SimTime now, const Pose2D& pose,
     if (!clear(pose.position())) {
       const double step = 0.01;
       bool found = false;
+      // Where no point within reach has the standoff (between M10 and M7's side, 0.87 m
+      // apart), the point of most clearance, if it gains at least a cell of the local map.
+      double best_clearance =
+          planner_->clearance(pose.position()).distance_m + config_.local_resolution_m;
+      Pose2D best;
+      bool better = false;
       for (double d = step; d <= config_.depart_max_m && !found; d += step) {
         for (int k = 0; k < 16 && !found; ++k) {
           // Straight back, then alternately 22.5 degrees more to either side.
           const double ang =
               pose.theta + core::kPi + ((k + 1) / 2) * (core::kPi / 8.0) * (k % 2 ? 1 : -1);
           const Vec2 p = pose.position() + Vec2(std::cos(ang), std::sin(ang)) * d;
-          if (clear(p)) {
-            depart_to_ = Pose2D{p.x(), p.y(), forward_ ? core::normalize_angle(ang) : pose.theta};
+          const double c = planner_->clearance(p).distance_m;
+          const Pose2D to{p.x(), p.y(), forward_ ? core::normalize_angle(ang) : pose.theta};
+          if (c >= config_.standoff_m()) {
+            depart_to_ = to;
             found = true;
+          } else if (c > best_clearance) {
+            best_clearance = c;
+            best = to;
+            better = true;
           }
         }
       }
+      if (!found && better) {
+        depart_to_ = best;
+        found = true;
+      }
       if (found) state_ = MoveBaseState::kDepart;
     }
+  }
+  if (state_ == MoveBaseState::kPlanning && !route_built_) build_route(now, pose);
+  if (!route_.empty() && route_step(now, pose)) return command_;
+  if (state_ == MoveBaseState::kAborted) {
+    command_ = {};
+    return command_;
   }
   if (state_ == MoveBaseState::kDepart) {
     bool arrived = false;
@@ -306,7 +357,9 @@ VelocityCommand MoveBaseNavigator::update(SimTime now, const Pose2D& pose,
           std::abs(core::angle_diff(base_goal_.theta, pose.theta)) <=
               config_.yaw_goal_tolerance_rad &&
           stopped) {
-        if (needs_approach_) {
+        if (!route_.empty()) {
+          route_done(pose);  // move_base arrived: final for the navgraph
+        } else if (needs_approach_) {
           state_ = MoveBaseState::kApproach;
           command_ = approach(pose);
         } else {
@@ -339,6 +392,7 @@ VelocityCommand MoveBaseNavigator::update(SimTime now, const Pose2D& pose,
     case MoveBaseState::kIdle:
     case MoveBaseState::kApproach:
     case MoveBaseState::kDepart:
+    case MoveBaseState::kAborted:
       break;
   }
   return command_;
@@ -356,11 +410,11 @@ void MoveBaseNavigator::start_recovery(SimTime now, const Pose2D& pose) {
   // The default sequence: conservative reset, rotation, aggressive reset, rotation.
   const int count = config_.clearing_rotation_allowed ? 4 : 2;
   if (!config_.recovery_behavior_enabled || recovery_index_ >= count) {
-    finish(trigger_ == Trigger::kPlanning ? NavOutcome::kNoPath : NavOutcome::kStuck,
-           trigger_ == Trigger::kPlanning
-               ? "move_base: failed to find a valid plan, even after executing recovery behaviors"
-               : "move_base: failed to find a valid control, even after executing recovery "
-                 "behaviors");
+    give_up(trigger_ == Trigger::kPlanning ? NavOutcome::kNoPath : NavOutcome::kStuck,
+            trigger_ == Trigger::kPlanning
+                ? "move_base: failed to find a valid plan, even after executing recovery behaviors"
+                : "move_base: failed to find a valid control, even after executing recovery "
+                  "behaviors");
     return;
   }
   ++stats_.recoveries;
@@ -415,7 +469,18 @@ VelocityCommand MoveBaseNavigator::run_recovery(SimTime now, const Pose2D& pose)
 
 VelocityCommand MoveBaseNavigator::approach(const Pose2D& pose) {
   bool arrived = false;
-  const VelocityCommand c = straight_to(pose, goal_, arrived);
+  Pose2D target = goal_;
+  if (forward_) {
+    // Carrying a puck, the straight move never backs off (the holder would lose the puck):
+    // a goal behind the approach pose -- where the pose of most clearance lies beyond it, as
+    // a pre-pose of M10's input facing M7 -- is reached by turning to its heading where the
+    // robot stands.
+    const Vec2 heading(std::cos(goal_.theta), std::sin(goal_.theta));
+    if ((goal_.position() - pose.position()).dot(heading) < 0.0) {
+      target = Pose2D{pose.x, pose.y, goal_.theta};
+    }
+  }
+  const VelocityCommand c = straight_to(pose, target, arrived);
   if (arrived) finish(NavOutcome::kArrived, {});
   return c;
 }
@@ -434,6 +499,217 @@ VelocityCommand MoveBaseNavigator::straight_to(const Pose2D& pose, const Pose2D&
   const Vec2 vr = core::rotate(vf, -pose.theta);
   const double w = std::clamp(1.5 * dth, -config_.approach_omega_rps, config_.approach_omega_rps);
   return {vr.x(), vr.y(), w};
+}
+
+// --- ppgoto along the team's navigation graph ----------------------------------------------
+
+namespace {
+
+// The corridor nodes of the Carologistics' 2013 navigation graph and their connections
+// (carologistics/fawkes-robotino 6cffc15f2, cfg/navgraph-llsf.yaml: positions, travel_tolerance
+// and the `connections` among these nodes). Left out: the nodes at devices (M1..M10, ExpM*,
+// R1, R2, T, Ins, deliver: goals, reached here by the approach) and the agent's waiting spots
+// (WAIT_FOR_INS, WAIT_FOR_DELIVER, reached by directed detours only).
+struct GraphNode {
+  const char* name;
+  double x, y, tolerance;
+};
+constexpr GraphNode kGraphNodes[] = {
+    {"P11", 1.0, 1.1, 0.5},  {"P12", 1.0, 2.15, 0.4}, {"P13", 1.0, 3.4, 0.4},
+    {"P14", 1.0, 4.4, 0.5},  {"P21", 2.2, 1.1, 0.5},  {"P22", 2.2, 2.15, 0.4},
+    {"P23", 2.2, 3.4, 0.4},  {"P24", 2.2, 4.4, 0.5},  {"P31", 3.4, 1.1, 0.5},
+    {"P32", 3.4, 2.15, 0.5}, {"P33", 3.4, 3.4, 0.5},  {"P34", 3.4, 4.4, 0.5},
+    {"P41", 4.7, 1.1, 0.5},  {"P42", 4.7, 2.15, 0.5}, {"P43", 4.7, 3.4, 0.5},
+    {"P44", 4.7, 4.4, 0.5},  {"IA", 1.0, 2.8, 0.8},   {"M9W", 1.0, 3.9, 0.5},
+    {"M9N", 1.68, 4.4, 0.5}, {"M8E", 2.2, 1.65, 0.5}, {"M4S", 2.75, 1.1, 0.5},
+    {"M6W", 2.2, 3.85, 0.5}, {"M6S", 2.75, 3.4, 0.5}, {"M6N", 2.75, 4.4, 0.5},
+    {"M1S", 3.9, 1.1, 0.5},  {"M5E", 3.4, 2.8, 0.5},  {"M2W", 3.4, 3.92, 0.5},
+    {"M1E", 4.7, 1.7, 0.5},  {"M2O", 4.7, 3.92, 0.5}, {"DW", 4.7, 3.1, 0.5},
+    {"M3E", 3.4, 0.55, 0.5}, {"M7E", 3.4, 5.05, 0.5}, {"SR1", 0.4, 0.5, 0.5},
+    {"SR2", 0.4, 1.75, 0.5},
+};
+constexpr std::pair<const char*, const char*> kGraphEdges[] = {
+    {"P11", "P21"}, {"P11", "P12"}, {"P11", "SR1"}, {"P12", "SR2"}, {"P12", "IA"},  {"IA", "P13"},
+    {"P12", "P22"}, {"IA", "P23"},  {"P13", "M9W"}, {"M9W", "P14"}, {"P13", "P23"}, {"IA", "P22"},
+    {"P14", "M9N"}, {"M9N", "P24"}, {"P21", "M8E"}, {"M8E", "P22"}, {"P21", "M4S"}, {"M4S", "P31"},
+    {"P31", "M3E"}, {"P22", "P32"}, {"P22", "P23"}, {"P23", "M6W"}, {"M6W", "P24"}, {"P23", "M6S"},
+    {"M6S", "P33"}, {"P24", "M6N"}, {"M6N", "P34"}, {"P34", "M7E"}, {"P31", "P32"}, {"P31", "M1S"},
+    {"M1S", "P41"}, {"P32", "P42"}, {"P32", "M5E"}, {"M5E", "P33"}, {"P33", "M2W"}, {"M2W", "P34"},
+    {"P33", "P43"}, {"P43", "M2O"}, {"M2O", "P44"}, {"P34", "P44"}, {"P41", "M1E"}, {"M1E", "P42"},
+    {"P42", "DW"},  {"DW", "P43"},  {"P32", "DW"},  {"P33", "DW"},
+};
+constexpr std::size_t kGraphSize = std::size(kGraphNodes);
+
+std::size_t graph_index(const char* name) {
+  for (std::size_t i = 0; i < kGraphSize; ++i) {
+    if (std::string_view(kGraphNodes[i].name) == name) return i;
+  }
+  return kGraphSize;
+}
+
+std::size_t closest_node(const Vec2& p) {
+  std::size_t best = 0;
+  double best_d = std::numeric_limits<double>::max();
+  for (std::size_t i = 0; i < kGraphSize; ++i) {
+    const double d = std::hypot(kGraphNodes[i].x - p.x(), kGraphNodes[i].y - p.y());
+    if (d < best_d) {
+      best_d = d;
+      best = i;
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+void MoveBaseNavigator::build_route(SimTime now, const Pose2D& pose) {
+  // Fawkes' navgraph, a cartesian goto: A* from the node closest to the robot to the node
+  // closest to the target, then the target itself ("free-target", the target's heading);
+  // optimize_plan drops the first node when it does not lie on the way (the angle robot --
+  // node -- next node at most 90 degrees).
+  route_built_ = true;
+  route_.clear();
+  route_next_ = 0;
+  if (!config_.navgraph) return;
+  if ((final_goal_.position() - pose.position()).norm() < config_.navgraph_direct_m) return;
+  const std::size_t from = closest_node(pose.position());
+  const std::size_t to = closest_node(final_goal_.position());
+  std::array<double, kGraphSize> dist{};
+  std::array<std::size_t, kGraphSize> prev{};
+  std::array<bool, kGraphSize> done{};
+  dist.fill(std::numeric_limits<double>::infinity());
+  prev.fill(kGraphSize);
+  dist[to] = 0.0;  // from the goal, so that prev leads towards it
+  for (std::size_t round = 0; round < kGraphSize; ++round) {
+    std::size_t u = kGraphSize;
+    for (std::size_t i = 0; i < kGraphSize; ++i) {
+      if (!done[i] && std::isfinite(dist[i]) && (u == kGraphSize || dist[i] < dist[u])) u = i;
+    }
+    if (u == kGraphSize || u == from) break;
+    done[u] = true;
+    for (const auto& [a, b] : kGraphEdges) {
+      const std::size_t ia = graph_index(a), ib = graph_index(b);
+      const std::size_t v = ia == u ? ib : ib == u ? ia : kGraphSize;
+      if (v == kGraphSize || done[v]) continue;
+      const double d = dist[u] + std::hypot(kGraphNodes[u].x - kGraphNodes[v].x,
+                                            kGraphNodes[u].y - kGraphNodes[v].y);
+      if (d < dist[v]) {
+        dist[v] = d;
+        prev[v] = u;
+      }
+    }
+  }
+  if (!std::isfinite(dist[from])) return;
+  for (std::size_t i = from; i != kGraphSize; i = prev[i]) {
+    route_.push_back({Pose2D{kGraphNodes[i].x, kGraphNodes[i].y, 0.0}, kGraphNodes[i].tolerance});
+  }
+  route_.push_back({final_goal_, config_.navgraph_target_tolerance_m});
+  const auto sq = [](const Vec2& a, const Vec2& b) { return (a - b).squaredNorm(); };
+  if (route_.size() > 1 && sq(pose.position(), route_[0].pose.position()) +
+                                   sq(route_[0].pose.position(), route_[1].pose.position()) >=
+                               sq(pose.position(), route_[1].pose.position())) {
+    route_.erase(route_.begin());
+  }
+  send_goal(now, pose);
+}
+
+void MoveBaseNavigator::send_goal(SimTime now, const Pose2D& pose) {
+  // send_next_goal: a node faces the way from where the robot stands; the target keeps its
+  // heading. move_base takes it as a new goal: it plans at once, its timers and its recovery
+  // sequence start over (a rotation under way ends first: move_base runs it to its end).
+  const Waypoint& w = route_[route_next_];
+  const bool last = route_next_ + 1 == route_.size();
+  if (last) {
+    base_goal_ = final_goal_;
+    needs_approach_ = final_needs_approach_;
+  } else {
+    const Vec2 d = w.pose.position() - pose.position();
+    base_goal_ = Pose2D{w.pose.x, w.pose.y, std::atan2(d.y(), d.x())};
+    needs_approach_ = false;
+  }
+  sent_at_ = now;
+  trigger_ = Trigger::kPlanning;
+  recovery_index_ = 0;
+  last_valid_plan_ = now;
+  last_valid_control_ = now;
+  rotating_to_goal_ = false;
+  next_control_ = now;
+  // Under way, the new plan is made at once and the robot keeps its speed until the next
+  // controller cycle (move_base publishes nothing while it plans).
+  const bool under_way = state_ == MoveBaseState::kControlling;
+  state_ = under_way && make_plan(pose) ? MoveBaseState::kControlling : MoveBaseState::kPlanning;
+}
+
+bool MoveBaseNavigator::route_step(SimTime now, const Pose2D& pose) {
+  // The navgraph's loop (every step). Returns true if it ended the navigation.
+  if (state_ == MoveBaseState::kDepart || state_ == MoveBaseState::kApproach ||
+      state_ == MoveBaseState::kIdle) {
+    return false;
+  }
+  if (target_reached_) {
+    // Reached the target: move_base goes on until it is final or target_time passed.
+    if (now - target_reached_at_ >= SimTime::from_seconds(config_.navgraph_target_time_s) ||
+        state_ == MoveBaseState::kAborted) {
+      route_done(pose);
+      return true;
+    }
+    return false;
+  }
+  const Waypoint& w = route_[route_next_];
+  const bool last = route_next_ + 1 == route_.size();
+  const double dist = (w.pose.position() - pose.position()).norm();
+  const bool reached =
+      last ? dist <= w.tolerance && std::abs(core::angle_diff(w.pose.theta, pose.theta)) <=
+                                        config_.navgraph_orientation_tolerance_rad
+           : dist <= w.tolerance;
+  if (reached) {
+    if (last) {
+      target_reached_ = true;
+      target_reached_at_ = now;
+      if (state_ == MoveBaseState::kAborted) {
+        route_done(pose);
+        return true;
+      }
+      return false;
+    }
+    ++route_next_;
+    ++stats_.waypoints;
+    send_goal(now, pose);
+    return false;
+  }
+  if (now - sent_at_ > SimTime::from_seconds(config_.navgraph_resend_interval_s) &&
+      !(state_ == MoveBaseState::kClearing && rotating_)) {
+    ++stats_.resends;
+    send_goal(now, pose);
+  }
+  return false;
+}
+
+void MoveBaseNavigator::route_done(const Pose2D& pose) {
+  // The navgraph is final: it stops the motion; the skill's straight move follows if needed.
+  route_.clear();
+  target_reached_ = false;
+  base_goal_ = final_goal_;
+  needs_approach_ = final_needs_approach_;
+  if (needs_approach_) {
+    state_ = MoveBaseState::kApproach;
+    command_ = approach(pose);
+  } else {
+    finish(NavOutcome::kArrived, {});
+  }
+}
+
+void MoveBaseNavigator::give_up(NavOutcome outcome, std::string message) {
+  // move_base aborts. Following the navgraph, that is no failure: the robot stands until the
+  // navgraph sends the goal again (or, past the target, the navgraph is final).
+  if (!route_.empty()) {
+    ++stats_.aborts;
+    state_ = MoveBaseState::kAborted;
+    command_ = {};
+    rotating_ = false;
+    return;
+  }
+  finish(outcome, std::move(message));
 }
 
 // --- the global planner (navfn) ------------------------------------------------------------

@@ -32,6 +32,8 @@ AgentBrain::AgentBrain(Game& game, int index, AgentBrainConfig config, clips::Lo
   ac.max_rules_per_cycle = config.max_rules_per_cycle;
   max_runaway_cycles_ = config.max_runaway_cycles;
   ac.sandbox = config.sandbox;
+  ac.fawkes = config.fawkes;
+  ac.agent_dir = config.agent_dir;
   ac.config = std::move(config.config);
   if (config.locks) {
     ac.locks = true;
@@ -46,6 +48,11 @@ AgentBrain::AgentBrain(Game& game, int index, AgentBrainConfig config, clips::Lo
   io.messages = &game.registry();
   RobotRadio* radio = &game.robot(index).radio();
   io.broadcast = [radio](const google::protobuf::Message& m) { radio->broadcast(m); };
+  // pb-send to the refbox (pb-connect's server): the radio has no unicast, the refbox hears
+  // every broadcast (docs/fawkes.md).
+  io.send = io.broadcast;
+  RobotStack* robot = &game.robot(index);
+  io.motor = [robot](bool on) { robot->set_motor_enabled(on); };
   io.log = std::move(log);
   io.lock_events = std::move(locks);
   file_entries_ = std::move(config.agent_files);
@@ -67,8 +74,9 @@ std::unique_ptr<clips::AgentHost> AgentBrain::make_host() const {
       std::string error;
       const std::string text =
           core::try_read_input_file(f, core::kMaxSourceBytes, "CLIPS file", error).value_or("");
-      if (!locks_ && (what.find("deftemplate lock") != std::string::npos ||
-                      text.find("(lock (") != std::string::npos)) {
+      if (!locks_ && !host_config_.fawkes &&
+          (what.find("deftemplate lock") != std::string::npos ||
+           text.find("(lock (") != std::string::npos)) {
         throw clips::AgentLoadError(
             what +
             "\nhint: the agent uses the host's lock facts, which exist only with the lock "

@@ -133,6 +133,7 @@ Game::Game(GameConfig config)
   // The radio: the refbox hears and is heard by every channel, the robots share "team".
   add_refbox_messages(registry_);
   comm::add_agent_messages(registry_, config_.hub.lock_messages);
+  for (const auto& protos : config_.agent_protos) protos->register_in(registry_);
   std::vector<std::string> names;
   names.emplace_back(kRefboxPeer);
   for (const auto& r : config_.world.robots) names.push_back(r.name);
@@ -358,8 +359,10 @@ void Game::step() {
     for (const auto& d : discs_) {
       if (d.id != i) others_.push_back(d);
     }
-    world_->set_command(core::RobotId(i),
-                        stacks_[static_cast<std::size_t>(i)]->actuate(now, others_));
+    RobotStack& stack = *stacks_[static_cast<std::size_t>(i)];
+    const kinematic::MotorCommand c = stack.actuate(now, others_);
+    // An agent's (motor-disable) switches the motors off: the robot stands (Fawkes' motor-switch).
+    world_->set_command(core::RobotId(i), stack.motor_enabled() ? c : kinematic::MotorCommand{});
   }
 
   mark(1);

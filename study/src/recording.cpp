@@ -650,6 +650,9 @@ void Recorder::frame(const sim::Game& game) {
     j["rotations"] = st.rotate_recoveries;
     j["escapes"] = st.escapes;
     j["plans"] = st.plans;
+    j["waypoints"] = st.waypoints;
+    j["resends"] = st.resends;
+    j["aborts"] = st.aborts;
     m.write(j);
   }
 

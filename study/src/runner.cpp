@@ -406,6 +406,8 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
     c.skills = scenario.skills;
     c.locks = spec.locks;
     c.sandbox = spec.sandbox;
+    c.fawkes = spec.fawkes;
+    c.agent_dir = spec.agent_dir;
     const std::string name(game.robot(i).name());
     // The agent's decisions (info and above) go into the recording; the team agent's role
     // changes are counted.

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "llsf/comm/hub_config.h"
+#include "llsf/comm/proto_library.h"
 #include "llsf/core/error.h"
 #include "llsf/core/input_file.h"
 #include "llsf/kinematic/world_config.h"
@@ -168,9 +169,63 @@ std::vector<std::string> read_agent(const core::ConfigNode& n, const std::string
   return out;
 }
 
+// A path inside `root` (relative to it), or a failure at `at`.
+std::string inside(const core::ConfigNode& at, const std::string& root, const std::string& rel,
+                   const char* what) {
+  std::error_code ec;
+  const fs::path r = fs::weakly_canonical(root, ec);
+  const fs::path p = fs::weakly_canonical(r / rel, ec);
+  const auto [end, it] = std::mismatch(r.begin(), r.end(), p.begin(), p.end());
+  if (ec || end != r.end() || fs::path(rel).is_absolute()) {
+    at.fail(std::string(what) + " '" + rel + "' is outside the agent directory " + r.string() +
+            " (an agent reads only its own directory: docs/security.md)");
+  }
+  if (!fs::exists(p, ec))
+    at.fail(std::string(what) + " '" + rel + "' not found (looked at " + p.string() + ")");
+  return p.string();
+}
+
+// robots.agent as a map: a Fawkes-style agent {fawkes: DIR, entry: FILE, protos: [DIRS]}.
+void read_fawkes_agent(const core::ConfigNode& n, const std::string& dir, RobotSpec& spec) {
+  const core::ConfigNode d = n.at("fawkes");
+  spec.agent_dir = resolve(dir, d.as_string());
+  std::error_code ec;
+  if (!fs::is_directory(spec.agent_dir, ec)) {
+    d.fail("agent directory '" + d.as_string() + "' not found (looked at " + spec.agent_dir + ")");
+  }
+  const core::ConfigNode e = n.at("entry");
+  std::string entry = e.as_string();
+  if (!entry.ends_with(".clp")) entry += ".clp";  // as Fawkes' /clips-agent/agent
+  spec.agent = {inside(e, spec.agent_dir, entry, "entry file")};
+  spec.proto_dirs.clear();
+  if (const core::ConfigNode p = n["protos"]; p.defined()) {
+    const std::vector<std::string> dirs = string_list(p);
+    for (std::size_t i = 0; i < dirs.size(); ++i) {
+      const core::ConfigNode at = p.is_sequence() ? p.at(static_cast<int>(i)) : p;
+      spec.proto_dirs.push_back(inside(at, spec.agent_dir, dirs[i], "proto directory"));
+    }
+  }
+  n.no_other_keys();
+  spec.fawkes = true;
+  std::erase_if(spec.config,
+                [](const clips::ConfigEntry& c) { return c.path == "/clips-agent/agent"; });
+  spec.config.push_back(
+      clips::ConfigEntry::of("/clips-agent/agent", entry.substr(0, entry.size() - 4)));
+}
+
+// robots.agent / each[i].agent: files and directories, or a Fawkes-style agent (a map).
+void read_agent_spec(const core::ConfigNode& n, const std::string& dir, RobotSpec& spec) {
+  if (n.is_map()) return read_fawkes_agent(n, dir, spec);
+  spec.agent = read_agent(n, dir);
+  spec.fawkes = false;
+  spec.agent_dir.clear();
+  spec.proto_dirs.clear();
+}
+
 void read_robots(const core::ConfigNode& n, const std::string& dir, Scenario& s) {
   int count = static_cast<int>(s.game.world.robots.size());
-  std::vector<std::string> agent;
+  RobotSpec common;
+  core::ConfigNode agent_node;
   clips::ConfigEntries config;
   bool locks = false;
   bool sandbox = true;
@@ -185,18 +240,22 @@ void read_robots(const core::ConfigNode& n, const std::string& dir, Scenario& s)
       }
       count = static_cast<int>(v);
     }
-    if (const core::ConfigNode a = n["agent"]; a.defined()) agent = read_agent(a, dir);
     if (const core::ConfigNode c = n["config"]; c.defined()) {
       c.require_map();
       config = clips::config_from_node(c, "/clips-agent");
     }
+    common.config = config;
+    agent_node = n["agent"];
+    if (agent_node.defined()) read_agent_spec(agent_node, dir, common);
     n.read("locks", locks);
     n.read("sandbox", sandbox);
     each = n["each"];
     n.no_other_keys();
   }
+  common.locks = locks;
+  common.sandbox = sandbox;
   s.game.world.robots.resize(static_cast<std::size_t>(count));
-  s.robots.assign(static_cast<std::size_t>(count), RobotSpec{agent, config, locks, sandbox});
+  s.robots.assign(static_cast<std::size_t>(count), common);
   if (!each.defined()) return;
   if (!each.is_sequence()) each.fail("expected a list with one entry per robot");
   if (each.size() > count) each.fail("more entries than robots (" + std::to_string(count) + ")");
@@ -205,11 +264,11 @@ void read_robots(const core::ConfigNode& n, const std::string& dir, Scenario& s)
     if (r.is_null()) continue;
     r.require_map();
     RobotSpec& spec = s.robots[static_cast<std::size_t>(i)];
-    if (const core::ConfigNode a = r["agent"]; a.defined()) spec.agent = read_agent(a, dir);
     if (const core::ConfigNode c = r["config"]; c.defined()) {
       c.require_map();
       merge_config(spec.config, clips::config_from_node(c, "/clips-agent"));
     }
+    if (const core::ConfigNode a = r["agent"]; a.defined()) read_agent_spec(a, dir, spec);
     kinematic::RobotStart& start = s.game.world.robots[static_cast<std::size_t>(i)];
     r.read("name", start.name);
     r.read("jersey", start.jersey);
@@ -224,6 +283,28 @@ void read_robots(const core::ConfigNode& n, const std::string& dir, Scenario& s)
     }
     r.no_other_keys();
   }
+}
+
+// Fawkes-style agents: their host has no lock protocol (they bring their own lock.clp), and
+// their own .proto files are loaded once per directory list (game.agent_protos).
+void read_fawkes_protos(const core::ConfigNode& robots, Scenario& s) {
+  std::map<std::vector<std::string>, std::shared_ptr<const comm::ProtoLibrary>> loaded;
+  for (const RobotSpec& spec : s.robots) {
+    if (!spec.fawkes) continue;
+    if (spec.locks) {
+      robots["locks"].fail(
+          "the host's lock protocol is off for a Fawkes-style agent, which brings its own (a "
+          "lock.clp with its own lock template and messages): remove robots.locks "
+          "(docs/fawkes.md)");
+    }
+    if (spec.proto_dirs.empty() || loaded.contains(spec.proto_dirs)) continue;
+    try {
+      loaded[spec.proto_dirs] = comm::ProtoLibrary::load(spec.proto_dirs);
+    } catch (const core::ConfigError& e) {
+      robots["agent"].fail(std::string("the agent's .proto files: ") + e.what());
+    }
+  }
+  for (auto& [dirs, lib] : loaded) s.game.agent_protos.push_back(lib);
 }
 
 void read_tests(const core::ConfigNode& n, Scenario& s) {
@@ -461,6 +542,7 @@ Scenario read_scenario(const core::ConfigNode& root, const std::string& file) {
   s.duration = core::SimTime::from_seconds(duration);
   check_physics_steps(root, s);
   read_robots(root["robots"], dir, s);
+  read_fawkes_protos(root["robots"], s);
   if (const core::ConfigNode n = root["skills"]; n.defined()) {
     s.skills = lua::SkillEngineConfig::from_config(n, dir);  // dirs relative to the file
     s.skills.profile = profile.name;

@@ -203,6 +203,15 @@ std::string batch_identity_hash(const std::string& scenario_path, const Scenario
   for (const Scenario& s : file.variants) {
     for (const RobotSpec& r : s.robots) {
       for (const std::string& f : sim::agent_files(r.agent)) files.insert(f);
+      // A Fawkes-style agent path-loads any file of its directory, and has its .proto files.
+      std::error_code ec;
+      if (r.fawkes && fs::is_directory(r.agent_dir, ec)) {
+        for (const auto& e : fs::recursive_directory_iterator(r.agent_dir, ec)) {
+          const fs::path ext = e.path().extension();
+          if (e.is_regular_file() && (ext == ".clp" || ext == ".proto"))
+            files.insert(e.path().string());
+        }
+      }
     }
     const std::vector<std::string> dirs = s.skills.skill_dirs.empty()
                                               ? sim::skill_library_dirs(s.game.levels.skill)

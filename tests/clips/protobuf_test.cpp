@@ -148,7 +148,7 @@ TEST_CASE("pb-* errors are runtime errors") {
   CHECK(a.runtime_errors() == errors);
 }
 
-TEST_CASE("an unset nested message reads as its defaults and cannot be written") {
+TEST_CASE("an unset nested message reads as a new message: filled and set, not in place") {
   const auto reg = agent_registry();
   AgentFixture f({}, &reg);
   f.step();
@@ -156,9 +156,22 @@ TEST_CASE("an unset nested message reads as its defaults and cannot be written")
   f.load("(defglobal ?*c* = (pb-create \"llsf_agent_msgs.WorldmodelChange\"))");
   CHECK(a.eval("(pb-field-value (pb-field-value ?*c* incoming) action)") == Value::string(""));
   const int errors = a.runtime_errors();
+  // Writing the new message changes neither the default instance nor the message...
   a.eval("(pb-set-field (pb-field-value ?*c* incoming) action \"x\")");
-  CHECK(a.runtime_errors() == errors + 1);
+  CHECK(a.runtime_errors() == errors);
   CHECK(llsf_agent_msgs::Incoming::default_instance().action().empty());
+  CHECK(a.eval("(pb-has-field ?*c* incoming)") == Value::boolean(false));
+  // ... until it is set (as Fawkes' agents fill a nested message and set it).
+  f.load("(defglobal ?*in* = (pb-field-value ?*c* incoming))");
+  a.eval("(pb-set-field ?*in* action \"FINISH\")");
+  a.eval("(pb-set-field ?*c* incoming ?*in*)");
+  CHECK(a.eval("(pb-field-value (pb-field-value ?*c* incoming) action)") ==
+        Value::string("FINISH"));
+  // A set field read in place and set from itself stays as it is.
+  a.eval("(pb-set-field ?*c* incoming (pb-field-value ?*c* incoming))");
+  CHECK(a.eval("(pb-field-value (pb-field-value ?*c* incoming) action)") ==
+        Value::string("FINISH"));
+  CHECK(a.runtime_errors() == errors);
 }
 
 TEST_CASE("pb-unchanged tells a message that repeats the last one with the same key") {

@@ -30,7 +30,7 @@ constexpr const char* kAgent = R"clp(
   (skill-call drive_to place ?p))
 (defrule job-done
   ?j <- (job (place ?p) (state RUNNING))
-  ?s <- (skill (name drive_to) (status FINAL))
+  ?s <- (skill (name "drive_to") (status FINAL))
   =>
   (retract ?s)
   (modify ?j (state DONE))

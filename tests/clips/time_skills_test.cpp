@@ -69,12 +69,13 @@ TEST_CASE("the skill fact follows the runner: IDLE, RUNNING, FINAL, then retract
   AgentFixture f;
   f.load(
       "(defrule start (start) => (skill-call drive_to place M1))\n"
-      "(defrule done (skill (name drive_to) (status FINAL)) => (assert (arrived)))\n");
+      "(defrule done (skill (name \"drive_to\") (status FINAL)) => (assert (arrived)))\n");
   f.step();
   f.assert_fact("(start)");
   f.step();
   auto s = f.facts("skill");
   REQUIRE(s.size() == 1);
+  CHECK(s[0].slot("name") == Value::string("drive_to"));  // a STRING, as in Fawkes
   CHECK(s[0].slot("status") == Value::symbol("IDLE"));
   CHECK(s[0].slot("skill-string") == Value::string("drive_to{place=\"M1\"}"));
   f.step();  // the fake runner reports RUNNING after exec()
@@ -96,20 +97,20 @@ TEST_CASE("a failed skill carries the runner's error; a new call aborts the old 
   f.step();
   f.skills().set_status(SkillStatus::kFailed, "no path");
   f.step();
-  CHECK(f.has("(failed drive_to \"no path\")"));
+  CHECK(f.has("(failed \"drive_to\" \"no path\")"));
 
   f.agent().eval("(skill-call drive_to place M2)");
   f.agent().eval("(skill-call get_s0)");
   f.step();
-  CHECK(f.has("(failed drive_to \"aborted by skill-call get_s0{}\")"));
+  CHECK(f.has("(failed \"drive_to\" \"aborted by skill-call get_s0{}\")"));
   const auto s = f.facts("skill");
   REQUIRE(s.size() == 1);
-  CHECK(s[0].slot("name") == Value::symbol("get_s0"));
+  CHECK(s[0].slot("name") == Value::string("get_s0"));
 
   f.agent().eval("(skill-stop)");
   f.step();
   CHECK(f.skills().stops() == 1);
-  CHECK(f.has("(failed get_s0 \"stopped by skill-stop\")"));
+  CHECK(f.has("(failed \"get_s0\" \"stopped by skill-stop\")"));
 }
 
 TEST_CASE("skill-call without a runner is a runtime error") {
@@ -123,7 +124,7 @@ TEST_CASE("a finished skill fact carries the runner's result") {
   AgentFixture f;
   f.load(
       "(defrule start (start) => (skill-call explore_machine place M3))\n"
-      "(defrule done (skill (name explore_machine) (status FINAL) (result ?r))\n"
+      "(defrule done (skill (name \"explore_machine\") (status FINAL) (result ?r))\n"
       "  => (assert (code ?r)))\n");
   f.step();
   f.assert_fact("(start)");

@@ -18,9 +18,12 @@ using namespace llsf::sim;
 
 namespace {
 
-// Two robots at the given poses, move_base-2013 navigation, the laser on, no agents.
-GameConfig two_robots(const core::Pose2D& a, const core::Pose2D& b) {
+// Two robots at the given poses, move_base-2013 navigation, the laser on, no agents. move_base
+// alone (goals straight to it, as the skills' relgoto) unless `navgraph` (Fawkes' navgraph
+// leads it, as ppgoto).
+GameConfig two_robots(const core::Pose2D& a, const core::Pose2D& b, bool navgraph = false) {
   GameConfig c = test::small_game(2, 3);
+  c.levels.move_base.navgraph = navgraph;
   c.world.sensors.laser.enabled = true;
   c.world.robots[0].pose = a;
   c.world.robots[1].pose = b;
@@ -51,6 +54,9 @@ planner::MoveBaseStats stats_of(const Game& g, int i) {
     s.rotate_recoveries += c.rotate_recoveries;
     s.recovery_s += c.recovery_s;
     s.plans += c.plans;
+    s.waypoints += c.waypoints;
+    s.resends += c.resends;
+    s.aborts += c.aborts;
   }
   return s;
 }
@@ -188,4 +194,32 @@ TEST_CASE("move_base-2013: a goal another robot stands on ends in move_base's ab
   CHECK(r.sa.recovery_s > 10.0);  // full turns at up to 0.78 rad/s
   CHECK(g.robot(0).nav_status().message.find("even after executing recovery behaviors") !=
         std::string::npos);
+}
+
+TEST_CASE("move_base-2013 with the navigation graph: corridor nodes, resends, no abort") {
+  // Across the field: the route passes the graph's corridor nodes and arrives.
+  {
+    GameConfig c = two_robots({1.0, 0.7, 0.0}, {0.5, 5.0, 0.0}, true);
+    Game g(c);
+    const Run r = play(g, {4.7, 4.4, 0.0}, nullptr, 120.0);
+    report("graph across the field", r);
+    MESSAGE("  ", r.sa.waypoints, " nodes passed, ", r.sa.resends, " resends");
+    CHECK(r.a == planner::NavOutcome::kArrived);
+    CHECK(r.sa.waypoints >= 3);
+    CHECK((g.world().robot_pose(core::RobotId(0)).position() - core::Vec2(4.7, 4.4)).norm() <=
+          0.25 + 1e-9);
+  }
+  // A goal another robot stands on: move_base plans in vain and starts its recoveries; the graph
+  // sends the goal again every 6 s (which starts move_base over before its sequence can end in
+  // an abort) and never gives up -- the 2013 robot had no timeout (thesis section 6.2).
+  {
+    GameConfig c = two_robots({1.0, 0.7, 0.0}, {3.4, 2.15, 0.0}, true);
+    Game g(c);
+    const Run r = play(g, {3.4, 2.15, 0.0}, nullptr, 120.0);
+    report("graph, goal occupied", r);
+    MESSAGE("  ", r.sa.resends, " resends, ", r.sa.aborts, " aborts outlived");
+    CHECK(r.a == planner::NavOutcome::kRunning);
+    CHECK(r.sa.recoveries >= 1);
+    CHECK(r.sa.resends >= 5);
+  }
 }

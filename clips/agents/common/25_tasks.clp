@@ -112,7 +112,7 @@
 (defrule task-skill-final
   (declare (salience ?*PRIORITY-TASK*))
   ?t <- (task (state RUNNING) (kind ?k))
-  ?s <- (skill (name ?n&:(eq ?n (task-skill ?k))) (status FINAL) (result ?r))
+  ?s <- (skill (name ?n&:(eq ?n (str-cat (task-skill ?k)))) (status FINAL) (result ?r))
   =>
   (retract ?s)
   (modify ?t (state DONE) (result ?r))
@@ -121,7 +121,7 @@
 (defrule task-skill-failed
   (declare (salience ?*PRIORITY-TASK*))
   ?t <- (task (state RUNNING) (kind ?k))
-  ?s <- (skill (name ?n&:(eq ?n (task-skill ?k))) (status FAILED) (error ?e) (result ?r))
+  ?s <- (skill (name ?n&:(eq ?n (str-cat (task-skill ?k)))) (status FAILED) (error ?e) (result ?r))
   =>
   (retract ?s)
   (log-warn "task " ?k " failed: " ?e)

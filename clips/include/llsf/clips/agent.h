@@ -106,6 +106,14 @@ struct AgentConfig {
   /// master's announcements. Off by default, so that agents without locks stay silent.
   bool locks = false;
   LockConfig lock_config;  ///< timing and team size of the lock protocol (if `locks`)
+  /// Fawkes' agent model (docs/fawkes.md): load_file() runs the entry file as Fawkes' clips-agent
+  /// did (top-level commands, path-load, (reset), config-load, the ff-feature facts), (now) is
+  /// (sec usec), confval facts come only from config-load, received messages only after
+  /// pb-peer-enable. Off: llsfsim's own agent model (docs/clips.md).
+  bool fawkes = false;
+  /// With `fawkes`: the agent directory (Fawkes' clips-dirs). path-load, path-resolve and the
+  /// entry file resolve relative to it; no file outside it can be read, none can be written.
+  std::string agent_dir;
 
   /// Throws std::invalid_argument naming the bad field.
   void validate() const;
@@ -120,6 +128,11 @@ struct AgentIo {
   BroadcastFn broadcast;
   LogSink log;
   LockListener lock_events;  ///< every lock state change of this robot (with locks on)
+  /// (motor-enable) / (motor-disable): switches the robot's motors (Fawkes' motor-switch).
+  std::function<void(bool on)> motor;
+  /// (pb-send ?client ?msg): a message to the stream server the agent connected to with
+  /// (pb-connect host port) (the refbox: the only server of a game). Without it, pb-send drops.
+  BroadcastFn send;
 };
 
 /// What one cycle did.
@@ -157,7 +170,10 @@ class AgentHost {
   AgentHost& operator=(const AgentHost&) = delete;
 
   /// Loads an agent file (read in C++, parsed from a string). Throws AgentLoadError
-  /// ("path:line: ...") on bad code or if the file cannot be read.
+  /// ("path:line: ...") on bad code or if the file cannot be read. With AgentConfig::fawkes the
+  /// file is the entry file (once): it starts the agent as Fawkes' clips-agent did
+  /// (docs/fawkes.md) and runs it to quiescence; every load error of the files it path-loads on
+  /// the way is in the AgentLoadError.
   void load_file(const std::string& path);
   /// Loads code from a string; `source_name` stands for the file name in error messages.
   void load_string(std::string_view code, std::string_view source_name);
@@ -172,6 +188,12 @@ class AgentHost {
 
   /// The robot's pose for the (pose (x) (y) (ori)) fact, updated at the next cycle if changed.
   void set_pose(const core::Pose2D& pose);
+  /// Writes a blackboard interface of a Fawkes-style agent (docs/fawkes.md): the fields of
+  /// interface `type` ("RobotinoLightInterface") with id `id` ("Light_State") by name, stamped
+  /// with the time of the last cycle. (blackboard-read) asserts it once per write. The pose
+  /// (set_pose) is written as Position3DInterface "Pose" by the host itself.
+  void write_interface(std::string_view type, std::string_view id,
+                       std::vector<std::pair<std::string, Value>> fields);
   /// A message received from peer `from` (name and id) at `at`; it becomes a protobuf-msg fact
   /// at the next cycle. The host takes ownership.
   void receive(std::unique_ptr<google::protobuf::Message> message, std::string_view from,

@@ -122,7 +122,8 @@ const char* lock_numbering_name(LockNumbering n);
 void add_agent_messages(MessageRegistry& registry, LockNumbering locks = LockNumbering::kLlsfsim);
 
 /// True if the type with dense index `index` is one of the agents' messages (package
-/// llsf_agent_msgs), whatever its component id: with LockNumbering::k2013 two of them share the
+/// llsf_agent_msgs, or read from an agent's own .proto files: comm::ProtoLibrary), whatever its
+/// component id: with LockNumbering::k2013 two of them share the
 /// refbox's component 2000, but they are not the refbox's business.
 bool is_agent_message(const MessageRegistry& registry, int index);
 

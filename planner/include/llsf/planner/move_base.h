@@ -87,6 +87,21 @@ struct MoveBaseConfig {
   double approach_tolerance_m = 0.02;
   double approach_angle_tolerance_rad = 0.03;
 
+  // ppgoto: the 2013 skills did not send move_base across the field; Fawkes' navgraph plugin
+  // (fawkesrobotics/fawkes bb80e90bc, 2013-07-13, src/plugins/navgraph/navgraph_thread.cpp)
+  // led the robot along the team's navigation graph (cfg/navgraph-llsf.yaml at 6cffc15f2),
+  // sending move_base one node after the other, resending the current one every
+  // resend_interval and never failing on move_base's abort (docs/planner.md). A goal nearer
+  // than `navgraph_direct_m` goes to move_base directly (the skills' relgoto).
+  bool navgraph = true;
+  double navgraph_direct_m = 1.0;
+  // cfg/conf.d/navgraph.yaml (6cffc15f2)
+  double navgraph_travel_tolerance_m = 0.4;   ///< a node passed (unless the node says otherwise)
+  double navgraph_target_tolerance_m = 0.25;  ///< the final target reached ...
+  double navgraph_orientation_tolerance_rad = 0.2;  ///< ... and facing its heading
+  double navgraph_resend_interval_s = 6.0;          ///< the current goal sent again after this
+  double navgraph_target_time_s = 10.0;             ///< move_base kept going after the target
+
   /// The clearance (robot centre to the nearest static obstacle or wall) of the pose move_base
   /// drives to instead of a goal too close to an obstacle, and of the point a departure goes
   /// to: where both costmaps see the robot free however their cells fall -- the robot radius
@@ -180,6 +195,7 @@ enum class MoveBaseState {
   kClearing,  ///< a recovery behaviour runs
   kApproach,  ///< the straight final move after move_base reached the approach pose
   kDepart,    ///< the straight move out of an obstacle's inscribed radius before planning
+  kAborted,   ///< move_base gave up; Fawkes' navgraph sends the goal again (ppgoto)
 };
 const char* to_string(MoveBaseState state);
 
@@ -189,6 +205,9 @@ struct MoveBaseStats {
   int plan_failures = 0;      ///< global planning attempts that found no path
   int control_failures = 0;   ///< controller cycles without a valid command
   int escapes = 0;            ///< controller cycles that backed off (escape velocity)
+  int waypoints = 0;          ///< navigation-graph nodes passed on the way (ppgoto)
+  int resends = 0;            ///< goals the navgraph sent again (ppgoto)
+  int aborts = 0;             ///< move_base aborts the navgraph outlived (ppgoto)
   int recoveries = 0;         ///< recovery behaviours run
   int rotate_recoveries = 0;  ///< of them, in-place rotations
   double recovery_s = 0.0;    ///< time spent in recovery behaviours
@@ -256,8 +275,27 @@ class MoveBaseNavigator {
   MoveBaseStats stats_;
   MoveBaseStats totals_;
   Pose2D goal_;       // what the caller asked for
-  Pose2D base_goal_;  // what move_base drives to (the approach pose if one is needed)
+  Pose2D base_goal_;  // what move_base drives to now (a graph node, or final_goal_)
   bool needs_approach_ = false;
+  Pose2D final_goal_;  // the last move_base goal (the approach pose if one is needed)
+  bool final_needs_approach_ = false;
+  // ppgoto's route: graph nodes, then the final target (final_goal_), each with the distance
+  // at which it counts as reached.
+  struct Waypoint {
+    Pose2D pose;
+    double tolerance = 0.4;
+  };
+  std::vector<Waypoint> route_;
+  std::size_t route_next_ = 0;
+  bool route_built_ = false;
+  bool target_reached_ = false;
+  core::SimTime target_reached_at_;
+  core::SimTime sent_at_;
+  void build_route(core::SimTime now, const Pose2D& pose);
+  void send_goal(core::SimTime now, const Pose2D& pose);
+  bool route_step(core::SimTime now, const Pose2D& pose);
+  void route_done(const Pose2D& pose);
+  void give_up(NavOutcome outcome, std::string message);
   bool depart_checked_ = false;
   bool forward_ = false;  // carrying a puck: the departure turns first, never backs off
   Pose2D depart_to_;      // where the departure move goes

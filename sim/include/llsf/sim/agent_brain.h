@@ -43,6 +43,10 @@ struct AgentBrainConfig {
   bool locks = false;
   /// The agents' sandbox (clips::AgentConfig::sandbox, docs/security.md).
   bool sandbox = true;
+  /// Fawkes' agent model (clips::AgentConfig::fawkes, docs/fawkes.md): `agent_files` is the one
+  /// entry file, inside `agent_dir` (Fawkes' clips-dirs), which path-load reads from.
+  bool fawkes = false;
+  std::string agent_dir;
   /// Robots that take part in the lock protocol (the majority is counted of these); 0: every
   /// robot of the game.
   int lock_team_size = 0;

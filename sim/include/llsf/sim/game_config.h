@@ -4,11 +4,13 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "llsf/comm/hub_config.h"
+#include "llsf/comm/proto_library.h"
 #include "llsf/core/sim_time.h"
 #include "llsf/kinematic/world_config.h"
 #include "llsf/planner/config.h"
@@ -187,6 +189,9 @@ struct GameConfig {
   /// Radio peers outside the simulation (none unless the game is served on sockets); added to
   /// the hub after the refbox and the robots, in this order.
   std::vector<ExternalPeerConfig> external_peers;
+  /// Message types of Fawkes-style agents' own .proto files (docs/fawkes.md), registered with
+  /// the radio after llsfsim's (a key taken by another type is a core::ConfigError).
+  std::vector<std::shared_ptr<const comm::ProtoLibrary>> agent_protos;
 
   /// Throws core::ConfigError "game.<field>: reason" for the first bad field (the world,
   /// refbox, protocol, hub and navigation configs are validated by their own validate()).

@@ -194,6 +194,9 @@ class RobotStack final : public lua::RobotApi {
   /// Handling (robot profiles): whether the robot is jammed against a device now, the device
   /// (DeviceView index; -1 none), and how many jams it had.
   bool jammed() const { return jam_device_ >= 0; }
+  /// The motor switch (an agent's motor-enable / motor-disable): off, the robot stands.
+  bool motor_enabled() const { return motor_enabled_; }
+  void set_motor_enabled(bool on) { motor_enabled_ = on; }
   int jam_device() const { return jam_device_; }
   int jams() const { return jams_; }
   /// The hackathon's colour camera (its sightings, frame time and pose), nullptr outside it.
@@ -245,6 +248,7 @@ class RobotStack final : public lua::RobotApi {
   SimTime jammed_since_;
   bool motor_started_ = false;  ///< a new run of direct motor commands began
   int jam_device_ = -1;
+  bool motor_enabled_ = true;  // set_motor_enabled()
   int jams_ = 0;
   // Navigation failures (a ring of the last kNavFailureMemory) and the current goal's place.
   std::array<NavFailure, kNavFailureMemory> nav_failure_ring_{};

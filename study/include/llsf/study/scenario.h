@@ -23,6 +23,11 @@ struct RobotSpec {
   clips::ConfigEntries config;     ///< confval facts (under /clips-agent)
   bool locks = false;              ///< the lock protocol (robots.locks)
   bool sandbox = true;             ///< the agents' sandbox (robots.sandbox, docs/security.md)
+  /// A Fawkes-style agent (robots.agent: {fawkes: DIR, entry: FILE}, docs/fawkes.md): `agent` is
+  /// its entry file, `agent_dir` the directory it may read (Fawkes' clips-dirs).
+  bool fawkes = false;
+  std::string agent_dir;
+  std::vector<std::string> proto_dirs;  ///< its own .proto directories (also in game.agent_protos)
 };
 
 /// A pass/fail condition on a finished game.

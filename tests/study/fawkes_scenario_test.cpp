@@ -1,0 +1,212 @@
+// SPDX-License-Identifier: MIT
+// Fawkes-style agents in a scenario (docs/fawkes.md): robots.agent {fawkes, entry, protos}, the
+// agent's own .proto files registered with the radio (its messages travel between the robots),
+// its own lock template beside the host (host locks off), its peer, and the scenario's errors.
+// The agent is a small Fawkes-style agent written for this test.
+#include <doctest/doctest.h>
+
+#include <filesystem>
+#include <string>
+
+#include "llsf/core/error.h"
+#include "llsf/sim/agent_brain.h"
+#include "llsf/sim/driver.h"
+#include "llsf/study/runner.h"
+#include "llsf/study/scenario.h"
+#include "support/temp_dir.h"
+
+using namespace llsf;
+using namespace llsf::study;
+
+namespace {
+
+// A "ping" agent: its own message type (package demo_msgs, not compiled into llsfsim), its own
+// lock template, a peer enabled from its config; each robot pings once a second, counts the
+// pings of the others and records them as lock facts of its own template.
+constexpr const char* kProto = R"pb(
+  syntax = "proto2"
+  ;
+package demo_msgs;
+import "Stamp.proto";
+message Ping {
+  enum CompType {
+    COMP_ID  = 3000;
+    MSG_TYPE = 1;
+  }
+  required string agent = 1;
+  optional Stamp stamp = 2;
+}
+)pb";
+
+constexpr const char* kStampProto = R"pb(
+  syntax = "proto2"
+  ;
+package demo_msgs;
+message Stamp {
+  required int64 sec = 1;
+  required int64 usec = 2;
+}
+)pb";
+
+constexpr const char* kEntry = R"clp(
+(path-load ping/globals.clp)
+(defrule load-config (init) => (config-load "/clips-agent"))
+(deffacts init (init))
+(defrule enable-protobuf (ff-feature protobuf) => (ff-feature-request "protobuf"))
+(defrule initialize
+  (agent-init)
+  (ff-feature-loaded protobuf)
+  =>
+  (path-load ping/lock.clp)
+  (path-load ping/net.clp)
+  (reset))
+)clp";
+
+constexpr const char* kGlobals = R"clp(
+(defglobal ?*NAME* = "?")
+(defrule name-from-config
+  (confval (path "/clips-agent/ping/robot-name") (type STRING) (value ?n))
+  =>
+  (bind ?*NAME* ?n))
+)clp";
+
+// The agent's own lock template: the agent is a STRING, unlike llsfsim's host template.
+constexpr const char* kLock = R"clp(
+(deftemplate lock
+  (slot type (type SYMBOL) (allowed-values GET REFUSE ACCEPT RELEASE RELEASE_RVCD))
+  (slot agent (type STRING))
+  (slot resource (type SYMBOL)))
+(deffacts lock-facts (timer (name ping) (time (create$ 0 0))))
+)clp";
+
+constexpr const char* kNet = R"clp(
+(defrule net-enable
+  (confval (path "/clips-agent/ping/peer-address") (value ?a))
+  (confval (path "/clips-agent/ping/peer-port") (value ?p))
+  (not (peer-enabled))
+  =>
+  (pb-peer-enable ?a ?p ?p)
+  (assert (peer-enabled)))
+
+(defrule ping
+  (peer-enabled)
+  (time $?now)
+  ?t <- (timer (name ping) (time $?last&:(timeout ?now ?last 1.0)))
+  =>
+  (modify ?t (time ?now))
+  (bind ?m (pb-create "demo_msgs.Ping"))
+  (pb-set-field ?m "agent" ?*NAME*)
+  (bind ?s (pb-create "demo_msgs.Stamp"))
+  (pb-set-field ?s "sec" (nth$ 1 ?now))
+  (pb-set-field ?s "usec" (nth$ 2 ?now))
+  (pb-set-field ?m "stamp" ?s)
+  (pb-destroy ?s)
+  (pb-broadcast ?m)
+  (pb-destroy ?m))
+
+(defrule pinged
+  ?f <- (protobuf-msg (type "demo_msgs.Ping") (ptr ?p))
+  =>
+  (retract ?f)
+  (bind ?from (pb-field-value ?p "agent"))
+  (bind ?sec (pb-field-value (pb-field-value ?p "stamp") "sec"))
+  (assert (lock (type GET) (agent ?from) (resource (sym-cat M ?sec)))))
+)clp";
+
+struct PingAgent {
+  test::TempDir dir{"llsf_fawkes_scenario"};
+  PingAgent() {
+    namespace fs = std::filesystem;
+    fs::create_directories(dir.path / "agents/ping/msgs");
+    dir.write("agents/ping/ping.clp", kEntry);
+    dir.write("agents/ping/globals.clp", kGlobals);
+    dir.write("agents/ping/lock.clp", kLock);
+    dir.write("agents/ping/net.clp", kNet);
+    dir.write("agents/ping/msgs/Ping.proto", kProto);
+    dir.write("agents/ping/msgs/Stamp.proto", kStampProto);
+  }
+  std::string scenario(const std::string& robots_extra = "") const {
+    const std::string text = R"yaml(
+name: fawkes ping
+duration_s: 6
+robots:
+  count: 2
+  agent: {fawkes: agents, entry: ping/ping, protos: [ping/msgs]}
+  config: {ping: {peer-address: 172.26.255.255, peer-port: 4444}}
+  each:
+    - {config: {ping: {robot-name: R-1}}}
+    - {config: {ping: {robot-name: R-2}}}
+)yaml" + robots_extra;
+    dir.write("s.yaml", text);
+    return dir.file("s.yaml");
+  }
+};
+
+}  // namespace
+
+TEST_CASE("a Fawkes-style agent's own messages travel between the robots") {
+  const PingAgent a;
+  const ScenarioFile f = load_scenario(a.scenario());
+  const Scenario& s = f.variants.at(0);
+  REQUIRE(s.robots.at(0).fawkes);
+  REQUIRE(s.game.agent_protos.size() == 1);
+  sim::GameDriver driver(s.game);
+  std::vector<sim::AgentBrain*> brains;
+  for (int i = 0; i < 2; ++i) {
+    sim::AgentBrainConfig c;
+    c.agent_files = s.robots[static_cast<std::size_t>(i)].agent;
+    c.config = s.robots[static_cast<std::size_t>(i)].config;
+    c.fawkes = true;
+    c.agent_dir = s.robots[static_cast<std::size_t>(i)].agent_dir;
+    brains.push_back(&driver.plug_agent(i, c));
+  }
+  driver.run_until(core::SimTime::from_seconds(5.0));
+  for (int i = 0; i < 2; ++i) {
+    CAPTURE(i);
+    const clips::AgentHost& agent = brains[static_cast<std::size_t>(i)]->agent();
+    CHECK(agent.runtime_errors() == 0);
+    // The other robot's pings, as the agent's own lock facts (agent a STRING).
+    const std::string other = i == 0 ? "R-2" : "R-1";
+    const auto locks = agent.find_facts("lock", {{"agent", clips::Value::string(other)}});
+    CHECK(locks.size() >= 3);
+    CHECK(agent.find_facts("lock", {{"agent", clips::Value::string(i == 0 ? "R-1" : "R-2")}})
+              .empty());  // a broadcast does not come back to its sender
+  }
+}
+
+TEST_CASE("a Fawkes-style agent's scenario: the host's locks off, paths inside, protos parsed") {
+  const PingAgent a;
+  CHECK_THROWS_WITH_AS(load_scenario(a.scenario("  locks: true\n")),
+                       doctest::Contains("the host's lock protocol is off for a Fawkes-style"),
+                       core::ConfigError);
+  a.dir.write("bad.yaml", R"yaml(
+name: escape
+robots:
+  agent: {fawkes: agents, entry: ../s.yaml}
+)yaml");
+  CHECK_THROWS_WITH_AS(load_scenario(a.dir.file("bad.yaml")),
+                       doctest::Contains("is outside the agent directory"), core::ConfigError);
+  a.dir.write("agents/ping/msgs/Broken.proto", "syntax = \"proto2\";\nmessage { }\n");
+  CHECK_THROWS_WITH_AS(load_scenario(a.scenario()), doctest::Contains("Broken.proto:2:"),
+                       core::ConfigError);
+}
+
+TEST_CASE("a Fawkes-style agent's messages collide with llsfsim's 2013 lock numbering") {
+  const PingAgent a;
+  // A LockMessage of the agent's own at the 2013 pair, as the team's agent has it.
+  a.dir.write("agents/ping/msgs/LockMessage.proto", R"pb(
+    syntax = "proto2"
+    ;
+package llsf_msgs;
+message LockMessage {
+  enum CompType { COMP_ID = 2000; MSG_TYPE = 1337; }
+  required string agent = 1;
+}
+)pb");
+  const ScenarioFile ok = load_scenario(a.scenario());
+  CHECK_NOTHROW(sim::GameDriver(ok.variants.at(0).game));
+  const ScenarioFile clash = load_scenario(a.scenario("radio: {lock_messages: 2013}\n"));
+  CHECK_THROWS_WITH_AS(sim::GameDriver(clash.variants.at(0).game),
+                       doctest::Contains("collides with llsf_agent_msgs.LockMessage"),
+                       core::ConfigError);
+}
