@@ -134,7 +134,8 @@ class RuleScan {
   }
 
   static std::string reads(std::string_view fn) {
-    return fn == "now" ? std::string("(now)") : "(" + std::string(fn) + " ...), which calls (now)";
+    if (fn == "now" || fn == "now-sec-usec") return "(" + std::string(fn) + ")";
+    return "(" + std::string(fn) + " ...), which calls (now)";
   }
 
   const Names& fns_;

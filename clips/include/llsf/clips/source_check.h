@@ -17,7 +17,8 @@ struct SourceWarning {
   std::string message;
 };
 
-/// Finds rule conditions that read the time (`(now)`, or a deffunction that calls it) where CLIPS
+/// Finds rule conditions that read the time (`(now)`, `(now-sec-usec)`, or a deffunction that
+/// calls one) where CLIPS
 /// does not evaluate them again when time passes: a `(test ...)` with no `(time ...)` pattern
 /// before it (a test is evaluated when the facts matched before it change), and a slot
 /// constraint of a fact pattern (`(timer (until ?u&:(< ?u (now))))`: tested when that fact
@@ -30,7 +31,8 @@ class TimeReadCheck {
   std::vector<SourceWarning> scan(std::string_view code);
 
  private:
-  std::set<std::string, std::less<>> time_functions_ = {"now"};
+  /// The host's clock functions, then the deffunctions that call one.
+  std::set<std::string, std::less<>> time_functions_ = {"now", "now-sec-usec"};
 };
 
 }  // namespace llsf::clips
