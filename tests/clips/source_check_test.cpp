@@ -141,8 +141,8 @@ TEST_CASE("a time read that CLIPS never evaluates again is a warning with its li
   CHECK(w[4].line == 24);  // a (time) inside a not holds no time fact
   // The (sec usec) clock of Fawkes-style agents counts too.
   TimeReadCheck fawkes;
-  const auto f = fawkes.scan(
-      "(defrule t (task (since $?s)) (test (timeout (now-sec-usec) ?s 1.0)) =>)\n");
+  const auto f =
+      fawkes.scan("(defrule t (task (since $?s)) (test (timeout (now-sec-usec) ?s 1.0)) =>)\n");
   REQUIRE(f.size() == 1);
   CHECK(f[0].message.find("reads the time ((now-sec-usec))") != std::string::npos);
   // The shipped agents' way (docs/clips.md) is quiet.
