@@ -60,12 +60,18 @@ void SkillEngineConfig::validate() const {
                 static_cast<double>(allocation_budget_bytes),
                 core::in_range(1 << 20, kMaxMemoryBytes));
   core::require("skill engine: max_cycle_wall_s", max_cycle_wall_s, core::in_range(0.01, 3600.0));
-  for (const std::string& dir : skill_dirs) {
-    std::error_code ec;
-    if (!fs::is_directory(dir, ec)) {
-      throw core::ConfigError("skill engine: skill directory '" + dir + "' does not exist");
+  const auto check_dirs = [](const std::vector<std::string>& dirs, const char* what) {
+    for (const std::string& dir : dirs) {
+      std::error_code ec;
+      if (!fs::is_directory(dir, ec)) {
+        throw core::ConfigError(std::string("skill engine: ") + what + " '" + dir +
+                                "' does not exist");
+      }
     }
-  }
+  };
+  check_dirs(skill_dirs, "skill directory");
+  check_dirs(module_dirs, "module directory");
+  check_dirs(cfg_dirs, "cfg directory");
 }
 
 SkillEngineConfig SkillEngineConfig::from_config(const core::ConfigNode& node,
@@ -84,6 +90,39 @@ SkillEngineConfig SkillEngineConfig::from_config(const core::ConfigNode& node,
   }
   // Each figure checked at its own key (validate() below repeats the checks for configs built
   // in code).
+  // module_dirs, cfg_dirs: like skill_dirs (relative to the file).
+  const auto read_dirs = [&](std::string_view key, std::vector<std::string>& out) {
+    const core::ConfigNode list = node[key];
+    if (!list.defined()) return;
+    if (!list.is_sequence()) list.fail("expected a list of directories");
+    for (const core::ConfigNode& d : list.elements()) {
+      const fs::path dir(d.as_string());
+      out.push_back(dir.is_absolute() || base_dir.empty()
+                        ? dir.string()
+                        : (fs::path(base_dir) / dir).lexically_normal().string());
+    }
+  };
+  read_dirs("module_dirs", cfg.module_dirs);
+  read_dirs("cfg_dirs", cfg.cfg_dirs);
+  // fawkes_config: a tree of maps whose leaves are the values, flattened to "/a/b/c" paths.
+  if (const core::ConfigNode tree = node["fawkes_config"]; tree.defined()) {
+    tree.require_map();
+    std::vector<std::pair<std::string, core::ConfigNode>> todo{{"", tree}};
+    while (!todo.empty()) {
+      auto [prefix, n] = todo.back();
+      todo.pop_back();
+      for (const std::string& key : n.keys()) {
+        const core::ConfigNode v = n[key];
+        if (v.is_map()) {
+          todo.emplace_back(prefix + "/" + key, v);
+        } else if (v.is_scalar()) {
+          cfg.fawkes_config[prefix + "/" + key] = v.as_string();
+        } else {
+          v.fail("expected a value or a map of values (lists are not offered)");
+        }
+      }
+    }
+  }
   node.read("rate_hz", cfg.rate_hz, core::in_range(0.1, 10000.0));
   const auto read_int = [&](std::string_view key, std::int64_t& out, double lo, double hi) {
     const core::ConfigNode v = node[key];
@@ -112,6 +151,7 @@ SkillEngineConfig SkillEngineConfig::from_config(const core::ConfigNode& node,
 namespace {
 
 constexpr const char* kPreludeChunkName = "=llsf/prelude.lua";
+constexpr const char* kFawkesChunkName = "=llsf/fawkes.lua";
 
 // Where a refused allocation happened: the innermost frame of a skill file (chunk names "@path")
 // and its current line, for Impl::explain(). Lua's memory error has no position, and Lua calls no
@@ -195,15 +235,15 @@ void budget_hook(lua_State* L, lua_Debug* ar) {
   e.budget_exhausted = true;
   // Name the skill's line: the hook may fire in the prelude's code (a library wrapper, the DSL
   // runtime) running on the skill's behalf; then the nearest caller outside the prelude.
+  const auto internal = [](const char* source) {
+    return std::strcmp(source, kPreludeChunkName) == 0 ||
+           std::strcmp(source, kFawkesChunkName) == 0;
+  };
   lua_getinfo(L, "Sl", ar);
   lua_Debug caller{};
-  for (int level = 1;
-       std::strcmp(ar->source, kPreludeChunkName) == 0 && lua_getstack(L, level, &caller) != 0;
-       ++level) {
+  for (int level = 1; internal(ar->source) && lua_getstack(L, level, &caller) != 0; ++level) {
     lua_getinfo(L, "Sl", &caller);
-    if (caller.currentline > 0 && std::strcmp(caller.source, kPreludeChunkName) != 0) {
-      ar = &caller;
-    }
+    if (caller.currentline > 0 && !internal(caller.source)) ar = &caller;
   }
   if (out_of_time) {
     const std::string secs = core::number_text(e.config.max_cycle_wall_s);
@@ -536,6 +576,16 @@ void SkillEngine::Impl::build() {
   push_interfaces(L);  // sets native.interfaces, interface_names, clock
   push_pattern_functions(L);
   lua_setfield(L, -2, "patterns");
+  push_fawkes_natives(L);
+  // The Fawkes layer (fawkes.lua) gets the natives too; its table goes to the prelude as
+  // native.fawkes.
+  if (luaL_loadbufferx(L, kFawkesLayer, std::char_traits<char>::length(kFawkesLayer),
+                       kFawkesChunkName, "t") != LUA_OK) {
+    LLSF_DEMAND_MSG(false, "fawkes layer: " + pop_message(L));
+  }
+  lua_pushvalue(L, -2);
+  if (protected_call(1, 1) != LUA_OK) LLSF_DEMAND_MSG(false, "fawkes layer: " + pop_message(L));
+  lua_setfield(L, -2, "fawkes");
   if (protected_call(1, 1) != LUA_OK) LLSF_DEMAND_MSG(false, "prelude: " + pop_message(L));
   engine_ref = luaL_ref(L, LUA_REGISTRYINDEX);
 
@@ -564,6 +614,8 @@ void SkillEngine::Impl::build() {
       lua_pushstring(L, shown.c_str());
       if (call_entry("begin_module", 2, 1) != LUA_OK) {
         load_error = pop_message(L);
+      } else if (lua_isnil(L, -1)) {
+        lua_pop(L, 1);  // a helper module a skill has loaded with require already
       } else {
         const std::string chunkname = "@" + shown;
         if (luaL_loadbufferx(L, text.data(), text.size(), chunkname.c_str(), "t") != LUA_OK) {
@@ -765,17 +817,19 @@ std::vector<SkillInfo> SkillEngine::skills() const {
     SkillInfo info;
     info.name = f.name;
     info.path = f.path;
-    with_skill_info(*impl_, f.name,
-                    [&](SkillStatus, const std::string&, const std::string&, std::string load_error,
-                        const std::string&, std::string doc, const std::string& deps) {
-                      info.load_error = std::move(load_error);
-                      info.documentation = std::move(doc);
-                      std::stringstream ss(deps);
-                      for (std::string d; std::getline(ss, d, ',');) {
-                        info.depends_skills.push_back(d);
-                      }
-                    });
-    out.push_back(std::move(info));
+    // (helper modules, files that define no skill, are not listed)
+    const bool skill = with_skill_info(
+        *impl_, f.name,
+        [&](SkillStatus, const std::string&, const std::string&, std::string load_error,
+            const std::string&, std::string doc, const std::string& deps) {
+          info.load_error = std::move(load_error);
+          info.documentation = std::move(doc);
+          std::stringstream ss(deps);
+          for (std::string d; std::getline(ss, d, ',');) {
+            info.depends_skills.push_back(d);
+          }
+        });
+    if (skill) out.push_back(std::move(info));
   }
   return out;
 }

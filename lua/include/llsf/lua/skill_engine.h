@@ -31,6 +31,16 @@ struct SkillEngineConfig {
   /// Directories whose `*.lua` files (not recursive, `init.lua` excluded) are skills; a skill of
   /// a later directory replaces one of the same name in an earlier one.
   std::vector<std::string> skill_dirs;
+  /// Directories besides `skill_dirs` where `require("name")` finds Lua helper modules
+  /// (`name.lua`, `a.b` as `a/b.lua`; files that are not skills, e.g. a team's tf_module.lua).
+  /// `require` searches `skill_dirs` first, then these; it reads only files inside them.
+  std::vector<std::string> module_dirs;
+  /// Fawkes' cfg directories: where `fawkes.load_yaml_navgraph("navgraph-llsf.yaml")` finds
+  /// navgraph files (read-only, only files inside them).
+  std::vector<std::string> cfg_dirs;
+  /// Fawkes configuration values skills read with `config:get_float("/skills/x/y")` etc.: path
+  /// ("/skills/x/y") -> value as written in YAML ("0.05", "true", "text").
+  std::map<std::string, std::string> fawkes_config;
   /// Rate at which `sim/` calls cycle(), in simulated Hz (the engine itself never waits).
   double rate_hz = 30.0;
   /// Lua VM instructions one cycle (or loading one file) may execute, counted in steps of 1000,
