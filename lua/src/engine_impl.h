@@ -77,6 +77,8 @@ struct NavgraphData {
 struct SkillFile {
   std::string name;
   std::string path;
+  /// The directory's init.lua (a Fawkes skill space naming its skills), not a skill.
+  bool space_init = false;
   std::int64_t mtime_ns = 0;
   std::int64_t size = 0;
 };

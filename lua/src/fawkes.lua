@@ -603,6 +603,21 @@ def("NavigatorInterface", {
   llsf = llsf.NavigatorInterface,
 })
 
+def("SkillerInterface", {
+  default_id = "Skiller",
+  fields = {skill_string = {"string"}, error = {"string"}, exclusive_controller = {"uint32"},
+            msgid = {"uint32"}, status = {"SkillStatusEnum"}},
+  constants = {S_INACTIVE = 0, S_FINAL = 1, S_RUNNING = 2, S_FAILED = 3},
+  messages = {},  -- skill strings come from the agent (llsfsim's skill runner), not from skills
+  -- The skill string the agent sent, its status and error (the engine's own state).
+  writer = function(id)
+    if id ~= "Skiller" then return nil end
+    return function(d)
+      d.skill_string, d.status, d.error = native.skiller()
+    end
+  end,
+})
+
 -- Interface objects ------------------------------------------------------------------------
 local objects = {}    -- uid -> object
 local data_of = {}    -- object -> its data (fields; refreshed from the writer)
@@ -753,7 +768,8 @@ end
 
 -- The interface object of a depends_interfaces entry {v=, type=, id=[, writing=true]}: nil and
 -- why for an unknown type or id. Without an id, the type's default (llsfsim's own skills).
-function F.interface(type_name, id, var, writing)
+local polled = {}  -- objects bound by files written for Fawkes, in binding order
+function F.interface(type_name, id, var, writing, poll)
   local t = types[type_name]
   if not t then return llsf[type_name], nil end  -- llsfsim's own types: one per robot, any id
   id = id or t.default_id
@@ -770,7 +786,16 @@ function F.interface(type_name, id, var, writing)
   local m = meta_of[obj]
   m.var = m.var or var
   if writing then m.writing = true end
+  if poll and not m.polled and m.write then
+    m.polled = true
+    polled[#polled + 1] = obj
+  end
   return obj
+end
+-- Fawkes' skiller read every interface at the start of each loop: the writers' fields (and so
+-- visibility_history) follow the robot from cycle to cycle, read or not.
+function F.poll()
+  for i = 1, #polled do pcall(refresh, polled[i]) end  -- (a failing read fails at the skill's)
 end
 function F.type_names()
   local names = {}

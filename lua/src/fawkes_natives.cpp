@@ -314,9 +314,21 @@ int native_navgraph(lua_State* L) {
   return 1;
 }
 
+// skiller() -> skill_string, status (0..3), error: the engine's own state, for the
+// SkillerInterface "Skiller" (what the skill string the agent sent is doing).
+int native_skiller(lua_State* L) {
+  const Impl& e = Impl::of(L);
+  lua_pushlstring(L, e.skill_string.data(), e.skill_string.size());
+  lua_pushinteger(L, static_cast<lua_Integer>(e.status));
+  lua_pushlstring(L, e.error.data(), e.error.size());
+  return 3;
+}
+
 }  // namespace
 
 void push_fawkes_natives(lua_State* L) {
+  lua_pushcfunction(L, native_skiller);
+  lua_setfield(L, -2, "skiller");
   lua_pushcfunction(L, native_read_module);
   lua_setfield(L, -2, "read_module");
   lua_pushcfunction(L, native_navgraph);

@@ -418,7 +418,7 @@ local function module_env(h)
           error(fmt("depends_interfaces[%d]: expected {v=\"name\", type=\"Type\"[, id=\"Id\"]}", i), 2)
         end
         -- Fawkes' types (fawkes.lua) by id, with llsfsim's methods at the default id.
-        local obj, why = fawkes.interface(d.type, d.id, d.v, d.writing)
+        local obj, why = fawkes.interface(d.type, d.id, d.v, d.writing, h.fawkes_style)
         if not obj then
           error(fmt("depends_interfaces[%d]: %s", i, why or
                     fmt("unknown interface type '%s' (known: %s)", d.type,
@@ -1145,6 +1145,24 @@ function E.finish_module(name)
   h.documentation = env.documentation
 end
 
+-- A Fawkes skill space: the init.lua of a skill directory names its skills with
+-- skillenv.use_skill("skills.<space>.<name>"). Runs it with only what such a file uses and
+-- returns the names (the last part of each), or nil and why it could not run.
+function E.skill_space(text, chunkname)
+  local names = {}
+  local function use_skill(m)
+    if type(m) == "string" then names[#names + 1] = m:match("([^.]+)$") end
+  end
+  local env = {skillenv = {use_skill = use_skill},
+               fawkes = {modinit = {register_all = noop, module_init = noop}},
+               module = noop, require = function() return {} end, print = noop, printf = noop}
+  local chunk, err = load(text, chunkname, "t", env)
+  if not chunk then return nil, err end
+  local ok, e = raw_pcall(chunk)
+  if not ok then return nil, error_text(e) end
+  return names
+end
+
 function E.set_load_error(name, msg)
   loading = nil
   handles[name].load_error = msg
@@ -1205,9 +1223,12 @@ function E.compile(s)
   return load(s, "=skill string", "t", string_env)
 end
 
+local fawkes_poll = fawkes.poll
+
 function E.run_cycle(chunk)
   cycle_id = cycle_id + 1
   cycle_now_ns = now_ns()
+  fawkes_poll()
   for i = #called, 1, -1 do called[i] = nil end
   depth, caller = 0, nil
   chunk()

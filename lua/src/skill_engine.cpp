@@ -12,6 +12,8 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <map>
+#include <set>
 #include <sstream>
 #include <system_error>
 
@@ -489,12 +491,14 @@ std::vector<SkillFile> SkillEngine::Impl::scan() const {
     std::error_code ec;
     for (const fs::directory_entry& entry : fs::directory_iterator(dir, ec)) {
       const fs::path& p = entry.path();
-      if (p.extension() != ".lua" || p.filename() == "init.lua") continue;
+      if (p.extension() != ".lua") continue;
       // One stat() per file: this runs at every exec() with hot reload on.
       struct stat st {};
       if (::stat(p.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) continue;
       SkillFile f;
-      f.name = p.stem().string();
+      f.space_init = p.filename() == "init.lua";
+      // (init.lua under a name no skill file has: "init@dir")
+      f.name = f.space_init ? "init@" + dir : p.stem().string();
       f.path = p.string();
       f.size = static_cast<std::int64_t>(st.st_size);
       f.mtime_ns = static_cast<std::int64_t>(st.st_mtim.tv_sec) * 1'000'000'000 +
@@ -589,10 +593,42 @@ void SkillEngine::Impl::build() {
   if (protected_call(1, 1) != LUA_OK) LLSF_DEMAND_MSG(false, "prelude: " + pop_message(L));
   engine_ref = luaL_ref(L, LUA_REGISTRYINDEX);
 
+  // Fawkes skill spaces: a directory whose init.lua names skills with skillenv.use_skill(...)
+  // has only those as skills; its other files are helper modules for require (or nothing).
+  std::map<std::string, std::set<std::string>> spaces;  // directory -> the skills it names
+  for (const SkillFile& f : files) {
+    if (!f.space_init) continue;
+    std::string read_error;
+    const std::string text = read_file(f.path, read_error);
+    if (!read_error.empty()) continue;  // (no space: every file is a skill)
+    lua_pushlstring(L, text.data(), text.size());
+    lua_pushstring(L, ("@" + display_path(f.path)).c_str());
+    if (call_entry("skill_space", 2, 1) != LUA_OK || !lua_istable(L, -1)) {
+      lua_settop(L, 0);
+      continue;
+    }
+    std::set<std::string> names;
+    const lua_Integer n = static_cast<lua_Integer>(lua_rawlen(L, -1));
+    for (lua_Integer i = 1; i <= n; ++i) {
+      lua_rawgeti(L, -1, i);
+      if (const char* name = lua_tostring(L, -1); name != nullptr) names.insert(name);
+      lua_pop(L, 1);
+    }
+    lua_settop(L, 0);
+    if (!names.empty()) spaces[fs::path(f.path).parent_path().lexically_normal().string()] = names;
+  }
+  std::vector<const SkillFile*> skill_files;
+  for (const SkillFile& f : files) {
+    if (f.space_init) continue;
+    const auto space = spaces.find(fs::path(f.path).parent_path().lexically_normal().string());
+    if (space != spaces.end() && space->second.count(f.name) == 0) continue;
+    skill_files.push_back(&f);
+  }
+
   // Handles for every skill first, so that depends_skills can be checked while files load.
-  lua_createtable(L, static_cast<int>(files.size()), 0);
-  for (std::size_t i = 0; i < files.size(); ++i) {
-    lua_pushstring(L, files[i].name.c_str());
+  lua_createtable(L, static_cast<int>(skill_files.size()), 0);
+  for (std::size_t i = 0; i < skill_files.size(); ++i) {
+    lua_pushstring(L, skill_files[i]->name.c_str());
     lua_rawseti(L, -2, static_cast<lua_Integer>(i + 1));
   }
   if (call_entry("declare_skills", 1, 0) != LUA_OK) {
@@ -600,7 +636,8 @@ void SkillEngine::Impl::build() {
   }
 
   loading_files = true;
-  for (const SkillFile& f : files) {
+  for (const SkillFile* file : skill_files) {
+    const SkillFile& f = *file;
     std::string load_error;
     std::string read_error;
     const std::string& shown = display_path(f.path);

@@ -64,11 +64,37 @@ TEST_CASE("Fawkes-style skills load: require of helper modules, helper files are
   std::vector<std::string> names;
   for (const lua::SkillInfo& s : engine.skills()) names.push_back(s.name);
   // place_table.lua declares nothing of a skill: a helper module, not listed, not callable.
-  CHECK(names == std::vector<std::string>{"drive_node", "nudge", "ppgoto", "read_light"});
+  CHECK(names == std::vector<std::string>{"drive_node", "nudge", "ppgoto", "probe", "read_light",
+                                          "transitions"});
   const lua::ExecResult r = engine.exec("place_table{}");
   REQUIRE(r);
   CHECK(test::run_cycles(engine, robot, 1) == SkillStatus::kFailed);
   CHECK(contains(engine.error(), "'place_table' is no skill"));
+}
+
+TEST_CASE("a skill directory whose init.lua names its skills (a Fawkes skill space)") {
+  test::TempDir dir;
+  dir.write("init.lua",
+            "require('fawkes.modinit')\nmodule(..., fawkes.modinit.register_all)\n"
+            "print('Initializing the space')\n"
+            "skillenv.use_skill('skills.space.named')\n"
+            "skillenv.use_skill('skills.generic.ppgoto')\n");
+  dir.write("named.lua", skill_running("named", "self.fsm.result = require('helper').answer"));
+  dir.write("helper.lua", "answer = 'forty-two'\n");
+  dir.write("left_out.lua", "this is no Lua\n");
+  lua::SkillEngineConfig cfg = fawkes_config();
+  cfg.skill_dirs = {LLSF_SOURCE_DIR "/lua/skills/fawkes", dir.path.string()};
+  FakeRobot robot;
+  lua::SkillEngine engine(cfg, robot);
+  // left_out.lua is not named: not loaded (it would not load); ppgoto of another directory.
+  CHECK(engine.load_errors().empty());
+  std::vector<std::string> names;
+  for (const lua::SkillInfo& s : engine.skills()) names.push_back(s.name);
+  CHECK(names == std::vector<std::string>{"named", "ppgoto"});
+  // A file the space does not name is a module for require.
+  REQUIRE(engine.exec("named{}"));
+  CHECK(test::run_cycles(engine, robot, 1) == SkillStatus::kFinal);
+  CHECK(engine.result() == "forty-two");
 }
 
 TEST_CASE("require finds only Lua files of the skill and module directories") {
@@ -180,6 +206,42 @@ TEST_CASE("Fawkes' light, switch and sensor interfaces; a skill writes Light det
   REQUIRE(engine.exec("read_light{}"));
   CHECK(test::run_until_done(engine, robot) == SkillStatus::kFailed);
   CHECK(contains(engine.error(), "WAIT: timeout after 2 s"));
+}
+
+TEST_CASE("Fawkes' add_transitions and nil globals in a file written for Fawkes") {
+  FakeRobot robot;
+  lua::SkillEngine engine(fawkes_config(), robot);
+  test::LogCapture log;
+  log.attach(engine);
+  REQUIRE(engine.exec("transitions{}"));
+  CHECK(test::run_until_done(engine, robot) == SkillStatus::kFinal);
+  CHECK(engine.result() == "count=3 closure=nil");
+  // The closure's unknown function: a warning at its line, once.
+  int warnings = 0;
+  for (const std::string& l : log.lines) {
+    warnings += contains(l, "transitions.lua:15: undeclared global 'no_such_function'") ? 1 : 0;
+  }
+  CHECK(warnings == 1);
+  // precond= is a precondition too: FAILED on entry.
+  REQUIRE(engine.exec("transitions{fail=true}"));
+  CHECK(test::run_cycles(engine, robot, 1) == SkillStatus::kFailed);
+  CHECK(contains(engine.error(), "START: precondition vars.fail"));
+}
+
+TEST_CASE("the relative navigator, the puck detection by id, fawkes.Time") {
+  FakeRobot robot;
+  robot.pose_estimate.pose = {1.0, 1.0, core::kPi / 2};
+  robot.puck_sightings = {{{0.5, 0.1}}};
+  robot.nav_steps = 5;
+  lua::SkillEngine engine(fawkes_config(), robot);
+  REQUIRE(engine.exec("probe{}"));
+  CHECK(test::run_until_done(engine, robot) == SkillStatus::kFinal);
+  // (1, 0) ahead of a robot at (1, 1) facing +y is (1, 2) in the map.
+  CHECK(engine.result() ==
+        "dest=1.00,2.00 puck1=0.50,0.10 vis1=true vis2=true closest=false elapsed=true "
+        "skiller=probe{}/2");
+  CHECK(robot.pose_estimate.pose.y == doctest::Approx(2.0));
+  CHECK(robot.pose_estimate.pose.theta == doctest::Approx(core::kPi / 2));
 }
 
 TEST_CASE("bad Fawkes-style input: navgraph files, messages, config, interface ids") {
