@@ -417,7 +417,9 @@ def("RobotinoLightInterface", {
       d.yellow = visible and L.yellow(L) or "UNKNOWN"
       d.green = visible and L.green(L) or "UNKNOWN"
       d.ready = visible
-      d.visibility_history = history(d, visible, now)
+      -- (frames since the reading last changed, as the agent's "Light_State" counts them)
+      local h = history(d, visible, now)
+      d.visibility_history = visible and (floor(L.stable_for(L) * 1e9) // cycle_ns + 1) or h
     end
   end,
   llsf = llsf.RobotinoLightInterface,

@@ -147,10 +147,49 @@ void AgentBrain::set_trace(clips::TraceOptions options, clips::TraceSink sink) {
 
 void AgentBrain::on_skill_cycle(lua::RobotApi& robot) { skills_->on_skill_cycle(robot); }
 
+namespace {
+
+const char* lamp_symbol(lua::Lamp l) {
+  switch (l) {
+    case lua::Lamp::kOn:
+      return "ON";
+    case lua::Lamp::kBlink:
+      return "BLINKING";
+    case lua::Lamp::kOff:
+      return "OFF";
+  }
+  return "UNKNOWN";
+}
+
+}  // namespace
+
 void AgentBrain::on_agent_cycle(lua::RobotApi& robot, RobotRadio& radio) {
   if (halt_) return;  // halted: no cycle (the game clears the inbox)
   const lua::PoseEstimate pose = robot.pose();
   if (pose.valid) agent_->set_pose(pose.pose);
+  if (host_config_.fawkes) {
+    // The light detection as Fawkes' light plugin wrote RobotinoLightInterface "Light_State"
+    // (docs/fawkes.md): the lamps (UNKNOWN while no device is seen), ready while one is, and
+    // visibility_history in frames of the skill rate since the reading last changed (negative:
+    // since the device was lost), as the skills' interface of that id counts them.
+    const lua::LightReading light = robot.light();
+    const core::SimTime now = robot.now();
+    if (light.visible != light_seen_ && !light.visible) light_lost_since_ = now;
+    light_seen_ = light.visible;
+    const std::int64_t frame_ns = skills_->engine().cycle_period().ns();
+    const std::int64_t since_ns =
+        (now - (light.visible ? light.stable_since : light_lost_since_)).ns();
+    const std::int64_t frames =
+        (frame_ns > 0 ? std::max<std::int64_t>(since_ns, 0) / frame_ns : 0) + 1;
+    using clips::Value;
+    agent_->write_interface(
+        "RobotinoLightInterface", "Light_State",
+        {{"red", Value::symbol(light.visible ? lamp_symbol(light.red) : "UNKNOWN")},
+         {"yellow", Value::symbol(light.visible ? lamp_symbol(light.yellow) : "UNKNOWN")},
+         {"green", Value::symbol(light.visible ? lamp_symbol(light.green) : "UNKNOWN")},
+         {"visibility_history", Value::integer_value(light.visible ? frames : -frames)},
+         {"ready", Value::boolean(light.visible)}});
+  }
   for (Received& r : radio.inbox()) {
     if (r.message) agent_->receive(std::move(r.message), r.from, r.from_id, r.at);
   }
