@@ -680,7 +680,16 @@ end
 -- Methods every interface object has.
 local common = {}
 function common.read(obj) refresh(obj) end
-function common.write(obj) meta_of[obj].written = true end
+local dirty = {}  -- objects skills wrote since F.written() last looked, in writing order
+local function mark_written(obj)
+  local m = meta_of[obj]
+  m.written = true
+  if not m.dirty then
+    m.dirty = true
+    dirty[#dirty + 1] = obj
+  end
+end
+function common.write(obj) mark_written(obj) end
 function common.has_writer(obj)
   local m = meta_of[obj]
   return m.write ~= nil or m.written == true
@@ -752,7 +761,7 @@ local function make_object(type_name, id, t)
       return function(self, a, b)
         local dd = data_of[self]
         if t.fields[set][2] then dd[set][floor(a) + 1] = b else dd[set] = a end
-        meta_of[self].written = true
+        mark_written(self)  -- (Fawkes' skiller wrote its writing interfaces after every loop)
       end
     end
     local maxlen = k:match("^maxlenof_(.+)$")
@@ -794,6 +803,32 @@ function F.interface(type_name, id, var, writing, poll)
   end
   return obj
 end
+-- The interfaces skills wrote (set_field(...) or write()) since the last call, for the agent's
+-- blackboard: {type=, id=, serial=, fields={{name, kind, value}, ...}} with kind "symbol",
+-- "string", "integer", "float" or "bool" and value a scalar or a list (array fields).
+local field_kinds = {string = "string", bool = "bool", int32 = "integer", uint32 = "integer",
+                     float = "float", double = "float"}
+function F.written()
+  local out = {}
+  for i = 1, #dirty do
+    local obj = dirty[i]
+    dirty[i] = nil
+    local m = meta_of[obj]
+    m.dirty = false
+    m.serial = (m.serial or 0) + 1
+    local names = {}
+    for name in pairs(m.t.fields) do names[#names + 1] = name end
+    table.sort(names)
+    local fields = {}
+    for _, name in ipairs(names) do
+      local spec = m.t.fields[name]
+      fields[#fields + 1] = {name, field_kinds[spec[1]] or "symbol", data_of[obj][name]}
+    end
+    out[#out + 1] = {type = m.type, id = m.id, serial = m.serial, fields = fields}
+  end
+  return out
+end
+
 -- Fawkes' skiller read every interface at the start of each loop: the writers' fields (and so
 -- visibility_history) follow the robot from cycle to cycle, read or not.
 function F.poll()

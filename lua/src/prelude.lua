@@ -1257,6 +1257,11 @@ function E.run_cycle(chunk)
   return status, errors and concat(errors, "; ") or nil, results and concat(results, "; ") or ""
 end
 
+-- The blackboard interfaces skills wrote since the last call (fawkes.lua, F.written).
+function E.written_interfaces()
+  return fawkes.written()
+end
+
 function E.reset_all()
   depth, caller = 0, nil
   for i = #active, 1, -1 do

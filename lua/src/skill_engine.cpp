@@ -871,6 +871,77 @@ std::vector<SkillInfo> SkillEngine::skills() const {
   return out;
 }
 
+std::vector<WrittenInterface> SkillEngine::written_interfaces() {
+  Impl& e = *impl_;
+  std::vector<WrittenInterface> out;
+  if (e.L == nullptr || e.call_entry("written_interfaces", 0, 1) != LUA_OK) {
+    lua_settop(e.L, 0);
+    return out;
+  }
+  // {{type=, id=, serial=, fields={{name, kind, value}, ...}}, ...} (fawkes.lua, F.written)
+  lua_State* L = e.L;
+  const auto text = [L](int index) {
+    std::size_t n = 0;
+    const char* s = lua_type(L, index) == LUA_TSTRING ? lua_tolstring(L, index, &n) : nullptr;
+    return s != nullptr ? std::string(s, n) : std::string();
+  };
+  const auto add_value = [L, &text](InterfaceField& f, int index) {
+    if (f.kind == InterfaceField::Kind::kSymbol || f.kind == InterfaceField::Kind::kString) {
+      f.texts.push_back(text(index));
+    } else if (f.kind == InterfaceField::Kind::kBool) {
+      f.numbers.push_back(lua_toboolean(L, index) != 0 ? 1.0 : 0.0);
+    } else {
+      f.numbers.push_back(lua_tonumber(L, index));
+    }
+  };
+  const lua_Integer n = static_cast<lua_Integer>(lua_rawlen(L, -1));
+  for (lua_Integer i = 1; i <= n; ++i) {
+    lua_rawgeti(L, -1, i);
+    WrittenInterface w;
+    lua_getfield(L, -1, "type");
+    w.type = text(-1);
+    lua_getfield(L, -2, "id");
+    w.id = text(-1);
+    lua_getfield(L, -3, "serial");
+    w.serial = static_cast<std::int64_t>(lua_tointeger(L, -1));
+    lua_pop(L, 3);
+    lua_getfield(L, -1, "fields");
+    const lua_Integer nf = static_cast<lua_Integer>(lua_rawlen(L, -1));
+    for (lua_Integer j = 1; j <= nf; ++j) {
+      lua_rawgeti(L, -1, j);
+      InterfaceField f;
+      lua_rawgeti(L, -1, 1);
+      f.name = text(-1);
+      lua_rawgeti(L, -2, 2);
+      const std::string kind = text(-1);
+      f.kind = kind == "string"    ? InterfaceField::Kind::kString
+               : kind == "integer" ? InterfaceField::Kind::kInteger
+               : kind == "float"   ? InterfaceField::Kind::kFloat
+               : kind == "bool"    ? InterfaceField::Kind::kBool
+                                   : InterfaceField::Kind::kSymbol;
+      lua_pop(L, 2);
+      lua_rawgeti(L, -1, 3);
+      if (lua_istable(L, -1)) {
+        f.array = true;
+        const lua_Integer ne = static_cast<lua_Integer>(lua_rawlen(L, -1));
+        for (lua_Integer k = 1; k <= ne; ++k) {
+          lua_rawgeti(L, -1, k);
+          add_value(f, -1);
+          lua_pop(L, 1);
+        }
+      } else {
+        add_value(f, -1);
+      }
+      lua_pop(L, 2);  // value, field entry
+      w.fields.push_back(std::move(f));
+    }
+    lua_pop(L, 2);  // fields, entry
+    out.push_back(std::move(w));
+  }
+  lua_settop(L, 0);
+  return out;
+}
+
 std::vector<std::string> SkillEngine::load_errors() const {
   std::vector<std::string> out;
   for (const SkillInfo& s : skills()) {

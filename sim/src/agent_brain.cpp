@@ -161,6 +161,31 @@ const char* lamp_symbol(lua::Lamp l) {
   return "UNKNOWN";
 }
 
+clips::Value field_value(const lua::InterfaceField& f) {
+  using Kind = lua::InterfaceField::Kind;
+  const auto element = [&f](std::size_t i) {
+    switch (f.kind) {
+      case Kind::kString:
+        return clips::Value::string(f.texts[i]);
+      case Kind::kInteger:
+        return clips::Value::integer_value(static_cast<std::int64_t>(f.numbers[i]));
+      case Kind::kFloat:
+        return clips::Value::float_value(f.numbers[i]);
+      case Kind::kBool:
+        return clips::Value::boolean(f.numbers[i] != 0.0);
+      case Kind::kSymbol:
+        break;
+    }
+    return clips::Value::symbol(f.texts[i]);
+  };
+  const std::size_t n =
+      f.kind == Kind::kSymbol || f.kind == Kind::kString ? f.texts.size() : f.numbers.size();
+  if (!f.array) return n > 0 ? element(0) : clips::Value{};
+  std::vector<clips::Value> items;
+  for (std::size_t i = 0; i < n; ++i) items.push_back(element(i));
+  return clips::Value::multifield(std::move(items));
+}
+
 }  // namespace
 
 void AgentBrain::on_agent_cycle(lua::RobotApi& robot, RobotRadio& radio) {
@@ -189,6 +214,12 @@ void AgentBrain::on_agent_cycle(lua::RobotApi& robot, RobotRadio& radio) {
          {"green", Value::symbol(light.visible ? lamp_symbol(light.green) : "UNKNOWN")},
          {"visibility_history", Value::integer_value(light.visible ? frames : -frames)},
          {"ready", Value::boolean(light.visible)}});
+    // What the skills wrote with Fawkes' API (the team's "Light determined"): one blackboard.
+    for (const lua::WrittenInterface& w : skills_->engine().written_interfaces()) {
+      std::vector<std::pair<std::string, Value>> fields;
+      for (const lua::InterfaceField& f : w.fields) fields.emplace_back(f.name, field_value(f));
+      agent_->write_interface(w.type, w.id, std::move(fields));
+    }
   }
   for (Received& r : radio.inbox()) {
     if (r.message) agent_->receive(std::move(r.message), r.from, r.from_id, r.at);

@@ -8,6 +8,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <string>
 
 #include "lua/fake_robot.h"
@@ -201,6 +202,22 @@ TEST_CASE("Fawkes' light, switch and sensor interfaces; a skill writes Light det
   REQUIRE(engine.exec("read_light{}"));
   CHECK(test::run_until_done(engine, robot) == SkillStatus::kFinal);
   CHECK(engine.result() == "OFF BLINKING ON green=true switch=false optical=0,10");
+  // What the skill wrote, for the agent's blackboard: once.
+  const std::vector<lua::WrittenInterface> written = engine.written_interfaces();
+  REQUIRE(written.size() == 1);
+  CHECK(written[0].type == "RobotinoLightInterface");
+  CHECK(written[0].id == "Light determined");
+  std::map<std::string, std::string> fields;
+  for (const lua::InterfaceField& f : written[0].fields) {
+    fields[f.name] =
+        f.texts.empty() ? std::to_string(static_cast<int>(f.numbers.at(0))) : f.texts.at(0);
+  }
+  CHECK(fields == std::map<std::string, std::string>{{"green", "ON"},
+                                                     {"ready", "1"},
+                                                     {"red", "OFF"},
+                                                     {"visibility_history", "0"},
+                                                     {"yellow", "BLINKING"}});
+  CHECK(engine.written_interfaces().empty());
 
   robot.light_reading.visible = false;
   REQUIRE(engine.exec("read_light{}"));

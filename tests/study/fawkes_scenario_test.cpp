@@ -263,3 +263,66 @@ robots:
   CHECK(unknown_not_ready);
   CHECK(lowest <= -50);  // about 2 s at 30 frames per second
 }
+
+TEST_CASE("what a skill writes with Fawkes' API reaches a Fawkes-style agent's blackboard") {
+  test::TempDir dir{"llsf_fawkes_written"};
+  std::filesystem::create_directories(dir.path / "agents/mark");
+  std::filesystem::create_directories(dir.path / "skills");
+  dir.write("agents/mark/mark.clp", R"clp(
+(defrule use-blackboard
+  (ff-feature blackboard)
+  =>
+  (ff-feature-request "blackboard")
+  (blackboard-enable-time-read)
+  (blackboard-open "RobotinoLightInterface" "Light determined")
+  (path-load mark/sense.clp))
+)clp");
+  dir.write("agents/mark/sense.clp", R"clp(
+(defrule call-mark (time $?) (not (called)) => (assert (called)) (skill-call mark))
+(defrule determined
+  (RobotinoLightInterface (id "Light determined") (green ?g) (ready ?r))
+  =>
+  (assert (determined ?g ?r)))
+)clp");
+  dir.write("skills/mark.lua", R"lua(
+module(..., skillenv.module_init)
+name = "mark"
+fsm = SkillHSM:new{name=name, start="SET"}
+depends_interfaces = {
+  {v="output", type="RobotinoLightInterface", id="Light determined", writing=true},
+}
+documentation = "writes Light determined"
+skillenv.skill_module(_M)
+fsm:define_states{export_to=_M, {"SET", JumpState}}
+fsm:add_transitions{{"SET", "FINAL", cond=true}}
+function SET:init()
+  output:set_green(output.ON)
+  output:set_ready(true)
+end
+)lua");
+  dir.write("s.yaml", R"yaml(
+name: fawkes written
+duration_s: 3
+robots:
+  count: 1
+  agent: {fawkes: agents, entry: mark/mark}
+skills: {skill_dirs: [skills]}
+)yaml");
+  const ScenarioFile f = load_scenario(dir.file("s.yaml"));
+  const Scenario& s = f.variants.at(0);
+  sim::GameDriver driver(s.game);
+  sim::AgentBrainConfig c;
+  c.agent_files = s.robots.at(0).agent;
+  c.config = s.robots.at(0).config;
+  c.fawkes = true;
+  c.agent_dir = s.robots.at(0).agent_dir;
+  c.skills = s.skills;
+  sim::AgentBrain& brain = driver.plug_agent(0, c);
+  driver.run_until(core::SimTime::from_seconds(2.0));
+  const clips::AgentHost& agent = brain.agent();
+  CHECK(agent.runtime_errors() == 0);
+  const auto facts = agent.facts("determined");
+  REQUIRE(facts.size() == 1);
+  CHECK(facts[0].fields().at(0).text == "ON");
+  CHECK(facts[0].fields().at(1).text == "TRUE");
+}

@@ -90,6 +90,25 @@ struct ExecResult {
   explicit operator bool() const { return ok; }
 };
 
+/// One field of a blackboard interface skills wrote (docs/fawkes.md, "The blackboard in skills").
+struct InterfaceField {
+  enum class Kind : std::uint8_t { kSymbol, kString, kInteger, kFloat, kBool };
+  std::string name;
+  Kind kind = Kind::kSymbol;
+  bool array = false;              ///< an array field: one element per entry below
+  std::vector<std::string> texts;  ///< kSymbol, kString
+  std::vector<double> numbers;     ///< kInteger, kFloat, kBool (0 or 1)
+};
+
+/// A blackboard interface skills wrote with Fawkes' API (`set_field(...)`, `write()`), e.g. the
+/// team's RobotinoLightInterface "Light determined".
+struct WrittenInterface {
+  std::string type;
+  std::string id;
+  std::int64_t serial = 0;             ///< counts the cycles in which skills wrote it
+  std::vector<InterfaceField> fields;  ///< every field, by name
+};
+
 /// What the engine knows about one skill file.
 struct SkillInfo {
   std::string name;
@@ -150,6 +169,11 @@ class SkillEngine {
     std::int64_t step = 0;
   };
   StatePath skill_state_path(std::string_view skill) const;
+
+  /// The blackboard interfaces skills wrote since the last call (each once, in writing order),
+  /// as Fawkes' skiller wrote its writing interfaces after every loop: for the agent's
+  /// blackboard (sim's AgentBrain forwards them to a Fawkes-style agent).
+  std::vector<WrittenInterface> written_interfaces();
 
   /// Every skill file found, in name order.
   std::vector<SkillInfo> skills() const;
