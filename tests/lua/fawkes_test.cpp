@@ -299,3 +299,25 @@ TEST_CASE("bad Fawkes-style input: navgraph files, messages, config, interface i
   CHECK(contains(load_error_of(engine, "bad_type"),
                  "depends_interfaces[1]: unknown interface type 'WorldModel' (known: "));
 }
+
+TEST_CASE("skills: module_dirs, cfg_dirs and fawkes_config in a scenario's skills map") {
+  const core::ConfigNode node = core::ConfigNode::parse(
+      "skills:\n  module_dirs: [modules]\n  cfg_dirs: [cfg]\n"
+      "  fawkes_config:\n    skills:\n      nudge: {near_dist: 0.05, name: x}\n"
+      "    flag: true\n",
+      "robot.yaml");
+  const lua::SkillEngineConfig cfg = lua::SkillEngineConfig::from_config(node["skills"], kDir);
+  CHECK(cfg.module_dirs == std::vector<std::string>{kDir + "/modules"});
+  CHECK(cfg.cfg_dirs == std::vector<std::string>{kDir + "/cfg"});
+  CHECK(cfg.fawkes_config ==
+        std::map<std::string, std::string>{
+            {"/flag", "true"}, {"/skills/nudge/name", "x"}, {"/skills/nudge/near_dist", "0.05"}});
+  const core::ConfigNode list =
+      core::ConfigNode::parse("skills:\n  fawkes_config: {a: [1, 2]}\n", "robot.yaml");
+  CHECK_THROWS_WITH_AS(lua::SkillEngineConfig::from_config(list["skills"], kDir),
+                       doctest::Contains("robot.yaml:2"), core::ConfigError);
+  const core::ConfigNode missing =
+      core::ConfigNode::parse("skills:\n  cfg_dirs: [no_such_dir]\n", "robot.yaml");
+  CHECK_THROWS_WITH_AS(lua::SkillEngineConfig::from_config(missing["skills"], kDir),
+                       doctest::Contains("cfg directory"), core::ConfigError);
+}
