@@ -343,11 +343,30 @@ local function history(d, visible, now)
   return visible and n or -n
 end
 
+-- (the arrays are filled in place: this runs for every polled interface in every cycle)
 local function pose_fields(d, x, y, yaw, frame, visible, now)
-  d.translation = {x, y, 0.0}
-  d.rotation = {0.0, 0.0, sin(yaw / 2), cos(yaw / 2)}
+  local t, r = d.translation, d.rotation
+  t[1], t[2], t[3] = x, y, 0.0
+  r[1], r[2], r[3], r[4] = 0.0, 0.0, sin(yaw / 2), cos(yaw / 2)
   d.frame = frame
   d.visibility_history = history(d, visible, now)
+end
+
+-- The puck detection's sightings nearest first ({x, y, squared distance}), once per time stamp:
+-- every OmniPuck<n> of every skill reads the same list.
+local puck_list, puck_list_ns = {}, -1
+local function by_distance(a, b) return a[3] < b[3] end
+local function pucks_by_distance(now)
+  if puck_list_ns == now then return puck_list end
+  local V = llsf.PuckVisionInterface
+  local list = {}
+  for i = 1, V.count(V) do
+    local px, py = V.puck(V, i)
+    list[#list + 1] = {px, py, px * px + py * py}
+  end
+  table.sort(list, by_distance)
+  puck_list, puck_list_ns = list, now
+  return list
 end
 
 def("Position3DInterface", {
@@ -370,13 +389,7 @@ def("Position3DInterface", {
     if n then
       n = tonumber(n)
       return function(d, now)
-        local V = llsf.PuckVisionInterface
-        local list = {}
-        for i = 1, V.count(V) do
-          local px, py = V.puck(V, i)
-          list[#list + 1] = {px, py, px * px + py * py}
-        end
-        table.sort(list, function(a, b) return a[3] < b[3] end)
+        local list = pucks_by_distance(now)
         local p = list[n]
         pose_fields(d, p and p[1] or 0.0, p and p[2] or 0.0, 0.0, "/base_link", p ~= nil, now)
       end
@@ -485,13 +498,11 @@ def("RobotinoSensorInterface", {
     if id ~= "Robotino" then return nil end
     return function(d)
       local S = llsf.RobotinoSensorInterface
-      local dist = {0, 0, 0, 0, 0, 0, 0, 0, 0}
-      dist[9] = S.ir_distance(S)
-      d.distance = dist
-      local an = {10, 10, 10, 10, 10, 10, 10, 10}
+      d.distance[9] = S.ir_distance(S)
+      local an = d.analog_in
+      for i = 1, 8 do an[i] = 10 end
       an[1] = S.optical_right(S) and 0 or 10
       an[5] = S.optical_left(S) and 0 or 10
-      d.analog_in = an
     end
   end,
   llsf = llsf.RobotinoSensorInterface,
@@ -728,7 +739,18 @@ local function make_object(type_name, id, t)
   local llsf_obj = t.llsf
   local llsf_first = llsf_obj ~= nil and (id == t.default_id or (t.llsf_first or {})[id])
   local mt = {__metatable = false}
-  mt.__index = function(_, k)
+  local lookup
+  -- What a key means is fixed per object: looked up once (no closure made per call).
+  local cache = {}
+  mt.__index = function(o, k)
+    local v = cache[k]
+    if v == nil then
+      v = lookup(o, k)
+      if v ~= nil then cache[k] = v end
+    end
+    return v
+  end
+  lookup = function(_, k)
     local c = common[k]
     if c then return c end
     if llsf_first then
@@ -742,7 +764,11 @@ local function make_object(type_name, id, t)
       if spec[2] then  -- an array field: iface:name(i), i from 0
         return function(self, i)
           local v = refresh(self)[k]
-          if i == nil then return v end
+          if i == nil then  -- the whole array, a copy (the data are shared by the skills)
+            local c = {}
+            for j = 1, #v do c[j] = v[j] end
+            return c
+          end
           if type(i) ~= "number" or i < 0 or i >= spec[2] then
             fail(2, "%s:%s(i): index %s out of range 0..%d", common.uid(self), k, tostring(i),
                  spec[2] - 1)
@@ -797,7 +823,8 @@ function F.interface(type_name, id, var, writing, poll)
   local m = meta_of[obj]
   m.var = m.var or var
   if writing then m.writing = true end
-  if poll and not m.polled and m.write then
+  -- (only what has a visibility history: other fields are read when asked for)
+  if poll and not m.polled and m.write and t.fields.visibility_history then
     m.polled = true
     polled[#polled + 1] = obj
   end
@@ -829,8 +856,8 @@ function F.written()
   return out
 end
 
--- Fawkes' skiller read every interface at the start of each loop: the writers' fields (and so
--- visibility_history) follow the robot from cycle to cycle, read or not.
+-- Fawkes' skiller read every interface at the start of each loop: the visibility histories of
+-- the interfaces files written for Fawkes bound follow the robot from cycle to cycle, read or not.
 function F.poll()
   for i = 1, #polled do pcall(refresh, polled[i]) end  -- (a failing read fails at the skill's)
 end
