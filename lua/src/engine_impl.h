@@ -121,6 +121,7 @@ struct SkillEngine::Impl {
   std::string cpp_error;
   std::string module_text;  // the module `require` read last, and its shown path
   std::string module_path;
+  bool module_in_skill_dir = false;
   NavgraphData navgraph;  // the navgraph file read last
 
   /// The engine that owns `L` (stored in the state's extra space).

@@ -86,7 +86,9 @@ bool find_module(Impl& e, const std::string& name) {
   // directories.
   std::vector<std::string> dirs = e.config.module_dirs;
   dirs.insert(dirs.end(), e.config.skill_dirs.begin(), e.config.skill_dirs.end());
-  for (const std::string& dir : dirs) {
+  for (std::size_t d = 0; d < dirs.size(); ++d) {
+    const std::string& dir = dirs[d];
+    e.module_in_skill_dir = d >= e.config.module_dirs.size();
     for (const std::string& rel : {stem + ".lua", stem + "/init.lua"}) {
       const std::string path = contained_file(dir, rel);
       if (path.empty()) continue;
@@ -106,7 +108,7 @@ bool find_module(Impl& e, const std::string& name) {
   return false;
 }
 
-// read_module(name) -> text, path  |  nil, what was searched
+// read_module(name) -> text, path, in a skill directory (not a module directory)  |  nil, why
 int native_read_module(lua_State* L) {
   std::size_t n = 0;
   const char* name = luaL_checklstring(L, 1, &n);
@@ -125,7 +127,8 @@ int native_read_module(lua_State* L) {
   charge(L, static_cast<std::int64_t>(e.module_text.size() / 8), 2, "reading a module");
   lua_pushlstring(L, e.module_text.data(), e.module_text.size());
   lua_pushstring(L, e.module_path.c_str());
-  return 2;
+  lua_pushboolean(L, e.module_in_skill_dir ? 1 : 0);
+  return 3;
 }
 
 // ---- navgraph -------------------------------------------------------------------------------

@@ -436,7 +436,7 @@ end
 
 -- require: helper modules ---------------------------------------------------------------------
 -- Fawkes' skills share code through Lua modules (a team's tf_module.lua, machine_pos_module.lua):
--- require("name") loads name.lua ("a.b": a/b.lua) of the skill directories or the module
+-- require("name") loads name.lua ("a.b": a/b.lua) of the module directories or else of the skill
 -- directories, once per interpreter, read-only, in an environment of its own over the skills'
 -- globals; it returns what the file returns, else its globals (its _M, as Fawkes' module()).
 local modules = {}    -- name -> the module
@@ -463,13 +463,16 @@ base.require = function(name)
   if type(name) ~= "string" then error("require: expected a module name (a string)", 2) end
   local m = modules[name] or builtin_modules[name]
   if m ~= nil then return m end
-  local h = handles[name]
-  if h and not h.is_module and (h.fsm or h.env and rawget(h.env, "name") ~= nil) then
-    error(fmt("require: '%s' is a skill: name it in depends_skills = {\"%s\"} and call it " ..
-              "from a SkillJumpState (skills={{%s}})", name, name, name), 2)
-  end
   if requiring[name] then error(fmt("require: module '%s' requires itself (a cycle)", name), 2) end
-  local text, path = native.read_module(name)
+  local text, path, in_skill_dir = native.read_module(name)
+  -- The file of a skill of the skill directories (a module directory did not have the name).
+  local h = handles[name]
+  local own = h and not h.is_module and in_skill_dir
+  local function is_skill()
+    error(fmt("require: '%s' is a skill: name it in depends_skills = {\"%s\"} and call it " ..
+              "from a SkillJumpState (skills={{%s}})", name, name, name), 3)
+  end
+  if own and (h.load_error or h.fsm or h.env and rawget(h.env, "name") ~= nil) then is_skill() end
   if not text then
     error(fmt("module '%s' is not available in skills: require loads only the Lua files of " ..
               "the skill and module directories (%s); to use another skill, name it in " ..
@@ -483,6 +486,14 @@ base.require = function(name)
   requiring[name], loading = true, nil
   local ok, ret = raw_pcall(chunk, name)
   requiring[name], loading = nil, outer
+  -- A skill file not loaded yet: it declares a skill (or makes a state machine, which only a
+  -- skill file may).
+  if own and ((ok and (rawget(env, "name") ~= nil or rawget(env, "fsm") ~= nil or
+                       rawget(env, "execute") ~= nil)) or
+              (not ok and type(ret) == "string" and ret:find("SkillHSM:new can only be called",
+                                                             1, true))) then
+    is_skill()
+  end
   if not ok then error(ret, 0) end
   if ret == nil then ret = env end
   modules[name] = ret

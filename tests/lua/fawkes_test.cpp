@@ -113,6 +113,11 @@ TEST_CASE("require finds only Lua files of the skill and module directories") {
   write(skills + "/via_link.lua", skill_running("via_link", "local m = require('linked')"));
   write(skills + "/loop_a.lua", "local b = require('loop_b')\n");
   write(skills + "/loop_b.lua", "local a = require('loop_a')\n");
+  // A skill file required before or after it loaded as a skill.
+  write(skills + "/b_user.lua", skill_running("b_user", "local m = require('zz_skill')"));
+  write(skills + "/zz_skill.lua", skill_running("zz_skill", ""));
+  write(skills + "/c_early.lua", "local m = require('zz_skill')\n" + skill_running("c_early", ""));
+  write(skills + "/zz_user.lua", skill_running("zz_user", "local m = require('b_user')"));
   write(skills + "/a_user.lua",
         "local a = require('loop_a')\nname = 'a_user'\ndocumentation = 'x'\n"
         "function execute() return S_FINAL end\n");
@@ -135,6 +140,13 @@ TEST_CASE("require finds only Lua files of the skill and module directories") {
   // A symbolic link out of the directory is not followed.
   CHECK(contains(run("via_link{}"), "module 'linked' is not available in skills"));
   CHECK(contains(load_error_of(engine, "a_user"), "module 'loop_a' requires itself (a cycle)"));
+  CHECK(contains(run("b_user{}"),
+                 "b_user.lua:10: require: 'zz_skill' is a skill: name it in "
+                 "depends_skills"));
+  CHECK(contains(run("zz_user{}"), "zz_user.lua:10: require: 'b_user' is a skill"));
+  CHECK(
+      contains(load_error_of(engine, "c_early"), "c_early.lua:1: require: 'zz_skill' is a skill"));
+  CHECK(load_error_of(engine, "zz_skill").empty());
 }
 
 TEST_CASE("self.skills[i] arguments, a navgraph's nodes and ppgoto drive the navigator") {
