@@ -71,6 +71,7 @@ struct ExerciseOptions {
   std::string record;
   bool quiet = false;
   bool list = false;
+  bool trace = false;  ///< --trace: each state change with the transition that made it
 };
 
 std::string stamp(SimTime t) { return fmt::format("[{:8.2f} s]", t.seconds()); }
@@ -322,8 +323,24 @@ SeedRun play_seed(const Exercise& ex, const ExerciseOptions& o, std::uint64_t se
       if (!c.result.empty()) out << "  -> " << c.result;
       out << "\n";
     });
-    if (recorder)
-      b.set_state_listener([&](const sim::SkillStateChange& c) { recorder->skill_state(c); });
+    // Every state the skill passes, also within one skill cycle (START -> DRIVE in one step);
+    // with --trace, from where and what took it there.
+    b.set_state_listener(
+        [&](const sim::SkillStateChange& c) {
+          if (recorder) {
+            sim::SkillStateChange r = c;
+            r.via = user_paths(r.via, skill_dir.path(), user);
+            recorder->skill_state(r);
+          }
+          if (o.quiet || c.to.empty()) return;
+          if (!o.trace && (c.to == "FINAL" || c.to == "FAILED")) return;  // the status line says it
+          out << stamp(c.time) << " " << c.robot << "   " << c.skill << ": ";
+          if (o.trace && !c.from.empty()) out << c.from << " -> ";
+          out << c.to;
+          if (!c.via.empty()) out << "  (" << user_paths(c.via, skill_dir.path(), user) << ")";
+          out << "\n";
+        },
+        o.trace);
   }
 
   // Paced mode (the wall clock only paces the loop; it never enters the game).
@@ -370,14 +387,7 @@ SeedRun play_seed(const Exercise& ex, const ExerciseOptions& o, std::uint64_t se
     bool running = false;
     for (std::size_t i = 0; i < brains.size(); ++i) {
       lua::SkillEngine& e = brains[i]->engine();
-      const std::string st = e.skill_state(ex.skill);
-      if (st != states[i]) {
-        if (!st.empty() && !o.quiet) {
-          out << stamp(game.time()) << " " << game.robot(static_cast<int>(i)).name() << "   "
-              << ex.skill << ": " << st << "\n";
-        }
-        states[i] = st;
-      }
+      states[i] = e.skill_state(ex.skill);  // for the progress lines (the listener prints)
       const lua::SkillStatus s = e.status();
       if (s == lua::SkillStatus::kFailed) {
         failed = static_cast<int>(i);
@@ -477,6 +487,13 @@ SeedRun play_seed(const Exercise& ex, const ExerciseOptions& o, std::uint64_t se
     friendly(e.error(), skill_dir.path(), user, ex.skill, out, run);
   } else if (!ended && ex.goal.kind != Goal::Kind::kPoints) {
     why_not = fmt::format("the skill was still running after {:.0f} s", end.seconds());
+    // Where it waits and for what (the first robot whose skill still runs).
+    for (const auto& b : brains) {
+      const std::string wait = b->engine().skill_wait(ex.skill);
+      if (wait.empty()) continue;
+      why_not += ": " + user_paths(wait, skill_dir.path(), user);
+      break;
+    }
   }
   out << "score    " << score << "\n";
   if (!why_not.empty()) out << "why      " << why_not << "\n";
@@ -839,6 +856,10 @@ Action add_exercise_command(CLI::App& app) {
   app.add_flag("-q,--quiet", o->quiet,
                "Only the score, errors and the verdict (--seeds: no progress lines)");
   app.add_flag("--list", o->list, "List the exercises with their goals and exit");
+  app.add_flag("--trace", o->trace,
+               "Print each state change as FROM -> TO with the transition that made it and its "
+               "file:line (every state a step passes through, also within one skill cycle); the "
+               "recording's skill_state lines get it too (via)");
   app.footer(
       "Examples:\n"
       "  llsfsim exercise --list\n"

@@ -28,6 +28,7 @@
 #include "live.h"
 #include "llsf/app/cli.h"
 #include "llsf/clips/agent.h"
+#include "llsf/clips/source_check.h"
 #include "llsf/comm/socket_config.h"
 #include "llsf/core/config.h"
 #include "llsf/core/error.h"
@@ -211,7 +212,8 @@ void print_summary(const study::RunResult& r, std::ostream& out) {
   }
 }
 
-/// Prints the agent warnings `run` shows before its game (a confval nobody reads, the sandbox
+/// Prints the agent warnings `run` shows before its game (a confval nobody reads, a time read
+/// CLIPS never evaluates again, the sandbox
 /// off; `check` has them all), each once, on `err`.
 void print_run_warnings(const study::Scenario& s, std::ostream& err);
 
@@ -538,7 +540,8 @@ struct AgentWarning {
   bool operator<(const AgentWarning& o) const { return text < o.text; }
 };
 
-/// `check`'s warnings about one robot's agent (docs/llsfsim.md, `check`): skill names in
+/// `check`'s warnings about one robot's agent (docs/llsfsim.md, `check`): rule conditions that
+/// read the time where CLIPS does not evaluate them again (clips::TimeReadCheck); skill names in
 /// `(skill-call NAME ...)` the skill library does not have (with `brain` only); confval paths
 /// the scenario sets that no agent file names, and the reverse; the lock switch against the
 /// agent's use of lock facts; the sandbox switched off. Those marked in_run `run` prints too.
@@ -571,7 +574,11 @@ std::vector<AgentWarning> agent_warnings(const study::RobotSpec& spec,
   std::vector<std::string> read_paths;  // literal paths in the agent (a trailing / is a prefix)
   std::vector<std::string> read_where;  // each one's file:line
   bool uses_locks = false;
+  clips::TimeReadCheck time_reads;  // the files in load order
   for (const AgentSource& src : sources) {
+    for (const clips::SourceWarning& w : time_reads.scan(src.code)) {
+      warn(fmt::format("{}:{}: {}", src.file, w.line, w.message), /*in_run=*/true);
+    }
     for (auto it = std::sregex_iterator(src.code.begin(), src.code.end(), kSkillCall);
          it != std::sregex_iterator(); ++it) {
       const std::string name = (*it)[1].str();

@@ -12,6 +12,7 @@
 #include <unordered_map>
 
 #include "feature.h"
+#include "llsf/clips/source_check.h"
 #include "llsf/core/config.h"
 #include "llsf/core/input_file.h"
 #include "llsf/core/text.h"
@@ -121,6 +122,7 @@ struct AgentHost::Impl {
   std::unordered_map<std::string, std::string> function_places;  // deffunction -> "file:line"
   std::int64_t max_steps_seen = 0;
   std::unique_ptr<detail::Tracer> tracer;  // set_trace()
+  TimeReadCheck time_check;                // over the files in load order
   // Fawkes' agent model (AgentConfig::fawkes).
   bool fawkes_started_ = false;
   std::vector<std::string>* load_failures_ = nullptr;  // while the entry file runs
@@ -639,6 +641,14 @@ struct AgentHost::Impl {
     const auto errors = env.load(text);
     flush_output();
     std::vector<std::string> out;
+    if (errors.empty()) {
+      // Loaded: what CLIPS takes without a word but that makes a rule misbehave.
+      for (const SourceWarning& w : time_check.scan(text)) {
+        emit(LogLevel::kWarn,
+             std::string(source) + ":" + std::to_string(w.line) + ": " + w.message);
+      }
+      return out;
+    }
     for (const auto& e : errors) {
       out.push_back(std::string(source) + ":" + std::to_string(e.line) + ": " +
                     with_hint(e.message));

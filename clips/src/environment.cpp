@@ -9,7 +9,11 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <optional>
+#include <regex>
 #include <stdexcept>
+
+#include "source_text.h"
 
 // CLIPS 6.30 is C without extern "C" guards; its macros must come after all C++ headers.
 extern "C" {
@@ -1114,6 +1118,98 @@ std::string compress_error(std::string_view raw) {
   return out;
 }
 
+// The slot `slot` of deftemplate `name` as its declaration would read, with the constraints
+// that limit it: "(slot c (type SYMBOL) (allowed-values RED GREEN))"; "" if there is no such
+// slot.
+std::string slot_declaration(void* env, const std::string& name, const std::string& slot) {
+  void* t = EnvFindDeftemplate(env, name.c_str());
+  if (t == nullptr || static_cast<struct deftemplate*>(t)->implied ||
+      EnvDeftemplateSlotExistP(env, t, slot.c_str()) == FALSE)
+    return {};
+  const bool multi = EnvDeftemplateSlotMultiP(env, t, slot.c_str()) != FALSE;
+  auto words = [env](const DATA_OBJECT& d) {
+    std::string out;
+    if (GetType(d) != MULTIFIELD) return out;
+    for (const Value& v : to_value(env, d).items) {
+      if (!out.empty()) out += ' ';
+      out += v.to_string();
+    }
+    return out;
+  };
+  std::string out = std::string("(") + (multi ? "multislot " : "slot ") + slot;
+  DATA_OBJECT d;
+  EnvDeftemplateSlotTypes(env, t, slot.c_str(), &d);
+  // Every type (no type facet) says nothing: left out.
+  if (const std::string types = words(d); GetType(d) == MULTIFIELD && GetDOLength(d) < 8)
+    out += " (type " + types + ")";
+  EnvDeftemplateSlotAllowedValues(env, t, slot.c_str(), &d);
+  if (GetType(d) == MULTIFIELD) out += " (allowed-values " + words(d) + ")";
+  EnvDeftemplateSlotRange(env, t, slot.c_str(), &d);
+  if (const std::string range = words(d); GetType(d) == MULTIFIELD && range != "-oo +oo")
+    out += " (range " + range + ")";
+  if (multi) {
+    EnvDeftemplateSlotCardinality(env, t, slot.c_str(), &d);
+    if (const std::string card = words(d); GetType(d) == MULTIFIELD && card != "0 +oo")
+      out += " (cardinality " + card + ")";
+  }
+  return out + ")";
+}
+
+// A constraint error (CSTRNCHK1, RULECSTR1-3) made clearer: one found in a rule's conditions
+// ("found in CE #2") is noticed when the whole rule has been read, so CLIPS' line is the rule's
+// last: it becomes the line of that conditional element; and the message names what the slot
+// allows, as its declaration reads ("; deftemplate todo has (slot order (type INTEGER))").
+// `raw` is CLIPS' whole message (with the construct echoed up to the error), `forms` the
+// source, read on first use.
+void explain_constraint(void* env, LoadError& e, std::string_view raw, const std::string& text,
+                        std::optional<std::vector<SourceNode>>& forms) {
+  static const std::regex kCe(R"((?:CE|Pattern) #(\d+))");
+  // "... for slot order.", "Variable ?x in CE #2 slot machine has ...", "... CE #1 slot n to ..."
+  static const std::regex kSlot(R"((?:for|CE #\d+) slot ([^ .]+))");
+  static const std::regex kRule(R"(\(in defrule ([^ )]+)\))");
+  const bool constraint =
+      e.message.starts_with("[CSTRNCHK1]") || e.message.starts_with("[RULECSTR1]") ||
+      e.message.starts_with("[RULECSTR2]") || e.message.starts_with("[RULECSTR3]");
+  std::smatch rule_m;
+  if (!constraint || !std::regex_search(e.message, rule_m, kRule)) return;
+  if (!forms) forms = read_source(text);
+  const SourceNode* rule = find_defrule(*forms, rule_m[1].str());
+  if (rule == nullptr) return;
+  std::string relation;
+  std::smatch m;
+  if (std::regex_search(e.message, m, kCe)) {
+    const std::vector<const SourceNode*> ces = rule_conditions(*rule);
+    const int n = std::stoi(m[1].str());
+    if (n < 1 || n > static_cast<int>(ces.size())) return;
+    e.line = ces[static_cast<std::size_t>(n - 1)]->line;
+    relation = std::string(ces[static_cast<std::size_t>(n - 1)]->head());
+  } else {
+    // In the actions: the template of the fact built, from the echo up to the error.
+    const std::string_view echo = raw.substr(std::min(raw.size(), raw.find("ERROR:")));
+    const std::size_t assert_at = echo.rfind("(assert (");
+    std::size_t modify_at = echo.rfind("(modify ");
+    if (const std::size_t d = echo.rfind("(duplicate "); d != std::string_view::npos)
+      modify_at = modify_at == std::string_view::npos ? d : std::max(modify_at, d);
+    if (assert_at != std::string_view::npos &&
+        (modify_at == std::string_view::npos || assert_at > modify_at)) {
+      std::string_view rest = echo.substr(assert_at + 9);
+      relation = std::string(rest.substr(0, rest.find_first_of(" \t\n()")));
+    } else if (modify_at != std::string_view::npos) {
+      std::string_view rest = echo.substr(echo.find(' ', modify_at) + 1);
+      rest = rest.substr(0, rest.find_first_of(" \t\n()"));
+      relation = std::string(bound_relation(*rule, rest));
+    }
+  }
+  if (relation.empty() || relation == "test" || !std::regex_search(e.message, m, kSlot)) return;
+  const std::string declaration = slot_declaration(env, relation, m[1].str());
+  if (declaration.empty()) return;
+  std::string what = "; deftemplate " + relation + " has " + declaration;
+  const std::size_t in_rule = e.message.rfind(" (in defrule ");
+  std::size_t at = in_rule;
+  if (at > 0 && e.message[at - 1] == '.') --at;  // "... for slot order." -> "... order; ..."
+  e.message.replace(at, in_rule - at, what);
+}
+
 }  // namespace
 
 std::vector<LoadError> Environment::load(const std::string& text) {
@@ -1132,12 +1228,14 @@ std::vector<LoadError> Environment::load(const std::string& text) {
   loading_ = false;
 
   std::vector<LoadError> errors;
+  std::optional<std::vector<SourceNode>> forms;  // the source, read if an error needs it
   for (std::size_t i = 0; i < error_starts_.size(); ++i) {
     const std::size_t begin = error_starts_[i].first;
     const std::size_t end =
         i + 1 < error_starts_.size() ? error_starts_[i + 1].first : load_errors_.size();
-    errors.push_back({error_starts_[i].second,
-                      compress_error(std::string_view(load_errors_).substr(begin, end - begin))});
+    const std::string_view raw = std::string_view(load_errors_).substr(begin, end - begin);
+    errors.push_back({error_starts_[i].second, compress_error(raw)});
+    explain_constraint(env_, errors.back(), raw, text, forms);
   }
   if (errors.empty() && !load_errors_.empty())
     errors.push_back({last_line, compress_error(load_errors_)});

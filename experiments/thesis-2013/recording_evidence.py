@@ -20,6 +20,16 @@ one markdown table row per variant, with means per game of:
   blocked by robot          of them, BLOCKED by another robot
   jams / jammed at end      device jams (robot profiles) and robots still jammed at the end
   no S0 seen                get_s0 failures with an empty insertion area
+  encounters                episodes in which two robots stayed closer than CLOSE_M while at
+                            least one of them was driving somewhere (each pair on its own), per
+                            game; "median enc s" and "longest enc s" are the
+                            median and the longest of them over all the variant's games
+  recovery s / aborted s    robot-seconds move_base ran a recovery behaviour / stood aborted
+                            waiting for the navigation graph to send its goal again (only at
+                            the move_base-2013 level, docs/recording.md)
+  stuck for good            robots that had a navigation goal at the end of the game and moved
+                            less than STUCK_M in its last STUCK_S seconds; a second table lists
+                            each with its seed, position and since when it stood there
 
 Standard library only; no llsfsim code. The numbers are what the recordings hold, nothing is
 modelled here.
@@ -33,6 +43,8 @@ import sys
 
 CLOSE_M = 0.6
 STILL_MPS = 0.02
+STUCK_M = 0.3
+STUCK_S = 120.0
 
 
 def recordings(paths):
@@ -57,6 +69,10 @@ def analyse(path):
     jammed = set()
     prev = None
     prev_t = None
+    encounter_start = {}  # (i, j) -> time the pair came closer than CLOSE_M
+    encounters = []
+    nav_state = {}  # robot -> (move_base state, since)
+    trail = collections.defaultdict(list)  # robot index -> [(t, x, y)]
     with open_text(path) as f:
         header = json.loads(f.readline())
         if header.get("format") != "llsfsim-recording":
@@ -79,11 +95,23 @@ def analyse(path):
                                 close[i] = close[j] = True
                     if any(close):
                         m["close_s"] += dt
+                    for i in range(len(poses)):
+                        for j in range(i + 1, len(poses)):
+                            busy = [k < len(robots) and (robots[k] in navigating or
+                                                         nav_state.get(robots[k], ("idle",))[0]
+                                                         != "idle") for k in (i, j)]
+                            near = math.dist(poses[i], poses[j]) < CLOSE_M and any(busy)
+                            if near and (i, j) not in encounter_start:
+                                encounter_start[(i, j)] = t
+                            elif not near and (i, j) in encounter_start:
+                                encounters.append(t - encounter_start.pop((i, j)))
                     for i, p in enumerate(poses):
                         speed = math.dist(p, prev[i]) / dt
                         if close[i] and speed < STILL_MPS and i < len(robots) and \
                                 robots[i] in navigating:
                             m["stalled_close_s"] += dt
+                for i, p in enumerate(poses):
+                    trail[i].append((t, p[0], p[1]))
                 prev, prev_t = poses, t
                 continue
             e = o.get("e")
@@ -104,6 +132,15 @@ def analyse(path):
                     navigating.add(o["robot"])
                 else:
                     navigating.discard(o["robot"])
+            elif e == "move_base":
+                r = o["robot"]
+                if r in nav_state:
+                    state, since = nav_state[r]
+                    if state == "clearing":
+                        m["recovery_s"] += t - since
+                    elif state == "aborted":
+                        m["aborted_s"] += t - since
+                nav_state[r] = (o["state"], t)
             elif e == "collision" and o.get("kind") == "robot-robot":
                 m["rr_contacts"] += 1
             elif e == "jam":
@@ -121,7 +158,32 @@ def analyse(path):
                 if "no puck seen" in err:
                     m["no_s0_seen"] += 1
     m["jammed_at_end"] = len(jammed)
-    return header.get("variant", ""), m
+    end = prev_t if prev_t is not None else 0.0
+    for (i, j), start in encounter_start.items():
+        encounters.append(end - start)
+    m["encounters"] = len(encounters)
+    for r, (state, since) in nav_state.items():
+        if state == "clearing":
+            m["recovery_s"] += end - since
+        elif state == "aborted":
+            m["aborted_s"] += end - since
+    stuck = []
+    for i, tr in trail.items():
+        name = robots[i] if i < len(robots) else str(i)
+        if not tr or tr[0][0] > end - STUCK_S:
+            continue
+        busy = name in navigating or nav_state.get(name, ("idle", 0))[0] != "idle"
+        last = (tr[-1][1], tr[-1][2])
+        # Since when it stood within STUCK_M of where it ended.
+        since = tr[0][0]
+        for t_k, x, y in reversed(tr):
+            if math.dist((x, y), last) >= STUCK_M:
+                break
+            since = t_k
+        if busy and since <= end - STUCK_S:
+            stuck.append((name, last[0], last[1], since))
+    m["stuck_for_good"] = len(stuck)
+    return header.get("variant", ""), header.get("seed", ""), m, encounters, stuck
 
 
 COLUMNS = [
@@ -130,6 +192,8 @@ COLUMNS = [
     ("r-r contacts", "rr_contacts"), ("nav fail", "nav_fail"),
     ("blocked by robot", "blocked_by_robot"), ("jams", "jams"),
     ("jammed at end", "jammed_at_end"), ("no S0 seen", "no_s0_seen"),
+    ("encounters", "encounters"), ("recovery s", "recovery_s"), ("aborted s", "aborted_s"),
+    ("stuck for good", "stuck_for_good"),
 ]
 
 
@@ -138,22 +202,37 @@ def main(argv):
         print(__doc__.strip())
         return 0 if len(argv) >= 2 else 2
     by_variant = collections.defaultdict(list)
+    encounters = collections.defaultdict(list)
+    stuck_rows = []
     for path in recordings(argv[1:]):
         try:
-            variant, m = analyse(path)
+            variant, seed, m, enc, stuck = analyse(path)
         except (OSError, ValueError, KeyError, EOFError) as err:
             print(f"recording_evidence: {path}: {err}", file=sys.stderr)
             return 2
         by_variant[variant].append(m)
+        encounters[variant].extend(enc)
+        stuck_rows.extend((variant, seed, *row) for row in stuck)
     if not by_variant:
         print("recording_evidence: no recordings found", file=sys.stderr)
         return 2
-    print("| variant | games | " + " | ".join(c for c, _ in COLUMNS) + " |")
-    print("|---|---:|" + "---:|" * len(COLUMNS))
+    print("| variant | games | " + " | ".join(c for c, _ in COLUMNS) +
+          " | median enc s | longest enc s |")
+    print("|---|---:|" + "---:|" * (len(COLUMNS) + 2))
     for variant in sorted(by_variant):
         games = by_variant[variant]
         cells = [f"{sum(g[k] for g in games) / len(games):.1f}" for _, k in COLUMNS]
-        print(f"| {variant} | {len(games)} | " + " | ".join(cells) + " |")
+        enc = sorted(encounters[variant])
+        median = enc[len(enc) // 2] if enc else 0.0
+        longest = enc[-1] if enc else 0.0
+        print(f"| {variant} | {len(games)} | " + " | ".join(cells) +
+              f" | {median:.1f} | {longest:.1f} |")
+    if stuck_rows:
+        print()
+        print("| variant | seed | robot stuck for good | x | y | standing there since s |")
+        print("|---|---:|---|---:|---:|---:|")
+        for variant, seed, name, x, y, since in sorted(stuck_rows, key=str):
+            print(f"| {variant} | {seed} | {name} | {x:.2f} | {y:.2f} | {since:.1f} |")
     return 0
 
 

@@ -739,6 +739,20 @@ function SkillHSM:add_transitions(spec)
     end
     text = text or t.cond or t.cond_and_precond or t.precond
     tr.label = tr.label or tr.desc or (type(text) == "string" and text) or "condition"
+    -- As written, for messages: {"CHECK", "FINAL", cond="vars.done"}.
+    local parts = {fmt("\"%s\"", from or "*"), fmt("\"%s\"", to)}
+    for _, key in ipairs({"cond", "cond_and_precond", "precond"}) do
+      local c = t[key]
+      if c == true then
+        parts[#parts + 1] = key .. "=true"
+      elseif type(c) == "string" then
+        parts[#parts + 1] = fmt("%s=\"%s\"", key, c)
+      elseif c ~= nil then
+        parts[#parts + 1] = key .. "=" .. (t.desc and fmt("<function: %s>", t.desc) or "<function>")
+      end
+    end
+    if t.timeout ~= nil then parts[#parts + 1] = fmt("timeout=%g", tr.timeout_ns / 1e9) end
+    tr.shown = "{" .. concat(parts, ", ") .. "}"
     if from then
       local st = self.states[from]
       if tr.cond or tr.timeout_ns then st.transitions[#st.transitions + 1] = tr end
@@ -753,6 +767,23 @@ end
 local call_skill, reset_skill
 
 local spec_args
+
+-- A condition reading a key of vars that nothing set (vars.arived for vars.arrived) never holds:
+-- the keys conditions missed are kept per state machine (key -> transition), for the check of a
+-- state that waits long (fsm_step) and the report of a skill still running at the end.
+local cond_fsm, cond_tr = nil, nil  -- the state machine and transition whose condition runs
+local vars_mt = {__index = function(_, k)
+  local fsm = cond_fsm
+  if fsm and type(k) == "string" then
+    local m = fsm.misses
+    if not m then
+      m = {}
+      fsm.misses = m
+    end
+    if m[k] == nil then m[k] = cond_tr end
+  end
+  return nil
+end}
 
 local function holds(c, st, fsm)
   if c == true then return true end
@@ -818,6 +849,7 @@ local function enter(fsm, st, now)
     if not jumped then break end
   end
   st.entered_ns = now
+  st.waited = nil
   st.args = setmetatable({}, st.args_mt)
   st.error = nil
   fsm.current = st
@@ -850,6 +882,8 @@ local kSpinNs, kSpinTransitions = 2 * 1000000000, 20
 -- A state machine that switches states in every step for kSpinNs of game time (at least
 -- kSpinTransitions switches) while no sub-skill runs and no timeout fires never waits for
 -- anything: e.g. two states bouncing with cond=true. One warning per call of the skill.
+local watch_misses  -- below
+
 local function watch_spin(fsm, now, path, trs, progress)
   if not trs or #trs == 0 or progress then
     if fsm.spin ~= nil then fsm.spin = nil end
@@ -863,15 +897,49 @@ local function watch_spin(fsm, now, path, trs, progress)
   sp.n = sp.n + #trs
   if sp.warned or sp.n < kSpinTransitions or now - sp.since < kSpinNs then return end
   sp.warned = true
-  local tr = trs[1]
+  local tr = nil  -- the first transition, or the first with cond=true
   for _, t in ipairs(trs) do
-    if t.cond == true then tr = t; break end
+    if type(t) == "table" then
+      if t.cond == true then tr = t; break end
+      tr = tr or t
+    end
   end
+  if not tr then return end
   log(2, fmt("%s: %s: states %s keep switching without waiting (%d switches in %.1f s of game " ..
              "time, no sub-skill running, no timeout): the transition {\"%s\", \"%s\", %s} " ..
              "fires at once; make the state wait for something (cond=\"...\", timeout=SECS)",
              tr.where, fsm.name, concat(path, " -> "), sp.n, (now - sp.since) / 1e9,
              tr.from or "*", tr.to.name, tr.cond == true and "cond=true" or tr.label))
+end
+
+-- The keys of vars the conditions of `st` read but nothing set, each with a set key near
+-- enough to be what was meant: {{"arived", "arrived", tr}, ...} in name order.
+local function missed_keys(fsm, st)
+  local out = {}
+  local set = {}
+  for k in next, fsm.vars do
+    if type(k) == "string" then set[#set + 1] = k end
+  end
+  for k, tr in pairs(fsm.misses or {}) do
+    if tr.from == nil or tr.from == st.name then
+      local near = nearest(k, set)
+      if near then out[#out + 1] = {k, near, tr} end
+    end
+  end
+  table.sort(out, function(a, b) return a[1] < b[1] end)
+  return out
+end
+
+-- A state that has waited kWaitNs on a condition that reads a key of vars nothing set, while a
+-- key near it is set: a typo, so the condition never holds. One warning per key and entry.
+local kWaitNs = 5 * 1000000000
+watch_misses = function(fsm, st, now)
+  for _, m in ipairs(missed_keys(fsm, st)) do
+    local k, near, tr = m[1], m[2], m[3]
+    log(2, fmt("%s: %s: state '%s' has waited %.0f s on %s, which reads vars.%s: nothing set " ..
+               "it (did you mean vars.%s?), so the condition never holds", tr.where, fsm.name,
+               st.name, (now - st.entered_ns) / 1e9, tr.shown, k, near))
+  end
 end
 
 local cycle_now_ns  -- the game time of the running cycle (E.run_cycle)
@@ -897,10 +965,12 @@ local function fsm_step(fsm)
       -- The state's transitions, then the defaults: the first whose timeout passed or whose
       -- condition holds (written out, no call per transition: this runs in every step).
       local list = not to and st.transitions or nil
+      cond_fsm = fsm
       while list do
         for i = 1, #list do
           local t = list[i]
           local c = t.cond
+          cond_tr = t
           if (t.timeout_ns and now - st.entered_ns >= t.timeout_ns) or c == true or
              (c ~= nil and c(st, fsm.vars, fsm)) then
             to, tr = t.to, t
@@ -909,6 +979,7 @@ local function fsm_step(fsm)
         end
         list = not to and list ~= fsm.defaults and fsm.defaults or nil
       end
+      cond_fsm, cond_tr = nil, nil
     else
       to = fsm.failed  -- the skill set fsm.error: failure
     end
@@ -917,6 +988,9 @@ local function fsm_step(fsm)
     if tr then
       trs[#trs + 1] = tr
       if tr.timeout_ns then progress = true end
+    else  -- what took it there, for skill_state's `via`
+      trs[#trs + 1] = err and "fail_to" or (st.subskills and fsm.error == nil and "final_to") or
+                      "error"
     end
     leave(fsm, st, to, tr, err)
     st = enter(fsm, to, now)
@@ -924,6 +998,11 @@ local function fsm_step(fsm)
   end
   if trs or fsm.spin ~= nil then watch_spin(fsm, now, path, trs, progress) end
   fsm.passed = path  -- the states this step went through (nil: it stayed), for skill_state
+  fsm.passed_by = trs  -- what took it from each to the next (a transition or "final_to", ...)
+  if not path and fsm.misses and not st.waited and now - st.entered_ns >= kWaitNs then
+    st.waited = true
+    watch_misses(fsm, st, now)
+  end
   if st.kind == "final" then return S_FINAL end
   if st.kind == "failed" then
     fsm.error = fsm.error or "FAILED"
@@ -971,7 +1050,9 @@ reset_skill = function(h)
   end
   if h.fsm then
     h.fsm.current, h.fsm.error, h.fsm.result, h.fsm.vars = nil, nil, nil, {}
-    h.fsm.passed = nil
+    -- fsm.passed(_by) stay: the last step's states are still to be reported when the string
+    -- ended in it (its step number tells them from a new step's).
+    h.fsm.misses = nil
     h.fsm.spin = nil
     for _, st in ipairs(h.fsm.state_list) do st.visit = 0 end
   end
@@ -1003,7 +1084,7 @@ call_skill = function(h, args)
     local vars = {}
     for k, v in pairs(args or {}) do vars[k] = v end
     h.active, h.status, h.error = true, S_RUNNING, nil
-    if h.fsm then h.fsm.vars = vars else h.vars = vars end
+    if h.fsm then h.fsm.vars = setmetatable(vars, vars_mt) else h.vars = vars end
     active[#active + 1] = h
   elseif h.status ~= S_RUNNING then
     return h.status
@@ -1022,6 +1103,7 @@ call_skill = function(h, args)
     ok, status, err = raw_pcall(step, h)
   end
   caller, h.in_call, depth = outer, false, depth - 1
+  cond_fsm, cond_tr = nil, nil  -- a condition that raised an error left them set
   if ok then
     h.status = status
     if status == S_FAILED then h.error = err == nil and "failed" or error_text(err) end
@@ -1136,6 +1218,20 @@ function E.finish_module(name)
                 unknown_state(fsm, fsm.start)), 0)
     end
     h.fsm = fsm
+    -- A transition after one with cond=true from the same state never fires (the first whose
+    -- condition holds is taken): warn at load.
+    for _, st in ipairs(fsm.state_list) do
+      local always = nil
+      for _, tr in ipairs(st.transitions) do
+        if always then
+          log(2, fmt("%s: %s: the transition %s can never fire: %s before it has cond=true and " ..
+                     "is always taken first; put it before that one, or drop it", tr.where,
+                     h.name, tr.shown, always.shown))
+        elseif tr.cond == true then
+          always = tr
+        end
+      end
+    end
     -- A state nothing leaves (no transition, timeout, precondition or sub-skill, no transition
     -- of every state) would only show as "still running" at the end: warn at load.
     if #fsm.defaults == 0 then
@@ -1213,12 +1309,46 @@ end
 -- Only the state (SkillBrain asks it in every cycle while a state listener is set), the states
 -- the last step went through ("GO,NEXT,GO"; nil if it stayed in one), so that states passed
 -- within one cycle are seen too, and that step's number (a step not taken reports nothing new).
-function E.skill_state(name)
+function E.skill_state(name, with_via)
   local h = handles[name]
   local fsm = h and h.fsm
   if not fsm then return "" end
+  local via = nil
+  if with_via and fsm.passed_by then  -- what took the step from each state to the next
+    local texts = {}
+    for i, t in ipairs(fsm.passed_by) do
+      texts[i] = type(t) == "table" and fmt("%s at %s", t.shown, t.where) or
+                 t == "final_to" and "its sub-skills ended FINAL (final_to)" or
+                 t == "fail_to" and "a sub-skill FAILED (fail_to)" or "fsm.error was set"
+    end
+    via = concat(texts, "\n")
+  end
   return fsm.current and fsm.current.name or "", fsm.passed and concat(fsm.passed, ",") or nil,
-         fsm.step_id
+         fsm.step_id, via
+end
+
+-- Why a running skill has not ended, for a report at the end of a game: the state it is in,
+-- since when (game seconds) and what would take it out, with the keys of vars its conditions
+-- read but nothing set. nil when it is not running in a state machine.
+function E.skill_wait(name)
+  local h = handles[name]
+  local fsm = h and h.fsm
+  local st = fsm and fsm.current
+  if not st or st.kind == "final" or st.kind == "failed" or h.status ~= S_RUNNING then return nil end
+  local out = fmt("in state %s since %.2f s", st.name, st.entered_ns / 1e9)
+  if st.subskills then
+    local names = {}
+    for i, sk in ipairs(st.subskills) do names[i] = sk.handle.name end
+    return out .. fmt(", its sub-skill(s) %s still running", concat(names, ", "))
+  end
+  local waits = {}
+  for _, tr in ipairs(st.transitions) do waits[#waits + 1] = fmt("%s (%s)", tr.shown, tr.where) end
+  for _, tr in ipairs(fsm.defaults) do waits[#waits + 1] = fmt("%s (%s)", tr.shown, tr.where) end
+  out = out .. ", waiting for " .. (#waits > 0 and concat(waits, " or ") or "nothing: no way out")
+  for _, m in ipairs(missed_keys(fsm, st)) do
+    out = out .. fmt("; vars.%s is never set (did you mean vars.%s?)", m[1], m[2])
+  end
+  return out
 end
 
 local string_env = setmetatable({}, {

@@ -828,21 +828,38 @@ std::string SkillEngine::skill_state(std::string_view skill) const {
   return out;
 }
 
-SkillEngine::StatePath SkillEngine::skill_state_path(std::string_view skill) const {
+SkillEngine::StatePath SkillEngine::skill_state_path(std::string_view skill, bool with_via) const {
   Impl& e = *impl_;
   lua_pushlstring(e.L, skill.data(), skill.size());
+  lua_pushboolean(e.L, with_via ? 1 : 0);
   StatePath out;
-  if (e.call_entry("skill_state", 1, 3) == LUA_OK) {
-    if (const char* p = lua_tostring(e.L, -2); p != nullptr) {
-      const std::string_view path(p);
-      std::size_t b = 0;
-      while (b <= path.size()) {
-        const std::size_t c = std::min(path.find(',', b), path.size());
-        out.states.emplace_back(path.substr(b, c - b));
-        b = c + 1;
-      }
+  // Splits `text` at `sep` into `into`.
+  auto split = [](std::string_view text, char sep, std::vector<std::string>& into) {
+    std::size_t b = 0;
+    while (b <= text.size()) {
+      const std::size_t c = std::min(text.find(sep, b), text.size());
+      into.emplace_back(text.substr(b, c - b));
+      b = c + 1;
     }
-    out.step = static_cast<std::int64_t>(lua_tointeger(e.L, -1));
+  };
+  if (e.call_entry("skill_state", 2, 4) == LUA_OK) {
+    if (const char* p = lua_tostring(e.L, -3); p != nullptr) split(p, ',', out.states);
+    out.step = static_cast<std::int64_t>(lua_tointeger(e.L, -2));
+    if (const char* v = lua_tostring(e.L, -1); v != nullptr && with_via) {
+      split(v, '\n', out.via);
+      for (std::string& s : out.via) s = e.full_paths(s);
+    }
+  }
+  lua_settop(e.L, 0);
+  return out;
+}
+
+std::string SkillEngine::skill_wait(std::string_view skill) const {
+  Impl& e = *impl_;
+  lua_pushlstring(e.L, skill.data(), skill.size());
+  std::string out;
+  if (e.call_entry("skill_wait", 1, 1) == LUA_OK) {
+    if (const char* s = lua_tostring(e.L, -1); s != nullptr) out = e.full_paths(s);
   }
   lua_settop(e.L, 0);
   return out;

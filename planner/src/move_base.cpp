@@ -63,7 +63,14 @@ void MoveBaseConfig::validate() const {
   core::require(p + "controller_patience_s", controller_patience_s, core::non_negative());
   core::require(p + "navgraph_direct_m", navgraph_direct_m, core::non_negative());
   core::require(p + "approach_speed_mps", approach_speed_mps, core::positive());
-  core::require(p + "approach_omega_rps", approach_omega_rps, core::positive());
+  core::require(p + "depart_speed_mps", depart_speed_mps, core::positive());
+  core::require(p + "motor_omega_rps", motor_omega_rps, core::positive());
+  core::require(p + "motor_gain_xy", motor_gain_xy, core::positive());
+  core::require(p + "motor_gain_th", motor_gain_th, core::positive());
+  core::require(p + "motor_min_speed_mps", motor_min_speed_mps, core::non_negative());
+  core::require(p + "motor_min_omega_rps", motor_min_omega_rps, core::non_negative());
+  core::require(p + "depart_tolerance_m", depart_tolerance_m, core::positive());
+  core::require(p + "depart_angle_tolerance_rad", depart_angle_tolerance_rad, core::positive());
   core::require(p + "approach_tolerance_m", approach_tolerance_m, core::positive());
   core::require(p + "approach_angle_tolerance_rad", approach_angle_tolerance_rad, core::positive());
 }
@@ -175,16 +182,21 @@ void MoveBaseNavigator::go_to(const Pose2D& goal, bool forward) {
   target_reached_ = false;
   state_ = MoveBaseState::kPlanning;
   depart_checked_ = false;
-  trigger_ = Trigger::kPlanning;
-  recovery_index_ = 0;
   rotating_ = false;
-  rotating_to_goal_ = false;
   escaping_ = false;
   stuck_left_ = stuck_right_ = stuck_left_strafe_ = stuck_right_strafe_ = false;
   rotating_left_ = rotating_right_ = strafe_left_ = strafe_right_ = false;
-  const SimTime now = has_last_update_ ? last_update_ : SimTime();
+  new_goal(has_last_update_ ? last_update_ : SimTime());
+}
+
+void MoveBaseNavigator::new_goal(SimTime now) {
+  // move_base's executeCb on a new goal: the recovery sequence and the patience timers start
+  // over, the controller plans afresh.
+  trigger_ = Trigger::kPlanning;
+  recovery_index_ = 0;
   last_valid_plan_ = now;
   last_valid_control_ = now;
+  rotating_to_goal_ = false;
   next_control_ = now;
 }
 
@@ -308,13 +320,15 @@ VelocityCommand MoveBaseNavigator::update(SimTime now, const Pose2D& pose,
   if (state_ == MoveBaseState::kDepart) {
     bool arrived = false;
     const double turn = core::angle_diff(depart_to_.theta, pose.theta);
-    if (forward_ && std::abs(turn) > config_.approach_angle_tolerance_rad) {
+    if (forward_ && std::abs(turn) > config_.depart_angle_tolerance_rad) {
       // Carrying a puck: turn towards the way out first (leave_IS: TURN, then MOTOR_MOVE).
-      command_ = {0.0, 0.0,
-                  std::clamp(1.5 * turn, -config_.approach_omega_rps, config_.approach_omega_rps)};
+      command_ =
+          straight_to(pose, Pose2D{pose.x, pose.y, depart_to_.theta}, config_.depart_speed_mps,
+                      config_.depart_tolerance_m, config_.depart_angle_tolerance_rad, arrived);
       return command_;
     }
-    command_ = straight_to(pose, depart_to_, arrived);
+    command_ = straight_to(pose, depart_to_, config_.depart_speed_mps, config_.depart_tolerance_m,
+                           config_.depart_angle_tolerance_rad, arrived);
     if (arrived) {
       state_ = MoveBaseState::kPlanning;
       last_valid_plan_ = now;
@@ -480,25 +494,34 @@ VelocityCommand MoveBaseNavigator::approach(const Pose2D& pose) {
       target = Pose2D{pose.x, pose.y, goal_.theta};
     }
   }
-  const VelocityCommand c = straight_to(pose, target, arrived);
+  const VelocityCommand c =
+      straight_to(pose, target, config_.approach_speed_mps, config_.approach_tolerance_m,
+                  config_.approach_angle_tolerance_rad, arrived);
   if (arrived) finish(NavOutcome::kArrived, {});
   return c;
 }
 
 VelocityCommand MoveBaseNavigator::straight_to(const Pose2D& pose, const Pose2D& target,
-                                               bool& arrived) const {
-  const Vec2 d = target.position() - pose.position();
-  const double dist = d.norm();
+                                               double speed, double tolerance_m,
+                                               double tolerance_rad, bool& arrived) const {
+  // motor_move: each axis of the robot frame on its own, no obstacle check, no timeout.
+  const Vec2 d = core::rotate(target.position() - pose.position(), -pose.theta);
   const double dth = core::angle_diff(target.theta, pose.theta);
-  arrived =
-      dist <= config_.approach_tolerance_m && std::abs(dth) <= config_.approach_angle_tolerance_rad;
-  if (arrived) return {};
-  // A straight relative move (Fawkes' motor_move): proportional, capped; no obstacle check.
-  const double v = std::min(config_.approach_speed_mps, 1.5 * dist);
-  Vec2 vf = dist > 1e-9 ? Vec2(d * (v / dist)) : Vec2(0.0, 0.0);
-  const Vec2 vr = core::rotate(vf, -pose.theta);
-  const double w = std::clamp(1.5 * dth, -config_.approach_omega_rps, config_.approach_omega_rps);
-  return {vr.x(), vr.y(), w};
+  const MoveBaseConfig& c = config_;
+  auto axis = [](double left, double tolerance, double gain, double lo, double hi) {
+    if (std::abs(left) <= tolerance) return 0.0;
+    return sign(left) * std::min(hi, std::max(lo, gain * std::abs(left)));
+  };
+  // Each axis stops within tolerance / sqrt(2) (motor_move's per-axis box, sized so that the
+  // move ends within `tolerance_m` of where its caller asked).
+  const double box = tolerance_m / std::sqrt(2.0);
+  const VelocityCommand v{
+      axis(d.x(), box, c.motor_gain_xy, c.motor_min_speed_mps, speed),
+      axis(d.y(), box, c.motor_gain_xy, c.motor_min_speed_mps, speed),
+      axis(dth, tolerance_rad, c.motor_gain_th, c.motor_min_omega_rps, c.motor_omega_rps)};
+  const bool at = v.vx_mps == 0.0 && v.vy_mps == 0.0;
+  arrived = at && std::abs(dth) <= tolerance_rad;
+  return v;
 }
 
 // --- ppgoto along the team's navigation graph ----------------------------------------------
@@ -628,12 +651,7 @@ void MoveBaseNavigator::send_goal(SimTime now, const Pose2D& pose) {
     needs_approach_ = false;
   }
   sent_at_ = now;
-  trigger_ = Trigger::kPlanning;
-  recovery_index_ = 0;
-  last_valid_plan_ = now;
-  last_valid_control_ = now;
-  rotating_to_goal_ = false;
-  next_control_ = now;
+  new_goal(now);
   // Under way, the new plan is made at once and the robot keeps its speed until the next
   // controller cycle (move_base publishes nothing while it plans).
   const bool under_way = state_ == MoveBaseState::kControlling;
@@ -740,13 +758,25 @@ bool MoveBaseNavigator::make_plan(const Pose2D& pose) {
     ++stats_.plan_failures;
     return false;
   }
+  // The potential reaches the start only through a passable 4-neighbour: a robot inside the
+  // inscribed cells has none, and there is no plan (the search below would find none after
+  // exploring every cell it can reach).
+  constexpr int kDi4[4] = {1, -1, 0, 0};
+  constexpr int kDj4[4] = {0, 0, 1, -1};
+  bool start_open = si == gi && sj == gj;
+  for (int e = 0; e < 4 && !start_open; ++e) {
+    const int a = si + kDi4[e], b = sj + kDj4[e];
+    start_open = a >= 0 && b >= 0 && a < nx && b < ny && passable(a, b);
+  }
+  if (!start_open) {
+    ++stats_.plan_failures;
+    return false;
+  }
   using Item = std::pair<float, std::size_t>;
   std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
   potential_[index(gi, gj)] = 0.0f;
   open.push({0.0f, index(gi, gj)});
   const std::size_t start = index(si, sj);
-  constexpr int kDi[4] = {1, -1, 0, 0};
-  constexpr int kDj[4] = {0, 0, 1, -1};
   while (!open.empty()) {
     const auto [p, k] = open.top();
     open.pop();
@@ -756,7 +786,7 @@ bool MoveBaseNavigator::make_plan(const Pose2D& pose) {
     const int i = static_cast<int>(k % static_cast<std::size_t>(nx));
     const int j = static_cast<int>(k / static_cast<std::size_t>(nx));
     for (int e = 0; e < 4; ++e) {
-      const int a = i + kDi[e], b = j + kDj[e];
+      const int a = i + kDi4[e], b = j + kDj4[e];
       if (a < 0 || b < 0 || a >= nx || b >= ny || !passable(a, b)) continue;
       const std::size_t kk = index(a, b);
       const float c = p + 50.0f + 0.8f * static_cast<float>(m.cost(a, b));

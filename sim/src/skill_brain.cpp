@@ -65,21 +65,24 @@ void SkillBrain::report_state() {
   const lua::SkillStatus status = engine_.status();
   if (st.empty() && (status == lua::SkillStatus::kFinal || status == lua::SkillStatus::kFailed))
     st = lua::to_string(status);
-  auto emit = [&](std::string from, std::string to) {
+  auto emit = [&](std::string from, std::string to, std::string via = {}) {
     SkillStateChange c;
     c.time = game_.time();
     c.robot = std::string(game_.robot(index_).name());
     c.skill = std::string(skill);
     c.from = std::move(from);
     c.to = std::move(to);
+    c.via = std::move(via);
     state_listener_(c);
   };
   // Every state a step went through, also within one cycle (GO -> NEXT -> GO is not "nothing").
   if (!skill.empty() && skill == state_skill_) {
-    const lua::SkillEngine::StatePath p = engine_.skill_state_path(skill);
+    lua::SkillEngine::StatePath p = engine_.skill_state_path(skill, state_via_);
     if (p.step != state_step_ && p.states.size() >= 2) {
       if (p.states.front() != state_) emit(state_, p.states.front());  // e.g. the start state
-      for (std::size_t i = 1; i < p.states.size(); ++i) emit(p.states[i - 1], p.states[i]);
+      for (std::size_t i = 1; i < p.states.size(); ++i) {
+        emit(p.states[i - 1], p.states[i], i - 1 < p.via.size() ? std::move(p.via[i - 1]) : "");
+      }
       state_ = p.states.back();
     }
     state_step_ = p.step;

@@ -61,12 +61,17 @@ RobotProfile robotino_2013() {
 RobotProfile robotino_2013_move_base() {
   RobotProfile p = robotino_2013();
   p.name = "robotino-2013-move_base";
-  // base_local_planner_params.yaml: max_vel_x 0.5, max_rotational_vel 0.78, acc_lim_x/y 2.5,
-  // acc_lim_th 3.2 -- for move_base and for the world's robot alike.
+  // base_local_planner_params.yaml: max_vel_x 0.5, acc_lim_x/y 2.5, acc_lim_th 3.2 -- for
+  // move_base and for the world's robot alike. move_base turns at most at max_rotational_vel
+  // 0.78 rad/s (MoveBaseConfig); the base itself turned as fast as the skills' motor_move
+  // commanded (src/lua/skills/robotino/motor_move.lua V_MAX: 0.4 m/s, 2.2 rad/s), which also
+  // caps the skills' own motor moves.
   p.max_speed_mps = 0.5;
-  p.max_omega_rps = 0.78;
+  p.max_omega_rps = 2.2;
   p.max_accel_mps2 = 2.5;
   p.max_alpha_rps2 = 3.2;
+  p.motor_max_speed_mps = 0.4;
+  p.motor_max_omega_rps = 2.2;
   // move_base's navigation sees other robots only with the laser (costmap_common_params.yaml:
   // the laser is the only observation source), at the thesis' 5 Hz.
   p.navigation = sim::NavigationLevel::kMoveBase2013;

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "llsf/study/recording.h"
 
+#include "llsf/study/runner.h"
+
 #include <zlib.h>
 
 #include <algorithm>
@@ -314,6 +316,7 @@ void Recorder::skill_state(const sim::SkillStateChange& c) {
   j["skill"] = c.skill;
   j["from"] = c.from;
   j["to"] = c.to;
+  if (!c.via.empty()) j["via"] = c.via;
   impl_->write(j);
 }
 
@@ -459,6 +462,18 @@ void Recorder::lock(const std::string& robot, const clips::LockEvent& e) {
   j["resource"] = e.resource;
   j["from"] = clips::to_string(e.from);
   j["to"] = clips::to_string(e.to);
+  impl_->write(j);
+}
+
+void Recorder::issue(core::SimTime t, const RunIssue& i) {
+  Json j = Impl::event(t, "issue");
+  j["robot"] = i.robot;
+  j["kind"] = i.kind;
+  if (!i.rule.empty()) j["rule"] = i.rule;
+  if (!i.place.empty()) j["place"] = i.place;
+  j["text"] = i.text;
+  // Noticed later than it happened (a lock held too long is found at the end).
+  if (fixed(i.time_s, 2) < fixed(t.seconds(), 2)) j["time_s"] = fixed(i.time_s, 2);
   impl_->write(j);
 }
 

@@ -377,15 +377,6 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   std::vector<RunIssue> issues;
   int issues_dropped = 0;
   int mistakes = 0;  // every one, kept or not
-  auto add_issue = [&issues, &issues_dropped, &mistakes](RunIssue i) {
-    if (i.is_mistake()) ++mistakes;
-    // A halt (at most one per robot) is always kept: RunResult::agent_error() reads it.
-    if (issues.size() < RunResult::kMaxIssues || i.kind == "agent-halted") {
-      issues.push_back(std::move(i));
-    } else {
-      ++issues_dropped;
-    }
-  };
   check_trace_requests(scenario, hooks.trace);
   std::unique_ptr<Recorder> recorder;
   sim::GameDriver driver(config);
@@ -396,6 +387,16 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
         RecordingInfo{scenario.name, scenario.variant, seed, std::string(core::kVersion)}, 10.0,
         hooks.record_sink);
   }
+  auto add_issue = [&issues, &issues_dropped, &mistakes, &recorder, &game](RunIssue i) {
+    if (i.is_mistake()) ++mistakes;
+    // A halt (at most one per robot) is always kept: RunResult::agent_error() reads it.
+    if (issues.size() < RunResult::kMaxIssues || i.kind == "agent-halted") {
+      if (recorder) recorder->issue(game.time(), i);  // the viewer's timeline marks it
+      issues.push_back(std::move(i));
+    } else {
+      ++issues_dropped;
+    }
+  };
   for (int i = 0; i < game.robot_count(); ++i) {
     const RobotSpec& spec = scenario.robots.at(static_cast<std::size_t>(i));
     if (spec.agent.empty()) continue;

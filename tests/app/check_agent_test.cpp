@@ -108,3 +108,26 @@ TEST_CASE(
   // -q: nothing.
   CHECK(llsfsim({"run", dir.file("s.yaml"), "--no-db", "--no-record", "-q"}).err.empty());
 }
+
+TEST_CASE("check and run warn on a time test CLIPS never evaluates again, with file:line") {
+  const TempDir dir;
+  write(dir, "agent/a.clp",
+        "(deftemplate idle (slot until (type FLOAT)))\n"
+        "(defrule idle-over\n"
+        "  ?f <- (idle (until ?u))\n"
+        "  (test (>= (now) ?u))\n"
+        "  =>\n"
+        "  (retract ?f))\n");
+  write(dir, "s.yaml", "name: c\nduration_s: 1\nrobots:\n  count: 1\n  agent: [agent]\n");
+  const std::string want =
+      "a.clp:4: rule idle-over: (test ...) reads the time ((now)) but no (time ...) pattern "
+      "comes before it";
+  const auto c = llsfsim({"check", dir.file("s.yaml")});
+  INFO(c.out, c.err);
+  CHECK(c.code == 0);  // a warning
+  CHECK(has(c.out, want));
+  const auto r = llsfsim({"run", dir.file("s.yaml"), "--no-db", "--no-record"});
+  INFO(r.out, r.err);
+  CHECK(has(r.err, "llsfsim run: warn: "));
+  CHECK(has(r.err, want));
+}

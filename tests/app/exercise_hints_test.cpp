@@ -19,6 +19,7 @@ using llsf::test::llsfsim;
 using llsf::test::Run;
 
 const std::string kMistakes = LLSF_SOURCE_DIR "/tests/app/exercises/mistakes/";
+const std::string kSolutions = LLSF_SOURCE_DIR "/tests/app/exercises/";
 
 /// The line number of the "-- MISTAKE" marker in `path`.
 int marked(const std::string& path) {
@@ -163,6 +164,13 @@ TEST_CASE("exercise: silent mistakes are warnings with the line; a load-time pri
       {"no_way_out.lua",
        "drive_to_point: state 'WAIT' has no way out: no transition, timeout or sub-skill leaves "
        "it, so the skill would stay there"},
+      {"never_fires.lua",
+       "drive_to_point: the transition {\"CHECK\", \"FINAL\", cond=\"vars.done\"} can never "
+       "fire: {\"CHECK\", \"DRIVE\", cond=true} before it has cond=true and is always taken first"},
+      {"typo_vars.lua",
+       "drive_to_point: state 'CHECK' has waited 5 s on {\"CHECK\", \"FINAL\", "
+       "cond=\"vars.arived\"}, which reads vars.arived: nothing set it (did you mean "
+       "vars.arrived?), so the condition never holds"},
   };
   for (const Warning& w : warnings) {
     const std::string path = kMistakes + w.file;
@@ -180,4 +188,34 @@ TEST_CASE("exercise: silent mistakes are warnings with the line; a load-time pri
   const Run r = llsfsim({"exercise", "01", "--skill", kMistakes + "print_at_load.lua"});
   INFO(r.out, r.err);
   CHECK(has(r.out, "[    0.00 s] robot1 info: loading drive_to_point, version 3\n"));
+}
+
+TEST_CASE("exercise: every state a step passes is printed; --trace says what took it there") {
+  const std::string path = kMistakes + "typo_vars.lua";
+  const Run r = llsfsim({"exercise", "01", "--skill", path});
+  INFO(r.out, r.err);
+  // START -> DRIVE within the first skill cycle: both states are printed.
+  CHECK(has(r.out, "[    0.01 s] robot1   drive_to_point: START\n"));
+  CHECK(has(r.out, "[    0.01 s] robot1   drive_to_point: DRIVE\n"));
+  // Still running at the end: the why names the state, since when and what it waits for.
+  const std::string line = ":" + std::to_string(marked(path)) + ")";
+  CHECK(has(r.out, "why      the skill was still running after 60 s: in state CHECK since "));
+  CHECK(has(r.out, ", waiting for {\"CHECK\", \"FINAL\", cond=\"vars.arived\"} ("));
+  CHECK(has(r.out, line + "; vars.arived is never set (did you mean vars.arrived?)\n"));
+
+  const Run t = llsfsim({"exercise", "01", "--skill", path, "--trace"});
+  INFO(t.out, t.err);
+  CHECK(has(t.out, "[    0.01 s] robot1   drive_to_point: START\n"));
+  CHECK(has(t.out,
+            "[    0.01 s] robot1   drive_to_point: START -> DRIVE  ({\"START\", \"DRIVE\", "
+            "cond=true} at "));
+  CHECK(has(t.out, "typo_vars.lua:" + std::to_string(marked(path)) + ")\n"));
+  CHECK(has(t.out, "drive_to_point: DRIVE -> CHECK  (its sub-skills ended FINAL (final_to))\n"));
+
+  // A step that ends the skill: its states are printed too (DRIVE -> CHECK -> FINAL at once).
+  const Run f =
+      llsfsim({"exercise", "01", "--skill", kSolutions + "01-drive-to-point.lua", "--trace"});
+  INFO(f.out, f.err);
+  CHECK(has(f.out, "drive_to_point: DRIVE -> CHECK  (its sub-skills ended FINAL (final_to))\n"));
+  CHECK(has(f.out, "drive_to_point: CHECK -> FINAL  ({\"CHECK\", \"FINAL\", cond=<function>} at "));
 }

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <string>
 
 #include "fixture.h"
@@ -196,30 +197,36 @@ TEST_CASE("move_base-2013: a goal another robot stands on ends in move_base's ab
         std::string::npos);
 }
 
+// A, led by the navigation graph, to `goal`; B stands at `b`.
+Run graph_run(const char* what, const core::Pose2D& a, const core::Pose2D& b,
+              const core::Pose2D& goal, Game*& game, std::unique_ptr<Game>& holder) {
+  holder = std::make_unique<Game>(two_robots(a, b, true));
+  game = holder.get();
+  const Run r = play(*game, goal, nullptr, 120.0);
+  report(what, r);
+  MESSAGE("  ", r.sa.waypoints, " nodes passed, ", r.sa.resends, " resends, ", r.sa.aborts,
+          " aborts outlived");
+  return r;
+}
+
 TEST_CASE("move_base-2013 with the navigation graph: corridor nodes, resends, no abort") {
+  Game* g = nullptr;
+  std::unique_ptr<Game> holder;
   // Across the field: the route passes the graph's corridor nodes and arrives.
-  {
-    GameConfig c = two_robots({1.0, 0.7, 0.0}, {0.5, 5.0, 0.0}, true);
-    Game g(c);
-    const Run r = play(g, {4.7, 4.4, 0.0}, nullptr, 120.0);
-    report("graph across the field", r);
-    MESSAGE("  ", r.sa.waypoints, " nodes passed, ", r.sa.resends, " resends");
-    CHECK(r.a == planner::NavOutcome::kArrived);
-    CHECK(r.sa.waypoints >= 3);
-    CHECK((g.world().robot_pose(core::RobotId(0)).position() - core::Vec2(4.7, 4.4)).norm() <=
-          0.25 + 1e-9);
-  }
+  const core::Pose2D far{4.7, 4.4, 0.0};
+  const Run across =
+      graph_run("graph across the field", {1.0, 0.7, 0.0}, {0.5, 5.0, 0.0}, far, g, holder);
+  CHECK(across.a == planner::NavOutcome::kArrived);
+  CHECK(across.sa.waypoints >= 3);
+  CHECK((g->world().robot_pose(core::RobotId(0)).position() - far.position()).norm() <=
+        0.25 + 1e-9);
   // A goal another robot stands on: move_base plans in vain and starts its recoveries; the graph
   // sends the goal again every 6 s (which starts move_base over before its sequence can end in
   // an abort) and never gives up -- the 2013 robot had no timeout (thesis section 6.2).
-  {
-    GameConfig c = two_robots({1.0, 0.7, 0.0}, {3.4, 2.15, 0.0}, true);
-    Game g(c);
-    const Run r = play(g, {3.4, 2.15, 0.0}, nullptr, 120.0);
-    report("graph, goal occupied", r);
-    MESSAGE("  ", r.sa.resends, " resends, ", r.sa.aborts, " aborts outlived");
-    CHECK(r.a == planner::NavOutcome::kRunning);
-    CHECK(r.sa.recoveries >= 1);
-    CHECK(r.sa.resends >= 5);
-  }
+  const core::Pose2D occupied{3.4, 2.15, 0.0};
+  const Run blocked =
+      graph_run("graph, goal occupied", {1.0, 0.7, 0.0}, occupied, occupied, g, holder);
+  CHECK(blocked.a == planner::NavOutcome::kRunning);
+  CHECK(blocked.sa.recoveries >= 1);
+  CHECK(blocked.sa.resends >= 5);
 }

@@ -155,7 +155,7 @@ export interface RescueState {
 
 export interface Marker {
   t: number;
-  kind: "award" | "failure" | "collision" | "rescue" | "log" | "nav";
+  kind: "award" | "failure" | "collision" | "rescue" | "log" | "nav" | "agent";
   label: string;
 }
 
@@ -482,6 +482,16 @@ export class Recording {
         kind: "failure",
         label: `${line.robot}: ${line.string ?? ""} failed: ${line.error ?? ""}`,
       });
+    } else if (line.e === "issue" && line.kind !== "skill-failure") {
+      // An agent's mistake (docs/recording.md: a runtime error, a rule loop, a halted agent, an
+      // unknown skill, a lock held too long); skill failures have their own markers. A lock held
+      // too long is noticed at the end: its marker stands where it happened (time_s).
+      const where = line.rule ? ` rule ${line.rule}${line.place ? ` (${line.place})` : ""}` : "";
+      this.markers.push({
+        t: typeof line.time_s === "number" ? line.time_s : line.t,
+        kind: "agent",
+        label: `${line.robot ?? ""} ${line.kind ?? "issue"}${where}: ${line.text ?? ""}`,
+      });
     } else if (line.e === "jam" && line.jammed) {
       // Robot profiles: a robot jammed at a device (docs/profiles.md).
       this.markers.push({t: line.t, kind: "failure", label: `${line.robot} jammed at ${line.d}`});
@@ -528,7 +538,9 @@ export class Recording {
     } else if (line.e === "skill_state") {
       const from = String(line.from ?? "") || "–";
       const to = String(line.to ?? "") || "–";
-      entry = {t: line.t, robot, kind: "state", level: "", text: `${String(line.skill ?? "")}: ${from} → ${to}`};
+      // `via` (exercise --trace): what took it there, the transition and its file:line.
+      const via = line.via ? `  (${String(line.via)})` : "";
+      entry = {t: line.t, robot, kind: "state", level: "", text: `${String(line.skill ?? "")}: ${from} → ${to}${via}`};
     } else {
       const where = line.place
         ? String(line.place)

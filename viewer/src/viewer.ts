@@ -857,9 +857,9 @@ class Replay {
         g.textBaseline = "top";
         g.fillText(`rescue ${last} points`, w - 10, 2);
       }
-      // Rows: the skills' log lines at the top, awards and rescues, failures and the navigator's
-      // refusals, collisions at the bottom.
-      const rows = {log: 0.2, award: 0.45, failure: 0.68, nav: 0.68, collision: 0.88, rescue: 0.45};
+      // Rows: the skills' log lines and the agents' errors at the top, awards and rescues,
+      // failures and the navigator's refusals, collisions at the bottom.
+      const rows = {log: 0.2, agent: 0.2, award: 0.45, failure: 0.68, nav: 0.68, collision: 0.88, rescue: 0.45};
       const colors = {
         award: "#2e7d32",
         failure: "#c0392b",
@@ -867,6 +867,7 @@ class Replay {
         rescue: "#00897b",
         log: "#1f5fa8",
         nav: "#8e24aa",
+        agent: "#d81b60",
       };
       for (const m of this.rec.markers) {
         const x = this.timelineX(m.t);

@@ -16,7 +16,9 @@
 //      the newest output line is its last one;
 //      a click on a fact index in a firing filters the list to that fact;
 //   4. the same game without the agents' lines shows "no agent facts recorded";
-//   5. a live game (`llsfsim run --serve`): the agent browser lists the selected robot's facts.
+//   5. a live game (`llsfsim run --serve`): the agent browser lists the selected robot's facts;
+//   6. a one-robot game whose agent makes a runtime error: the timeline marks it (an `agent`
+//      marker naming the rule and its file:line; hovering shows it).
 // When the recording has no `facts` lines (an llsfsim before the agents' trace), the test writes
 // them itself in that format (synthetic: facts derived from the game's skill and agent lines) and
 // skips step 5; it says which in its last line. Screenshots go to ARTIFACT_DIR (agent-*.png).
@@ -190,6 +192,14 @@ try {
     lines = synthesize(lines);
     writeLines(recorded, lines);
   }
+  // A game whose agent makes a runtime error at 2 s (step 6).
+  writeFileSync(join(tmp, "broken.clp"),
+                '(defrule broken (time ?s ?) (test (>= ?s 2)) (not (broke)) => (assert (broke))\n' +
+                '  (eval "(no-such-fn)"))\n');
+  writeFileSync(join(tmp, "broken.yaml"),
+                "name: broken\nduration_s: 5\nstart: production\nrobots: {count: 1, agent: [broken.clp]}\n");
+  execFileSync(llsfsim, ["run", "broken.yaml", "--no-db", "-q", "--record", join(recordings, "broken.jsonl.gz")],
+               {cwd: tmp, encoding: "utf8", stdio: ["ignore", "pipe", "pipe"], env, timeout: 300_000});
   // The same game without the agents' trace, as recorded before it existed.
   writeLines(join(recordings, "old.jsonl.gz"), lines.filter((l) => !kTraceEvents.has(l.e)));
 
@@ -364,6 +374,20 @@ try {
     check(liveFacts > 0, "the live agent browser lists no facts");
   }
 
+  // 6. An agent's runtime error is a marker on the timeline.
+  await page.goto(`${url}#/file/broken.jsonl.gz`);
+  await readyOrError("#/file/broken.jsonl.gz");
+  const marks = (await page.evaluate(() => window.llsfViewer.debug())).markers;
+  const agentError = marks.find((m) => m.kind === "agent");
+  check(agentError && /robot1 runtime-error rule broken \(.*broken\.clp:1\): .*no-such-fn/.test(agentError.label) &&
+        Math.abs(agentError.t - 2) < 0.2,
+        `no timeline marker for the agent's runtime error: ${JSON.stringify(marks)}`);
+  const timelineBox = await page.locator("canvas[data-timeline]").boundingBox();
+  await page.mouse.move(timelineBox.x + agentError.x, timelineBox.y + timelineBox.height * 0.2);
+  const agentTip = await page.textContent(".tip");
+  check(agentTip.includes("runtime-error rule broken"), `hovering the agent error shows "${agentTip}"`);
+  await page.screenshot({path: join(artifacts, "agent-error-marker.png")});
+
   check(errors.length === 0, errors.join("\n"));
   ok = true;
   console.log(
@@ -371,6 +395,7 @@ try {
       `${rows.length} facts as in the recording (snapshot at ${want.snapshotT} s), f-${expectIndex} ` +
       `${expectText}; template ${template}: ${narrowed.length}; ` +
       (real ? `live: ${liveFacts} facts` : "live: skipped (no trace recorded)") +
+      "; the agent's runtime error marked on the timeline" +
       `; screenshots in ${artifacts}`,
   );
 } catch (e) {

@@ -9,10 +9,11 @@
 //      and at least one camera sighting, the skill's state shows in the panel, and when the game
 //      is over the verdict banner says PASS with the score;
 //   2. replay: exercise 01 played with a skill that prints (printf in a state's init, print in
-//      another) and `--record`, opened with `llsfsim serve` at #/file/NAME: the printed lines
-//      are markers on the timeline (hovering shows the text, clicking seeks to the line's
-//      time), the skill's state changes and lines are in the panel, the grid and the mouse's
-//      field coordinates show, and at the end the verdict banner says PASS;
+//      another) and `--record --trace`, opened with `llsfsim serve` at #/file/NAME: the printed
+//      lines are markers on the timeline (hovering shows the text, clicking seeks to the line's
+//      time), the skill's state changes (with what made each: --trace) and lines are in the
+//      panel, the grid and the mouse's field coordinates show, and at the end the verdict banner
+//      says PASS;
 //   3. replay: the same skill sent to a goal inside M1: the navigator's refusal is a marker on
 //      the timeline and a line in the panel, and the banner says FAIL and why.
 // Screenshots go to ARTIFACT_DIR. Exit code 0, or 1 with a message.
@@ -126,7 +127,7 @@ try {
   try {
     stdout = execFileSync(
       llsfsim,
-      ["exercise", "01", "--skill", "printing.lua", "--record", join("rec", "ex01.jsonl.gz")],
+      ["exercise", "01", "--skill", "printing.lua", "--trace", "--record", join("rec", "ex01.jsonl.gz")],
       {cwd: tmp, encoding: "utf8", stdio: ["ignore", "pipe", "pipe"], env, timeout: 60_000},
     );
   } catch (e) {
@@ -176,6 +177,9 @@ try {
   const banner = await page.textContent("[data-verdict]");
   check(/^PASS\b.*m from the target/.test(banner), `the verdict banner says "${banner}"`);
   check(end.skills[0].state === "FINAL", `the skill's state at the end: ${end.skills[0].state}`);
+  // Recorded with --trace: each state change says what made it (the transition and its line).
+  check(end.skills[0].lines.some((l) => /^drive_to_point: CHECK → FINAL  \(\{"CHECK", "FINAL", cond=<function>\} at .*printing\.lua:\d+\)$/.test(l)),
+        `no state change with what made it in the panel: ${JSON.stringify(end.skills[0].lines)}`);
   await page.screenshot({path: join(artifacts, "exercise-replay-end.png")});
 
   // 3. The same skill sent into M1: the navigator's refusal on the timeline and in the panel,

@@ -167,8 +167,16 @@ class SkillEngine {
   struct StatePath {
     std::vector<std::string> states;  ///< empty if the step stayed in its state
     std::int64_t step = 0;
+    /// With `with_via`: what took the step from states[i] to states[i + 1], e.g.
+    /// `{"START", "DRIVE", cond=true} at skill.lua:19` or `its sub-skills ended FINAL
+    /// (final_to)` (paths as the engine loaded the files).
+    std::vector<std::string> via;
   };
-  StatePath skill_state_path(std::string_view skill) const;
+  StatePath skill_state_path(std::string_view skill, bool with_via = false) const;
+  /// Why a running state-machine skill has not ended (for a report when time is up): "in state
+  /// CHECK since 14.91 s, waiting for {"CHECK", "FINAL", cond="vars.arived"} (skill.lua:20);
+  /// vars.arived is never set (did you mean vars.arrived?)"; "" if it is not running.
+  std::string skill_wait(std::string_view skill) const;
 
   /// The blackboard interfaces skills wrote since the last call (each once, in writing order),
   /// as Fawkes' skiller wrote its writing interfaces after every loop: for the agent's

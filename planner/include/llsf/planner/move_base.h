@@ -78,12 +78,24 @@ struct MoveBaseConfig {
   // insertion area) first moves straight out to the nearest free point within this distance,
   // as the 2013 skills did before every ppgoto (leave_area: motor_move x = -0.2; leave_IS).
   double depart_max_m = 0.6;
+  // The straight moves (departure and final approach) are the team's motor_move
+  // (fawkes-robotino 6cffc15f2, src/lua/skills/robotino/motor_move.lua): per axis of the robot
+  // frame, a speed proportional to the distance left (V_MAX / D_DECEL / 5: 0.4 / 0.07 / 5 m/s
+  // per m, 2.2 / 0.2 / 5 rad/s per rad), at least V_MIN (0.035 m/s, 0.15 rad/s), at most
+  // the move's cap; an axis within TOLERANCE (0.04 m, 0.05 rad) stops; no timeout.
+  double motor_gain_xy = 0.4 / 0.07 / 5.0;
+  double motor_gain_th = 2.2 / 0.2 / 5.0;
+  double motor_min_speed_mps = 0.035;
+  double motor_min_omega_rps = 0.15;
+  double motor_omega_rps = 2.2;   ///< V_MAX.ori: the cap of every straight move's turn
+  double depart_speed_mps = 0.4;  ///< V_MAX.x: leave_area and leave_IS use motor_move's default
+  double depart_tolerance_m = 0.04;
+  double depart_angle_tolerance_rad = 0.05;
   // The final approach to a goal move_base cannot take (a pose at a machine, inside the
   // inscribed radius of its footprint): move_base drives to the nearest pose back along the
-  // goal heading that its costmap allows, then a straight relative move at this speed, as the
-  // 2013 skills did (ppgoto to a navgraph node, then move_under_rfid / motor_move).
-  double approach_speed_mps = 0.15;
-  double approach_omega_rps = 0.5;
+  // goal heading that its costmap allows, then a straight relative move, as the 2013 skills did
+  // (ppgoto to a navgraph node, then move_under_rfid: turn, APPROACH_AMPEL at vel_trans 0.1).
+  double approach_speed_mps = 0.1;
   double approach_tolerance_m = 0.02;
   double approach_angle_tolerance_rad = 0.03;
 
@@ -253,6 +265,7 @@ class MoveBaseNavigator {
     double end_x = 0.0, end_y = 0.0, end_th = 0.0;
   };
   void finish(NavOutcome outcome, std::string message);
+  void new_goal(core::SimTime now);
   bool make_plan(const Pose2D& pose);
   bool compute_velocity(const Pose2D& pose, const VelocityCommand& vel, VelocityCommand& cmd);
   void update_grids(const Pose2D& pose);
@@ -263,7 +276,8 @@ class MoveBaseNavigator {
   void start_recovery(core::SimTime now, const Pose2D& pose);
   VelocityCommand run_recovery(core::SimTime now, const Pose2D& pose);
   VelocityCommand approach(const Pose2D& pose);
-  VelocityCommand straight_to(const Pose2D& pose, const Pose2D& target, bool& arrived) const;
+  VelocityCommand straight_to(const Pose2D& pose, const Pose2D& target, double speed,
+                              double tolerance_m, double tolerance_rad, bool& arrived) const;
   void add_stats(double dt);
 
   const Planner* planner_;

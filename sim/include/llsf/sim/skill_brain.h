@@ -37,6 +37,10 @@ struct SkillStateChange {
   std::string skill;  ///< the skill string's first skill ("rescue" in "rescue{}")
   std::string from;   ///< the state before ("" when the skill was not running)
   std::string to;     ///< the state now ("" when the skill is not running or has no FSM)
+  /// With set_state_listener(..., true): what took it from `from` to `to` within the step
+  /// (`{"START", "DRIVE", cond=true} at skill.lua:19`, `its sub-skills ended FINAL (final_to)`);
+  /// "" otherwise and for changes seen only between steps (a new string, its end).
+  std::string via;
 };
 
 /// Runs a skill engine as robot `index`'s brain (on_skill_cycle). Its owner plugs it into the
@@ -62,9 +66,12 @@ class SkillBrain final : public RobotBrain {
   }
 
   /// Called when the state of the skill string's first skill changes (checked after exec() and
-  /// every cycle; one query of the engine per cycle, only while a listener is set).
-  void set_state_listener(std::function<void(const SkillStateChange&)> listener) {
+  /// every cycle; one query of the engine per cycle, only while a listener is set), once for
+  /// every state a step went through. `with_via`: the changes say what took them (`via`).
+  void set_state_listener(std::function<void(const SkillStateChange&)> listener,
+                          bool with_via = false) {
     state_listener_ = std::move(listener);
+    state_via_ = with_via;
   }
 
   void on_skill_cycle(lua::RobotApi& robot) override;
@@ -83,6 +90,7 @@ class SkillBrain final : public RobotBrain {
   std::string state_skill_;       ///< the skill whose state was last reported
   std::string state_;             ///< its state as last reported
   std::int64_t state_step_ = -1;  ///< the skill's step whose states were last reported
+  bool state_via_ = false;        ///< the listener wants SkillStateChange::via
 };
 
 }  // namespace llsf::sim

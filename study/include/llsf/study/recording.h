@@ -22,6 +22,8 @@
 
 namespace llsf::study {
 
+struct RunIssue;  // runner.h
+
 /// Version of the recording format written by Recorder.
 inline constexpr int kRecordingVersion = 1;
 
@@ -78,6 +80,9 @@ class Recorder {
                const std::string& why = {});
   /// A free-form event from an agent or tool ({"t":..,"e":"note","robot":..,"text":..}).
   void note(core::SimTime t, const std::string& robot, const std::string& text);
+  /// An issue of the run (runner.h, RunIssue: a runtime error, a rule loop, a halted agent, a
+  /// skill failure, ...) noticed at `t` (its own time, if earlier, is `time_s`).
+  void issue(core::SimTime t, const RunIssue& issue);
   /// Flushes and closes the file (idempotent).
   void close();
   /// Lines written so far.
