@@ -37,6 +37,9 @@ struct SkillOptions {
   std::string light = "ground_truth";
   std::string puck = "ground_truth";
   std::vector<std::string> skill_dirs;
+  std::vector<std::string> module_dirs;    ///< --modules: where require finds helper modules
+  std::vector<std::string> cfg_dirs;       ///< --cfg: Fawkes' cfg directories (navgraphs)
+  std::vector<std::string> fawkes_config;  ///< --fawkes-config /path=value
   std::string library_dir;
   double timeout_s = 300.0;
   double after_s = 0.0;
@@ -105,6 +108,17 @@ int run_skill(const SkillOptions& o, std::ostream& out, std::ostream& err) {
   lua::SkillEngineConfig ec;
   ec.skill_dirs = sim::skill_library_dirs(config.levels.skill, o.library_dir);
   for (const std::string& d : o.skill_dirs) ec.skill_dirs.push_back(d);
+  ec.module_dirs = o.module_dirs;
+  ec.cfg_dirs = o.cfg_dirs;
+  for (const std::string& kv : o.fawkes_config) {
+    const std::size_t eq = kv.find('=');
+    if (eq == std::string::npos || eq == 0 || kv[0] != '/') {
+      err << "llsfsim skill: --fawkes-config '" << kv
+          << "': expected /path=value, e.g. /skills/take_puck_to/front_sensor_dist=0.05\n";
+      return kExitBadInput;
+    }
+    ec.fawkes_config[kv.substr(0, eq)] = kv.substr(eq + 1);
+  }
   sim::SkillBrain& brain = driver.plug_skills(index, ec);
   if (o.list) {
     print_skills(brain, out);
@@ -274,6 +288,20 @@ Action add_skill_command(CLI::App& app) {
                  "same name")
       ->check(CLI::ExistingDirectory)
       ->allow_extra_args(false);  // one directory per --skills: skill strings follow
+  app.add_option("--modules", o->module_dirs,
+                 "Directory where require() finds Lua helper modules besides the skill "
+                 "directories (repeatable; skills written for Fawkes: docs/fawkes.md)")
+      ->check(CLI::ExistingDirectory)
+      ->allow_extra_args(false);
+  app.add_option("--cfg", o->cfg_dirs,
+                 "Fawkes cfg directory where fawkes.load_yaml_navgraph finds navgraph files "
+                 "(repeatable)")
+      ->check(CLI::ExistingDirectory)
+      ->allow_extra_args(false);
+  app.add_option("--fawkes-config", o->fawkes_config,
+                 "A Fawkes configuration value skills read with config:get_*(path), as "
+                 "/path=value (repeatable)")
+      ->allow_extra_args(false);
   app.add_option("--library", o->library_dir,
                  "The skill library directory (default: lua/skills of the data directory)")
       ->check(CLI::ExistingDirectory);

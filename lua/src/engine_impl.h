@@ -20,6 +20,8 @@ namespace llsf::lua {
 
 /// The text embedded from src/prelude.lua (generated prelude.cpp).
 extern const char* const kPrelude;
+/// The text embedded from src/fawkes.lua, the Fawkes compatibility layer (generated prelude.cpp).
+extern const char* const kFawkesLayer;
 
 /// Heap accounting of one interpreter.
 struct LuaHeap {
@@ -51,10 +53,32 @@ inline constexpr std::int64_t kHookInterval = 1000;
 /// Lines kept while the files load without a log sink (SkillEngine::Impl::pending_log).
 inline constexpr std::size_t kMaxPendingLog = 200;
 
+/// A Fawkes navgraph as read from its YAML file (fawkes_natives.cpp), before it goes to Lua.
+struct NavgraphNode {
+  std::string name;
+  double x = 0.0;
+  double y = 0.0;
+  bool unconnected = false;  ///< tagged !unconnected
+  std::vector<std::pair<std::string, std::string>> properties;
+};
+struct NavgraphEdge {
+  std::string from;
+  std::string to;
+  bool directed = false;  ///< tagged !dir
+};
+struct NavgraphData {
+  std::string name;
+  std::string root;
+  std::vector<NavgraphNode> nodes;
+  std::vector<NavgraphEdge> edges;
+};
+
 /// One skill file as last loaded (for hot reload).
 struct SkillFile {
   std::string name;
   std::string path;
+  /// The directory's init.lua (a Fawkes skill space naming its skills), not a skill.
+  bool space_init = false;
   std::int64_t mtime_ns = 0;
   std::int64_t size = 0;
 };
@@ -95,6 +119,10 @@ struct SkillEngine::Impl {
   NavState nav;
   LightReading light;
   std::string cpp_error;
+  std::string module_text;  // the module `require` read last, and its shown path
+  std::string module_path;
+  bool module_in_skill_dir = false;
+  NavgraphData navgraph;  // the navgraph file read last
 
   /// The engine that owns `L` (stored in the state's extra space).
   static Impl& of(lua_State* L) { return **static_cast<Impl**>(lua_getextraspace(L)); }
@@ -135,6 +163,9 @@ void push_pattern_functions(lua_State* L);
 /// Registers the robot interfaces: pushes a table type name -> interface object, and sets the
 /// globals the prelude reads from `native` (clock, interface names).
 void push_interfaces(lua_State* L);
+/// Sets the natives of the Fawkes layer in the table at -1: read_module, navgraph (reads files
+/// of the configured directories) and fawkes_config (path -> value text).
+void push_fawkes_natives(lua_State* L);
 /// The method names of every interface type (pose:get, puck_detector:nearest, ...), each once:
 /// for the "did you mean" of a misspelt method.
 std::vector<std::string> interface_method_names();

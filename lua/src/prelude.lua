@@ -39,6 +39,7 @@ local function readonly(t, what)
     end,
     __pairs = function() return next, t, nil end,
     __len = function() return #t end,
+    __call = function(_, ...) return t(...) end,  -- a callable class (fawkes.tf.StampedPose)
     __metatable = false})
   frozen[proxy] = what
   return proxy
@@ -160,10 +161,30 @@ base.profile = setmetatable({}, {
 frozen[base.profile] = "profile"
 -- Fawkes skill files start with `module(..., skillenv.module_init)` and call
 -- `skillenv.skill_module(_M)` after their declarations; here declarations are checked as they
--- are assigned, so both are accepted and do nothing.
-base.skillenv = readonly({skill_module = function() end, module_init = function() end},
-                         "skillenv")
-base.module = function() end
+-- are assigned, so both are accepted and do nothing (a file already is its own module).
+local noop = function() end
+base.skillenv = readonly({skill_module = noop, module_init = noop, use_skill = noop}, "skillenv")
+local loading  -- the handle whose file is running (set by E.begin_module)
+-- module(...) marks a file written for Fawkes (see define_states: state timeouts).
+base.module = function() if loading then loading.fawkes_style = true end end
+-- What skills written for Fawkes find besides (fawkes.lua): fawkes.Time, fawkes.tf, fawkes.modinit,
+-- fawkes.load_yaml_navgraph, the tf transformer, the config, require's built-in modules.
+local fawkes = native.fawkes
+local fawkes_tf
+do
+  local tf_classes = {}
+  for k, v in pairs(fawkes.fawkes.tf) do
+    tf_classes[k] = type(v) == "table" and readonly(v, "fawkes.tf." .. k) or v
+  end
+  fawkes_tf = readonly(tf_classes, "fawkes.tf")
+end
+local fawkes_modinit = readonly(fawkes.fawkes.modinit, "fawkes.modinit")
+base.Time = readonly(fawkes.Time, "fawkes.Time")
+base.fawkes = readonly({Time = base.Time, tf = fawkes_tf, modinit = fawkes_modinit,
+                        load_yaml_navgraph = fawkes.fawkes.load_yaml_navgraph}, "fawkes")
+base.tf = readonly(fawkes.tf_transformer, "tf")
+base.config = readonly(fawkes.config, "config")
+local builtin_modules = {["fawkes.modinit"] = fawkes_modinit, ["fawkes.tf"] = fawkes_tf}
 base.clock = native.clock
 frozen[native.clock] = "clock"
 
@@ -192,7 +213,7 @@ local handles = {}       -- name -> handle
 local proxies = {}       -- name -> what skills and skill strings see of the handle (read-only)
 local real_of = setmetatable({}, {__mode = "k"})  -- proxy -> handle
 local handle_list = {}   -- handles in load order (deterministic iteration)
-local loading = nil      -- the handle whose file is running
+loading = nil            -- the handle whose file is running
 local interface_types = native.interfaces  -- type name -> interface object (read-only)
 for type_name, obj in pairs(interface_types) do frozen[obj] = type_name end
 local conventional_vars = {pose = "Position3DInterface", navigator = "NavigatorInterface",
@@ -277,8 +298,6 @@ local unavailable = {
   os = "no files, processes or wall clock: for time use clock.now() (game seconds) " ..
        "or a transition's timeout=SECS",
   io = "no files or terminal: print(...) / printf(fmt, ...) write to the log",
-  require = "skills load no modules: name another skill in depends_skills = {\"skill\"} and " ..
-            "call it from a SkillJumpState (skills={{skill}})",
   package = "skills load no modules: name another skill in depends_skills = {\"skill\"}",
   dofile = "skills load no other files: name another skill in depends_skills = {\"skill\"}",
   loadfile = "skills load no other files: name another skill in depends_skills = {\"skill\"}",
@@ -356,7 +375,20 @@ local function module_env(h)
   mt.__index = function(t, k)
     local v = base[k]
     if v == nil then v = h.bindings[k] end
-    if v == nil then error(undeclared(h, k, t), 2) end
+    if v == nil then
+      -- A file written for Fawkes (module(...)) reads unknown globals as nil, as Fawkes'
+      -- modules did (the team's closures name functions that do not exist): a warning, once.
+      if h.fawkes_style then
+        h.nil_globals = h.nil_globals or {}
+        if not h.nil_globals[k] then
+          h.nil_globals[k] = true
+          log(2, fmt("%s: %s (nil: a file written for Fawkes reads unknown globals as nil)",
+                     where(2), undeclared(h, k, t)))
+        end
+        return nil
+      end
+      error(undeclared(h, k, t), 2)
+    end
     rawset(t, k, v)
     return v
   end
@@ -385,11 +417,14 @@ local function module_env(h)
         if type(d) ~= "table" or type(d.v) ~= "string" or type(d.type) ~= "string" then
           error(fmt("depends_interfaces[%d]: expected {v=\"name\", type=\"Type\"[, id=\"Id\"]}", i), 2)
         end
-        local obj = interface_types[d.type]
+        -- Fawkes' types (fawkes.lua) by id, with llsfsim's methods at the default id.
+        local obj, why = fawkes.interface(d.type, d.id, d.v, d.writing, h.fawkes_style)
         if not obj then
-          error(fmt("depends_interfaces[%d]: unknown interface type '%s' (known: %s)", i, d.type,
-                    native.interface_names), 2)
+          error(fmt("depends_interfaces[%d]: %s", i, why or
+                    fmt("unknown interface type '%s' (known: %s)", d.type,
+                        concat(fawkes.type_names(), ", "))), 2)
         end
+        if not frozen[obj] then frozen[obj] = d.type end
         h.bindings[d.v] = obj
       end
     end
@@ -397,6 +432,72 @@ local function module_env(h)
   end
   env._M = env
   return setmetatable(env, mt)
+end
+
+-- require: helper modules ---------------------------------------------------------------------
+-- Fawkes' skills share code through Lua modules (a team's tf_module.lua, machine_pos_module.lua):
+-- require("name") loads name.lua ("a.b": a/b.lua) of the module directories or else of the skill
+-- directories, once per interpreter, read-only, in an environment of its own over the skills'
+-- globals; it returns what the file returns, else its globals (its _M, as Fawkes' module()).
+local modules = {}    -- name -> the module
+local requiring = {}  -- names being loaded (a cycle is an error)
+
+-- Unknown globals read as nil (as in Fawkes' modules), with a warning once per name.
+local function helper_env(name)
+  local env, warned = {}, {}
+  env._M = env
+  return setmetatable(env, {__metatable = false, __index = function(_, k)
+    local v = base[k]
+    if v == nil and not warned[k] then
+      warned[k] = true
+      local candidates = {}
+      for n in pairs(base) do candidates[#candidates + 1] = n end
+      log(2, fmt("%s: undeclared global '%s' (in module '%s')%s is nil", where(2), tostring(k),
+                 name, did_you_mean(k, candidates)))
+    end
+    return v
+  end})
+end
+
+base.require = function(name)
+  if type(name) ~= "string" then error("require: expected a module name (a string)", 2) end
+  local m = modules[name] or builtin_modules[name]
+  if m ~= nil then return m end
+  if requiring[name] then error(fmt("require: module '%s' requires itself (a cycle)", name), 2) end
+  local text, path, in_skill_dir = native.read_module(name)
+  -- The file of a skill of the skill directories (a module directory did not have the name).
+  local h = handles[name]
+  local own = h and not h.is_module and in_skill_dir
+  local function is_skill()
+    error(fmt("require: '%s' is a skill: name it in depends_skills = {\"%s\"} and call it " ..
+              "from a SkillJumpState (skills={{%s}})", name, name, name), 3)
+  end
+  if own and (h.load_error or h.fsm or h.env and rawget(h.env, "name") ~= nil) then is_skill() end
+  if not text then
+    error(fmt("module '%s' is not available in skills: require loads only the Lua files of " ..
+              "the skill and module directories (%s); to use another skill, name it in " ..
+              "depends_skills = {\"skill\"} and call it from a SkillJumpState " ..
+              "(skills={{skill}})", name, path), 2)
+  end
+  local env = helper_env(name)
+  local chunk, err = load(text, "@" .. path, "t", env)
+  if not chunk then error(err, 0) end
+  local outer = loading
+  requiring[name], loading = true, nil
+  local ok, ret = raw_pcall(chunk, name)
+  requiring[name], loading = nil, outer
+  -- A skill file not loaded yet: it declares a skill (or makes a state machine, which only a
+  -- skill file may).
+  if own and ((ok and (rawget(env, "name") ~= nil or rawget(env, "fsm") ~= nil or
+                       rawget(env, "execute") ~= nil)) or
+              (not ok and type(ret) == "string" and ret:find("SkillHSM:new can only be called",
+                                                             1, true))) then
+    is_skill()
+  end
+  if not ok then error(ret, 0) end
+  if ret == nil then ret = env end
+  modules[name] = ret
+  return ret
 end
 
 -- States -------------------------------------------------------------------------------------
@@ -429,7 +530,7 @@ local function args_watch(st)
     rawset(t, k, v)
     if warned[k] then return end
     local names = {}
-    for i, sk in ipairs(st.skills or {}) do
+    for i, sk in ipairs(st.subskills or {}) do
       if sk.handle.name == k then return end
       names[i] = sk.handle.name
     end
@@ -489,6 +590,9 @@ end
 
 function SkillHSM:define_states(spec)
   local export = spec.export_to or self.skill.env
+  for _, st in ipairs{self.final, self.failed} do
+    if rawget(export, st.name) == nil then rawset(export, st.name, st) end
+  end
   for k, v in pairs(spec.closure or {}) do self.closure[k] = v end
   local pending = {}
   for _, e in ipairs(spec) do
@@ -504,16 +608,26 @@ function SkillHSM:define_states(spec)
       if type(e.skills) ~= "table" or #e.skills == 0 then
         error(fmt("SkillJumpState '%s' needs skills={{skill}, ...}", name), 2)
       end
-      st.skills = {}
+      -- st.subskills: the engine's; st.skills: Fawkes' self.skills[i], one table per sub-skill
+      -- holding it at [1] and its arguments (the static ones of the definition, and what init()
+      -- sets: self.skills[1].place = ...). They stay set from one entry of the state to the next,
+      -- as in Fawkes, where they were the definition's own table.
+      st.subskills, st.skills, st.call_args = {}, {}, {}
       for i, s in ipairs(e.skills) do
-        st.skills[i] = resolve_subskill(self, type(s) == "table" and not s.is_skill and s or {s}, 3)
+        local sub = resolve_subskill(self, type(s) == "table" and not s.is_skill and s or {s}, 3)
+        st.subskills[i] = sub
+        local spec = {proxies[sub.handle.name]}
+        for k, v in pairs(sub.static or {}) do spec[k] = v end
+        st.skills[i] = spec
       end
       st.final_to, st.fail_to = e.final_to, e.fail_to or "FAILED"
       if type(st.final_to) ~= "string" then
         error(fmt("SkillJumpState '%s' needs final_to=\"STATE\"", name), 2)
       end
     end
-    if e.timeout ~= nil then pending[#pending + 1] = {st, e.timeout} end
+    -- timeout= of a state definition is llsfsim's; Fawkes' skiller (2013) ignored it, and so
+    -- does a file written for Fawkes (module(..., skillenv.module_init)).
+    if e.timeout ~= nil and not self.skill.fawkes_style then pending[#pending + 1] = {st, e.timeout} end
     rawset(export, name, st)
   end
   for _, st in ipairs(self.state_list) do
@@ -582,8 +696,31 @@ function SkillHSM:add_transitions(spec)
                 to, unknown_state(self, to)), 2)
     end
     local tr = {from = from, to = self.states[to], desc = t.desc, error = t.error, where = loc}
-    if t.cond ~= nil then tr.cond = compile_cond(self, t.cond, "cond", loc, 3) end
-    if t.precond ~= nil then tr.precond = compile_cond(self, t.precond, "precond", loc, 3) end
+    local text
+    if self.skill.fawkes_style and from then
+      -- As Fawkes' add_transitions: the condition is t[3] or cond=; precond=COND is the
+      -- condition of a transition and a precondition both, precond=true makes cond one too,
+      -- precond_only=COND a precondition only.
+      local c = t[3]
+      if c == nil then c = t.cond end
+      if type(t.precond) ~= "boolean" and type(t.precond_only) ~= "boolean" then
+        if c == nil then c = t.precond end
+        if c == nil then c = t.precond_only end
+      end
+      text = c
+      if c ~= nil then
+        local f = compile_cond(self, c, "cond", loc, 3)
+        if t.precond_only then
+          tr.precond = f
+        else
+          tr.cond = f
+          if t.precond then tr.precond = f end
+        end
+      end
+    else
+      if t.cond ~= nil then tr.cond = compile_cond(self, t.cond, "cond", loc, 3) end
+      if t.precond ~= nil then tr.precond = compile_cond(self, t.precond, "precond", loc, 3) end
+    end
     if t.cond_and_precond ~= nil then
       tr.cond = compile_cond(self, t.cond_and_precond, "cond", loc, 3)
       tr.precond = tr.cond
@@ -600,7 +737,7 @@ function SkillHSM:add_transitions(spec)
     if not tr.cond and not tr.precond and not tr.timeout_ns then
       error(fmt("add_transitions: transition to '%s' needs cond, precond or timeout", to), 2)
     end
-    local text = t.cond or t.cond_and_precond or t.precond
+    text = text or t.cond or t.cond_and_precond or t.precond
     tr.label = tr.label or tr.desc or (type(text) == "string" and text) or "condition"
     -- As written, for messages: {"CHECK", "FINAL", cond="vars.done"}.
     local parts = {fmt("\"%s\"", from or "*"), fmt("\"%s\"", to)}
@@ -629,6 +766,8 @@ end
 -- Skill calls --------------------------------------------------------------------------------
 local call_skill, reset_skill
 
+local spec_args
+
 -- A condition reading a key of vars that nothing set (vars.arived for vars.arrived) never holds:
 -- the keys conditions missed are kept per state machine (key -> transition), for the check of a
 -- state that waits long (fsm_step) and the report of a skill still running at the end.
@@ -654,11 +793,11 @@ end
 -- Sub-skills of a SkillJumpState: next state and error text once they are done.
 local function run_subskills(fsm, st)
   local all_final = true
-  local skills = st.skills
+  local skills = st.subskills
   for i = 1, #skills do
     local sk = skills[i]
     local h = sk.handle
-    local status = call_skill(h, st.args[h.name] or sk.static or fsm.vars)
+    local status = call_skill(h, st.call_args[i] or st.args[h.name] or fsm.vars)
     if status == S_FAILED then
       return fsm.states[st.fail_to], fmt("%s()/%s failed: %s", st.name, h.name,
                                           tostring(h.error))
@@ -668,6 +807,26 @@ local function run_subskills(fsm, st)
   end
   if all_final then return fsm.states[st.final_to], nil end
   return nil, nil
+end
+
+-- The arguments of each sub-skill of `st` as Fawkes' SkillJumpState made them on entry: the
+-- keys of self.skills[i] other than [1], merged with self.args[name] (its keys win); neither:
+-- the sub-skill gets the skill's own fsm.vars (st.call_args[i] nil, self.args read per call).
+spec_args = function(st)
+  for i, sk in ipairs(st.subskills) do
+    local spec, args = st.skills[i], nil
+    for k, v in pairs(spec) do
+      if k ~= 1 then
+        args = args or {}
+        args[k] = v
+      end
+    end
+    local a = args and st.args[sk.handle.name]
+    if type(a) == "table" then
+      for k, v in pairs(a) do args[k] = v end
+    end
+    st.call_args[i] = args
+  end
 end
 
 -- Enters `st` (following preconditions) and returns the state actually entered.
@@ -695,10 +854,11 @@ local function enter(fsm, st, now)
   st.error = nil
   fsm.current = st
   fsm.running = st
-  if st.skills then
-    for _, sk in ipairs(st.skills) do reset_skill(sk.handle) end
+  if st.subskills then
+    for _, sk in ipairs(st.subskills) do reset_skill(sk.handle) end
   end
   if st.init then st:init() end
+  if st.subskills then spec_args(st) end
   return st
 end
 
@@ -798,7 +958,7 @@ local function fsm_step(fsm)
     if st.loop then st:loop() end
     local to, tr, err = nil, nil, nil
     if fsm.error == nil then
-      if st.skills then
+      if st.subskills then
         progress = true
         to, err = run_subskills(fsm, st)
       end
@@ -829,7 +989,7 @@ local function fsm_step(fsm)
       trs[#trs + 1] = tr
       if tr.timeout_ns then progress = true end
     else  -- what took it there, for skill_state's `via`
-      trs[#trs + 1] = err and "fail_to" or (st.skills and fsm.error == nil and "final_to") or
+      trs[#trs + 1] = err and "fail_to" or (st.subskills and fsm.error == nil and "final_to") or
                       "error"
     end
     leave(fsm, st, to, tr, err)
@@ -906,6 +1066,10 @@ reset_skill = function(h)
 end
 
 call_skill = function(h, args)
+  if h.is_module then
+    error(fmt("'%s' is no skill: %s defines none (a helper module for require)", h.name,
+              h.path or h.name), 0)
+  end
   if h.load_error then
     error(fmt("skill '%s' is not available: %s", h.name, h.load_error), 0)
   end
@@ -1005,6 +1169,10 @@ end
 function E.begin_module(name, path)
   local h = handles[name]
   h.path = path
+  if modules[name] ~= nil then  -- loaded by a require already: a helper module
+    h.is_module = true
+    return nil
+  end
   h.env = module_env(h)
   loading = h
   return h.env
@@ -1019,6 +1187,18 @@ function E.finish_module(name)
   -- the declarations go), else line 1.
   local at = h.name_where or (h.path .. ":1")
   local function fail(msg) error(at .. ": " .. msg, 0) end
+  -- A file that declares nothing of a skill is a helper module (Fawkes loaded only the files
+  -- its skill space named): not a skill, and what require returns for its name.
+  local declared = false
+  for _, k in ipairs{"name", "fsm", "documentation", "depends_skills", "depends_interfaces",
+                     "execute"} do
+    if rawget(env, k) ~= nil then declared = true end
+  end
+  if not declared then
+    h.is_module = true
+    modules[h.name] = env
+    return
+  end
   if rawget(env, "name") == nil then
     fail(fmt("the skill declares no 'name': add name = \"%s\" at the top of the file", h.name))
   end
@@ -1056,7 +1236,7 @@ function E.finish_module(name)
     -- of every state) would only show as "still running" at the end: warn at load.
     if #fsm.defaults == 0 then
       for _, st in ipairs(fsm.state_list) do
-        if st.kind ~= "final" and st.kind ~= "failed" and not st.skills and
+        if st.kind ~= "final" and st.kind ~= "failed" and not st.subskills and
            #st.transitions == 0 and #st.preconds == 0 then
           log(2, fmt("%s: %s: state '%s' has no way out: no transition, timeout or sub-skill " ..
                      "leaves it, so the skill would stay there; add one (fsm:add_transitions" ..
@@ -1072,6 +1252,24 @@ function E.finish_module(name)
   h.documentation = env.documentation
 end
 
+-- A Fawkes skill space: the init.lua of a skill directory names its skills with
+-- skillenv.use_skill("skills.<space>.<name>"). Runs it with only what such a file uses and
+-- returns the names (the last part of each), or nil and why it could not run.
+function E.skill_space(text, chunkname)
+  local names = {}
+  local function use_skill(m)
+    if type(m) == "string" then names[#names + 1] = m:match("([^.]+)$") end
+  end
+  local env = {skillenv = {use_skill = use_skill},
+               fawkes = {modinit = {register_all = noop, module_init = noop}},
+               module = noop, require = function() return {} end, print = noop, printf = noop}
+  local chunk, err = load(text, chunkname, "t", env)
+  if not chunk then return nil, err end
+  local ok, e = raw_pcall(chunk)
+  if not ok then return nil, error_text(e) end
+  return names
+end
+
 function E.set_load_error(name, msg)
   loading = nil
   handles[name].load_error = msg
@@ -1085,7 +1283,11 @@ function E.resolve()
     for _, h in ipairs(handle_list) do
       if not h.load_error then
         for _, dep in ipairs(h.depends) do
-          if handles[dep].load_error then
+          if handles[dep].is_module then
+            h.load_error = fmt("depends_skills: '%s' is no skill (a helper module)", dep)
+            changed = true
+            break
+          elseif handles[dep].load_error then
             h.load_error = fmt("depends on skill '%s', which failed to load", dep)
             changed = true
             break
@@ -1098,7 +1300,7 @@ end
 
 function E.skill_info(name)
   local h = handles[name]
-  if not h then return nil end
+  if not h or h.is_module then return nil end
   local state = h.fsm and h.fsm.current and h.fsm.current.name or ""
   return h.status, h.error or "", state, h.load_error or "", h.path or "",
          h.documentation or "", concat(h.depends, ",")
@@ -1134,9 +1336,9 @@ function E.skill_wait(name)
   local st = fsm and fsm.current
   if not st or st.kind == "final" or st.kind == "failed" or h.status ~= S_RUNNING then return nil end
   local out = fmt("in state %s since %.2f s", st.name, st.entered_ns / 1e9)
-  if st.skills then
+  if st.subskills then
     local names = {}
-    for i, sk in ipairs(st.skills) do names[i] = sk.handle.name end
+    for i, sk in ipairs(st.subskills) do names[i] = sk.handle.name end
     return out .. fmt(", its sub-skill(s) %s still running", concat(names, ", "))
   end
   local waits = {}
@@ -1162,9 +1364,12 @@ function E.compile(s)
   return load(s, "=skill string", "t", string_env)
 end
 
+local fawkes_poll = fawkes.poll
+
 function E.run_cycle(chunk)
   cycle_id = cycle_id + 1
   cycle_now_ns = now_ns()
+  fawkes_poll()
   for i = #called, 1, -1 do called[i] = nil end
   depth, caller = 0, nil
   chunk()
@@ -1191,6 +1396,11 @@ function E.run_cycle(chunk)
     end
   end
   return status, errors and concat(errors, "; ") or nil, results and concat(results, "; ") or ""
+end
+
+-- The blackboard interfaces skills wrote since the last call (fawkes.lua, F.written).
+function E.written_interfaces()
+  return fawkes.written()
 end
 
 function E.reset_all()

@@ -12,6 +12,8 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <map>
+#include <set>
 #include <sstream>
 #include <system_error>
 
@@ -60,12 +62,18 @@ void SkillEngineConfig::validate() const {
                 static_cast<double>(allocation_budget_bytes),
                 core::in_range(1 << 20, kMaxMemoryBytes));
   core::require("skill engine: max_cycle_wall_s", max_cycle_wall_s, core::in_range(0.01, 3600.0));
-  for (const std::string& dir : skill_dirs) {
-    std::error_code ec;
-    if (!fs::is_directory(dir, ec)) {
-      throw core::ConfigError("skill engine: skill directory '" + dir + "' does not exist");
+  const auto check_dirs = [](const std::vector<std::string>& dirs, const char* what) {
+    for (const std::string& dir : dirs) {
+      std::error_code ec;
+      if (!fs::is_directory(dir, ec)) {
+        throw core::ConfigError(std::string("skill engine: ") + what + " '" + dir +
+                                "' does not exist");
+      }
     }
-  }
+  };
+  check_dirs(skill_dirs, "skill directory");
+  check_dirs(module_dirs, "module directory");
+  check_dirs(cfg_dirs, "cfg directory");
 }
 
 SkillEngineConfig SkillEngineConfig::from_config(const core::ConfigNode& node,
@@ -84,6 +92,39 @@ SkillEngineConfig SkillEngineConfig::from_config(const core::ConfigNode& node,
   }
   // Each figure checked at its own key (validate() below repeats the checks for configs built
   // in code).
+  // module_dirs, cfg_dirs: like skill_dirs (relative to the file).
+  const auto read_dirs = [&](std::string_view key, std::vector<std::string>& out) {
+    const core::ConfigNode list = node[key];
+    if (!list.defined()) return;
+    if (!list.is_sequence()) list.fail("expected a list of directories");
+    for (const core::ConfigNode& d : list.elements()) {
+      const fs::path dir(d.as_string());
+      out.push_back(dir.is_absolute() || base_dir.empty()
+                        ? dir.string()
+                        : (fs::path(base_dir) / dir).lexically_normal().string());
+    }
+  };
+  read_dirs("module_dirs", cfg.module_dirs);
+  read_dirs("cfg_dirs", cfg.cfg_dirs);
+  // fawkes_config: a tree of maps whose leaves are the values, flattened to "/a/b/c" paths.
+  if (const core::ConfigNode tree = node["fawkes_config"]; tree.defined()) {
+    tree.require_map();
+    std::vector<std::pair<std::string, core::ConfigNode>> todo{{"", tree}};
+    while (!todo.empty()) {
+      auto [prefix, n] = todo.back();
+      todo.pop_back();
+      for (const std::string& key : n.keys()) {
+        const core::ConfigNode v = n[key];
+        if (v.is_map()) {
+          todo.emplace_back(prefix + "/" + key, v);
+        } else if (v.is_scalar()) {
+          cfg.fawkes_config[prefix + "/" + key] = v.as_string();
+        } else {
+          v.fail("expected a value or a map of values (lists are not offered)");
+        }
+      }
+    }
+  }
   node.read("rate_hz", cfg.rate_hz, core::in_range(0.1, 10000.0));
   const auto read_int = [&](std::string_view key, std::int64_t& out, double lo, double hi) {
     const core::ConfigNode v = node[key];
@@ -112,6 +153,7 @@ SkillEngineConfig SkillEngineConfig::from_config(const core::ConfigNode& node,
 namespace {
 
 constexpr const char* kPreludeChunkName = "=llsf/prelude.lua";
+constexpr const char* kFawkesChunkName = "=llsf/fawkes.lua";
 
 // Where a refused allocation happened: the innermost frame of a skill file (chunk names "@path")
 // and its current line, for Impl::explain(). Lua's memory error has no position, and Lua calls no
@@ -195,15 +237,15 @@ void budget_hook(lua_State* L, lua_Debug* ar) {
   e.budget_exhausted = true;
   // Name the skill's line: the hook may fire in the prelude's code (a library wrapper, the DSL
   // runtime) running on the skill's behalf; then the nearest caller outside the prelude.
+  const auto internal = [](const char* source) {
+    return std::strcmp(source, kPreludeChunkName) == 0 ||
+           std::strcmp(source, kFawkesChunkName) == 0;
+  };
   lua_getinfo(L, "Sl", ar);
   lua_Debug caller{};
-  for (int level = 1;
-       std::strcmp(ar->source, kPreludeChunkName) == 0 && lua_getstack(L, level, &caller) != 0;
-       ++level) {
+  for (int level = 1; internal(ar->source) && lua_getstack(L, level, &caller) != 0; ++level) {
     lua_getinfo(L, "Sl", &caller);
-    if (caller.currentline > 0 && std::strcmp(caller.source, kPreludeChunkName) != 0) {
-      ar = &caller;
-    }
+    if (caller.currentline > 0 && !internal(caller.source)) ar = &caller;
   }
   if (out_of_time) {
     const std::string secs = core::number_text(e.config.max_cycle_wall_s);
@@ -449,12 +491,14 @@ std::vector<SkillFile> SkillEngine::Impl::scan() const {
     std::error_code ec;
     for (const fs::directory_entry& entry : fs::directory_iterator(dir, ec)) {
       const fs::path& p = entry.path();
-      if (p.extension() != ".lua" || p.filename() == "init.lua") continue;
+      if (p.extension() != ".lua") continue;
       // One stat() per file: this runs at every exec() with hot reload on.
       struct stat st {};
       if (::stat(p.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) continue;
       SkillFile f;
-      f.name = p.stem().string();
+      f.space_init = p.filename() == "init.lua";
+      // (init.lua under a name no skill file has: "init@dir")
+      f.name = f.space_init ? "init@" + dir : p.stem().string();
       f.path = p.string();
       f.size = static_cast<std::int64_t>(st.st_size);
       f.mtime_ns = static_cast<std::int64_t>(st.st_mtim.tv_sec) * 1'000'000'000 +
@@ -536,13 +580,55 @@ void SkillEngine::Impl::build() {
   push_interfaces(L);  // sets native.interfaces, interface_names, clock
   push_pattern_functions(L);
   lua_setfield(L, -2, "patterns");
+  push_fawkes_natives(L);
+  // The Fawkes layer (fawkes.lua) gets the natives too; its table goes to the prelude as
+  // native.fawkes.
+  if (luaL_loadbufferx(L, kFawkesLayer, std::char_traits<char>::length(kFawkesLayer),
+                       kFawkesChunkName, "t") != LUA_OK) {
+    LLSF_DEMAND_MSG(false, "fawkes layer: " + pop_message(L));
+  }
+  lua_pushvalue(L, -2);
+  if (protected_call(1, 1) != LUA_OK) LLSF_DEMAND_MSG(false, "fawkes layer: " + pop_message(L));
+  lua_setfield(L, -2, "fawkes");
   if (protected_call(1, 1) != LUA_OK) LLSF_DEMAND_MSG(false, "prelude: " + pop_message(L));
   engine_ref = luaL_ref(L, LUA_REGISTRYINDEX);
 
+  // Fawkes skill spaces: a directory whose init.lua names skills with skillenv.use_skill(...)
+  // has only those as skills; its other files are helper modules for require (or nothing).
+  std::map<std::string, std::set<std::string>> spaces;  // directory -> the skills it names
+  for (const SkillFile& f : files) {
+    if (!f.space_init) continue;
+    std::string read_error;
+    const std::string text = read_file(f.path, read_error);
+    if (!read_error.empty()) continue;  // (no space: every file is a skill)
+    lua_pushlstring(L, text.data(), text.size());
+    lua_pushstring(L, ("@" + display_path(f.path)).c_str());
+    if (call_entry("skill_space", 2, 1) != LUA_OK || !lua_istable(L, -1)) {
+      lua_settop(L, 0);
+      continue;
+    }
+    std::set<std::string> names;
+    const lua_Integer n = static_cast<lua_Integer>(lua_rawlen(L, -1));
+    for (lua_Integer i = 1; i <= n; ++i) {
+      lua_rawgeti(L, -1, i);
+      if (const char* name = lua_tostring(L, -1); name != nullptr) names.insert(name);
+      lua_pop(L, 1);
+    }
+    lua_settop(L, 0);
+    if (!names.empty()) spaces[fs::path(f.path).parent_path().lexically_normal().string()] = names;
+  }
+  std::vector<const SkillFile*> skill_files;
+  for (const SkillFile& f : files) {
+    if (f.space_init) continue;
+    const auto space = spaces.find(fs::path(f.path).parent_path().lexically_normal().string());
+    if (space != spaces.end() && space->second.count(f.name) == 0) continue;
+    skill_files.push_back(&f);
+  }
+
   // Handles for every skill first, so that depends_skills can be checked while files load.
-  lua_createtable(L, static_cast<int>(files.size()), 0);
-  for (std::size_t i = 0; i < files.size(); ++i) {
-    lua_pushstring(L, files[i].name.c_str());
+  lua_createtable(L, static_cast<int>(skill_files.size()), 0);
+  for (std::size_t i = 0; i < skill_files.size(); ++i) {
+    lua_pushstring(L, skill_files[i]->name.c_str());
     lua_rawseti(L, -2, static_cast<lua_Integer>(i + 1));
   }
   if (call_entry("declare_skills", 1, 0) != LUA_OK) {
@@ -550,7 +636,8 @@ void SkillEngine::Impl::build() {
   }
 
   loading_files = true;
-  for (const SkillFile& f : files) {
+  for (const SkillFile* file : skill_files) {
+    const SkillFile& f = *file;
     std::string load_error;
     std::string read_error;
     const std::string& shown = display_path(f.path);
@@ -564,6 +651,8 @@ void SkillEngine::Impl::build() {
       lua_pushstring(L, shown.c_str());
       if (call_entry("begin_module", 2, 1) != LUA_OK) {
         load_error = pop_message(L);
+      } else if (lua_isnil(L, -1)) {
+        lua_pop(L, 1);  // a helper module a skill has loaded with require already
       } else {
         const std::string chunkname = "@" + shown;
         if (luaL_loadbufferx(L, text.data(), text.size(), chunkname.c_str(), "t") != LUA_OK) {
@@ -782,18 +871,91 @@ std::vector<SkillInfo> SkillEngine::skills() const {
     SkillInfo info;
     info.name = f.name;
     info.path = f.path;
-    with_skill_info(*impl_, f.name,
-                    [&](SkillStatus, const std::string&, const std::string&, std::string load_error,
-                        const std::string&, std::string doc, const std::string& deps) {
-                      info.load_error = std::move(load_error);
-                      info.documentation = std::move(doc);
-                      std::stringstream ss(deps);
-                      for (std::string d; std::getline(ss, d, ',');) {
-                        info.depends_skills.push_back(d);
-                      }
-                    });
-    out.push_back(std::move(info));
+    // (helper modules, files that define no skill, are not listed)
+    const bool skill = with_skill_info(
+        *impl_, f.name,
+        [&](SkillStatus, const std::string&, const std::string&, std::string load_error,
+            const std::string&, std::string doc, const std::string& deps) {
+          info.load_error = std::move(load_error);
+          info.documentation = std::move(doc);
+          std::stringstream ss(deps);
+          for (std::string d; std::getline(ss, d, ',');) {
+            info.depends_skills.push_back(d);
+          }
+        });
+    if (skill) out.push_back(std::move(info));
   }
+  return out;
+}
+
+std::vector<WrittenInterface> SkillEngine::written_interfaces() {
+  Impl& e = *impl_;
+  std::vector<WrittenInterface> out;
+  if (e.L == nullptr || e.call_entry("written_interfaces", 0, 1) != LUA_OK) {
+    lua_settop(e.L, 0);
+    return out;
+  }
+  // {{type=, id=, serial=, fields={{name, kind, value}, ...}}, ...} (fawkes.lua, F.written)
+  lua_State* L = e.L;
+  const auto text = [L](int index) {
+    std::size_t n = 0;
+    const char* s = lua_type(L, index) == LUA_TSTRING ? lua_tolstring(L, index, &n) : nullptr;
+    return s != nullptr ? std::string(s, n) : std::string();
+  };
+  const auto add_value = [L, &text](InterfaceField& f, int index) {
+    if (f.kind == InterfaceField::Kind::kSymbol || f.kind == InterfaceField::Kind::kString) {
+      f.texts.push_back(text(index));
+    } else if (f.kind == InterfaceField::Kind::kBool) {
+      f.numbers.push_back(lua_toboolean(L, index) != 0 ? 1.0 : 0.0);
+    } else {
+      f.numbers.push_back(lua_tonumber(L, index));
+    }
+  };
+  const lua_Integer n = static_cast<lua_Integer>(lua_rawlen(L, -1));
+  for (lua_Integer i = 1; i <= n; ++i) {
+    lua_rawgeti(L, -1, i);
+    WrittenInterface w;
+    lua_getfield(L, -1, "type");
+    w.type = text(-1);
+    lua_getfield(L, -2, "id");
+    w.id = text(-1);
+    lua_getfield(L, -3, "serial");
+    w.serial = static_cast<std::int64_t>(lua_tointeger(L, -1));
+    lua_pop(L, 3);
+    lua_getfield(L, -1, "fields");
+    const lua_Integer nf = static_cast<lua_Integer>(lua_rawlen(L, -1));
+    for (lua_Integer j = 1; j <= nf; ++j) {
+      lua_rawgeti(L, -1, j);
+      InterfaceField f;
+      lua_rawgeti(L, -1, 1);
+      f.name = text(-1);
+      lua_rawgeti(L, -2, 2);
+      const std::string kind = text(-1);
+      f.kind = kind == "string"    ? InterfaceField::Kind::kString
+               : kind == "integer" ? InterfaceField::Kind::kInteger
+               : kind == "float"   ? InterfaceField::Kind::kFloat
+               : kind == "bool"    ? InterfaceField::Kind::kBool
+                                   : InterfaceField::Kind::kSymbol;
+      lua_pop(L, 2);
+      lua_rawgeti(L, -1, 3);
+      if (lua_istable(L, -1)) {
+        f.array = true;
+        const lua_Integer ne = static_cast<lua_Integer>(lua_rawlen(L, -1));
+        for (lua_Integer k = 1; k <= ne; ++k) {
+          lua_rawgeti(L, -1, k);
+          add_value(f, -1);
+          lua_pop(L, 1);
+        }
+      } else {
+        add_value(f, -1);
+      }
+      lua_pop(L, 2);  // value, field entry
+      w.fields.push_back(std::move(f));
+    }
+    lua_pop(L, 2);  // fields, entry
+    out.push_back(std::move(w));
+  }
+  lua_settop(L, 0);
   return out;
 }
 

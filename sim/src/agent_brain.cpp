@@ -147,10 +147,80 @@ void AgentBrain::set_trace(clips::TraceOptions options, clips::TraceSink sink) {
 
 void AgentBrain::on_skill_cycle(lua::RobotApi& robot) { skills_->on_skill_cycle(robot); }
 
+namespace {
+
+const char* lamp_symbol(lua::Lamp l) {
+  switch (l) {
+    case lua::Lamp::kOn:
+      return "ON";
+    case lua::Lamp::kBlink:
+      return "BLINKING";
+    case lua::Lamp::kOff:
+      return "OFF";
+  }
+  return "UNKNOWN";
+}
+
+clips::Value field_value(const lua::InterfaceField& f) {
+  using Kind = lua::InterfaceField::Kind;
+  const auto element = [&f](std::size_t i) {
+    switch (f.kind) {
+      case Kind::kString:
+        return clips::Value::string(f.texts[i]);
+      case Kind::kInteger:
+        return clips::Value::integer_value(static_cast<std::int64_t>(f.numbers[i]));
+      case Kind::kFloat:
+        return clips::Value::float_value(f.numbers[i]);
+      case Kind::kBool:
+        return clips::Value::boolean(f.numbers[i] != 0.0);
+      case Kind::kSymbol:
+        break;
+    }
+    return clips::Value::symbol(f.texts[i]);
+  };
+  const std::size_t n =
+      f.kind == Kind::kSymbol || f.kind == Kind::kString ? f.texts.size() : f.numbers.size();
+  if (!f.array) return n > 0 ? element(0) : clips::Value{};
+  std::vector<clips::Value> items;
+  for (std::size_t i = 0; i < n; ++i) items.push_back(element(i));
+  return clips::Value::multifield(std::move(items));
+}
+
+}  // namespace
+
 void AgentBrain::on_agent_cycle(lua::RobotApi& robot, RobotRadio& radio) {
   if (halt_) return;  // halted: no cycle (the game clears the inbox)
   const lua::PoseEstimate pose = robot.pose();
   if (pose.valid) agent_->set_pose(pose.pose);
+  if (host_config_.fawkes) {
+    // The light detection as Fawkes' light plugin wrote RobotinoLightInterface "Light_State"
+    // (docs/fawkes.md): the lamps (UNKNOWN while no device is seen), ready while one is, and
+    // visibility_history in frames of the skill rate since the reading last changed (negative:
+    // since the device was lost), as the skills' interface of that id counts them.
+    const lua::LightReading light = robot.light();
+    const core::SimTime now = robot.now();
+    if (light.visible != light_seen_ && !light.visible) light_lost_since_ = now;
+    light_seen_ = light.visible;
+    const std::int64_t frame_ns = skills_->engine().cycle_period().ns();
+    const std::int64_t since_ns =
+        (now - (light.visible ? light.stable_since : light_lost_since_)).ns();
+    const std::int64_t frames =
+        (frame_ns > 0 ? std::max<std::int64_t>(since_ns, 0) / frame_ns : 0) + 1;
+    using clips::Value;
+    agent_->write_interface(
+        "RobotinoLightInterface", "Light_State",
+        {{"red", Value::symbol(light.visible ? lamp_symbol(light.red) : "UNKNOWN")},
+         {"yellow", Value::symbol(light.visible ? lamp_symbol(light.yellow) : "UNKNOWN")},
+         {"green", Value::symbol(light.visible ? lamp_symbol(light.green) : "UNKNOWN")},
+         {"visibility_history", Value::integer_value(light.visible ? frames : -frames)},
+         {"ready", Value::boolean(light.visible)}});
+    // What the skills wrote with Fawkes' API (the team's "Light determined"): one blackboard.
+    for (const lua::WrittenInterface& w : skills_->engine().written_interfaces()) {
+      std::vector<std::pair<std::string, Value>> fields;
+      for (const lua::InterfaceField& f : w.fields) fields.emplace_back(f.name, field_value(f));
+      agent_->write_interface(w.type, w.id, std::move(fields));
+    }
+  }
   for (Received& r : radio.inbox()) {
     if (r.message) agent_->receive(std::move(r.message), r.from, r.from_id, r.at);
   }

@@ -223,6 +223,22 @@ std::string batch_identity_hash(const std::string& scenario_path, const Scenario
         if (e.is_regular_file() && e.path().extension() == ".lua") files.insert(e.path().string());
       }
     }
+    // Skills written for Fawkes: their helper modules and navgraph files.
+    for (const std::string& d : s.skills.module_dirs) {
+      std::error_code ec;
+      for (const auto& e : fs::recursive_directory_iterator(d, ec)) {
+        if (e.is_regular_file() && e.path().extension() == ".lua") files.insert(e.path().string());
+      }
+    }
+    for (const std::string& d : s.skills.cfg_dirs) {
+      std::error_code ec;
+      for (const auto& e : fs::recursive_directory_iterator(d, ec)) {
+        const fs::path ext = e.path().extension();
+        if (e.is_regular_file() && (ext == ".yaml" || ext == ".yml")) {
+          files.insert(e.path().string());
+        }
+      }
+    }
   }
   std::uint64_t h = core::fnv1a(std::string_view(hashed_file_bytes(scenario_path)));
   for (const std::string& f : files) {

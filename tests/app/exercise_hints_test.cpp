@@ -74,8 +74,8 @@ TEST_CASE("exercise: each mistake gets its own message at the participant's file
        "use clock.now() (game seconds) or a transition's timeout=SECS",
        "skills run in a sandbox"},
       {"uses_require.lua", "01", kExitBadInput,
-       "'require' is not available in skills: skills load no modules: name another skill in "
-       "depends_skills",
+       "module 'helpers' is not available in skills: require loads only the Lua files of the "
+       "skill and module directories",
        "skills run in a sandbox"},
       {"printf_float.lua", "01", kExitFailed,
        "bad argument #2 to 'printf' (number has no integer representation)",

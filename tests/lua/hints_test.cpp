@@ -118,9 +118,13 @@ struct Engine {
 
 }  // namespace
 
+namespace {
+bool e_run_fails(Engine& e) { return e.load_error().empty() && e.run() == SkillStatus::kFailed; }
+}  // namespace
+
 TEST_CASE("globals skills do not have say so and what to use instead, at the line") {
-  for (const char* name : {"io", "os", "require", "package", "dofile", "loadfile", "load",
-                           "loadstring", "debug", "coroutine", "collectgarbage", "_G", "unpack"}) {
+  for (const char* name : {"io", "os", "package", "dofile", "loadfile", "load", "loadstring",
+                           "debug", "coroutine", "collectgarbage", "_G", "unpack"}) {
     Engine e(skill_with("", std::string("local x = ") + name));
     REQUIRE(e.load_error().empty());
     CHECK(e.run() == SkillStatus::kFailed);
@@ -128,6 +132,12 @@ TEST_CASE("globals skills do not have say so and what to use instead, at the lin
     CHECK(contains(e.error(),
                    std::string("mine.lua:7: '") + name + "' is not available in skills: "));
   }
+  // require loads only helper modules of the skill directories (docs/skills.md).
+  Engine req(skill_with("", "local x = require('socket')"));
+  CHECK(e_run_fails(req));
+  CHECK(contains(req.error(),
+                 "mine.lua:7: module 'socket' is not available in skills: require "
+                 "loads only the Lua files of the skill and module directories"));
   // At load time too.
   Engine e(skill_with("local f = io.open('/etc/passwd')\n"));
   CHECK(contains(e.load_error(),

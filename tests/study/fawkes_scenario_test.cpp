@@ -210,3 +210,119 @@ message LockMessage {
                        doctest::Contains("collides with llsf_agent_msgs.LockMessage"),
                        core::ConfigError);
 }
+
+TEST_CASE("a Fawkes-style agent reads the light detection as RobotinoLightInterface Light_State") {
+  test::TempDir dir{"llsf_fawkes_light"};
+  std::filesystem::create_directories(dir.path / "agents/light");
+  dir.write("agents/light/light.clp", R"clp(
+(defrule use-blackboard
+  (ff-feature blackboard)
+  =>
+  (ff-feature-request "blackboard")
+  (blackboard-enable-time-read)
+  (blackboard-open "RobotinoLightInterface" "Light_State")
+  (path-load light/sense.clp))
+)clp");
+  dir.write("agents/light/sense.clp", R"clp(
+(defrule seen-light
+  (RobotinoLightInterface (id "Light_State") (red ?r) (ready ?ready) (visibility_history ?v))
+  =>
+  (assert (seen-light ?r ?ready ?v)))
+)clp");
+  dir.write("s.yaml", R"yaml(
+name: fawkes light
+duration_s: 3
+robots:
+  count: 1
+  agent: {fawkes: agents, entry: light/light}
+)yaml");
+  const ScenarioFile f = load_scenario(dir.file("s.yaml"));
+  const Scenario& s = f.variants.at(0);
+  sim::GameDriver driver(s.game);
+  sim::AgentBrainConfig c;
+  c.agent_files = s.robots.at(0).agent;
+  c.config = s.robots.at(0).config;
+  c.fawkes = true;
+  c.agent_dir = s.robots.at(0).agent_dir;
+  sim::AgentBrain& brain = driver.plug_agent(0, c);
+  driver.run_until(core::SimTime::from_seconds(2.0));
+  const clips::AgentHost& agent = brain.agent();
+  CHECK(agent.runtime_errors() == 0);
+  // At its start pose the robot sees no signal: UNKNOWN, not ready, and a visibility history
+  // that counts down from -1 in frames of the skill rate (30 Hz), one fact per agent cycle.
+  const auto seen = agent.facts("seen-light");
+  REQUIRE(seen.size() >= 10);
+  bool unknown_not_ready = true;
+  std::int64_t lowest = 0;
+  for (const clips::Fact& fact : seen) {
+    const std::vector<clips::Value>& v = fact.fields();
+    REQUIRE(v.size() == 3);
+    unknown_not_ready = unknown_not_ready && v[0].text == "UNKNOWN" && v[1].text == "FALSE";
+    lowest = std::min(lowest, v[2].integer);
+  }
+  CHECK(unknown_not_ready);
+  CHECK(lowest <= -50);  // about 2 s at 30 frames per second
+}
+
+TEST_CASE("what a skill writes with Fawkes' API reaches a Fawkes-style agent's blackboard") {
+  test::TempDir dir{"llsf_fawkes_written"};
+  std::filesystem::create_directories(dir.path / "agents/mark");
+  std::filesystem::create_directories(dir.path / "skills");
+  dir.write("agents/mark/mark.clp", R"clp(
+(defrule use-blackboard
+  (ff-feature blackboard)
+  =>
+  (ff-feature-request "blackboard")
+  (blackboard-enable-time-read)
+  (blackboard-open "RobotinoLightInterface" "Light determined")
+  (path-load mark/sense.clp))
+)clp");
+  dir.write("agents/mark/sense.clp", R"clp(
+(defrule call-mark (time $?) (not (called)) => (assert (called)) (skill-call mark))
+(defrule determined
+  (RobotinoLightInterface (id "Light determined") (green ?g) (ready ?r))
+  =>
+  (assert (determined ?g ?r)))
+)clp");
+  dir.write("skills/mark.lua", R"lua(
+module(..., skillenv.module_init)
+name = "mark"
+fsm = SkillHSM:new{name=name, start="SET"}
+depends_interfaces = {
+  {v="output", type="RobotinoLightInterface", id="Light determined", writing=true},
+}
+documentation = "writes Light determined"
+skillenv.skill_module(_M)
+fsm:define_states{export_to=_M, {"SET", JumpState}}
+fsm:add_transitions{{"SET", "FINAL", cond=true}}
+function SET:init()
+  output:set_green(output.ON)
+  output:set_ready(true)
+end
+)lua");
+  dir.write("s.yaml", R"yaml(
+name: fawkes written
+duration_s: 3
+robots:
+  count: 1
+  agent: {fawkes: agents, entry: mark/mark}
+skills: {skill_dirs: [skills]}
+)yaml");
+  const ScenarioFile f = load_scenario(dir.file("s.yaml"));
+  const Scenario& s = f.variants.at(0);
+  sim::GameDriver driver(s.game);
+  sim::AgentBrainConfig c;
+  c.agent_files = s.robots.at(0).agent;
+  c.config = s.robots.at(0).config;
+  c.fawkes = true;
+  c.agent_dir = s.robots.at(0).agent_dir;
+  c.skills = s.skills;
+  sim::AgentBrain& brain = driver.plug_agent(0, c);
+  driver.run_until(core::SimTime::from_seconds(2.0));
+  const clips::AgentHost& agent = brain.agent();
+  CHECK(agent.runtime_errors() == 0);
+  const auto facts = agent.facts("determined");
+  REQUIRE(facts.size() == 1);
+  CHECK(facts[0].fields().at(0).text == "ON");
+  CHECK(facts[0].fields().at(1).text == "TRUE");
+}

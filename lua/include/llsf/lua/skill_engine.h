@@ -31,6 +31,16 @@ struct SkillEngineConfig {
   /// Directories whose `*.lua` files (not recursive, `init.lua` excluded) are skills; a skill of
   /// a later directory replaces one of the same name in an earlier one.
   std::vector<std::string> skill_dirs;
+  /// Directories besides `skill_dirs` where `require("name")` finds Lua helper modules
+  /// (`name.lua`, `a.b` as `a/b.lua`; files that are not skills, e.g. a team's tf_module.lua).
+  /// `require` searches `skill_dirs` first, then these; it reads only files inside them.
+  std::vector<std::string> module_dirs;
+  /// Fawkes' cfg directories: where `fawkes.load_yaml_navgraph("navgraph-llsf.yaml")` finds
+  /// navgraph files (read-only, only files inside them).
+  std::vector<std::string> cfg_dirs;
+  /// Fawkes configuration values skills read with `config:get_float("/skills/x/y")` etc.: path
+  /// ("/skills/x/y") -> value as written in YAML ("0.05", "true", "text").
+  std::map<std::string, std::string> fawkes_config;
   /// Rate at which `sim/` calls cycle(), in simulated Hz (the engine itself never waits).
   double rate_hz = 30.0;
   /// Lua VM instructions one cycle (or loading one file) may execute, counted in steps of 1000,
@@ -78,6 +88,25 @@ struct ExecResult {
   bool ok = false;
   std::string error;
   explicit operator bool() const { return ok; }
+};
+
+/// One field of a blackboard interface skills wrote (docs/fawkes.md, "The blackboard in skills").
+struct InterfaceField {
+  enum class Kind : std::uint8_t { kSymbol, kString, kInteger, kFloat, kBool };
+  std::string name;
+  Kind kind = Kind::kSymbol;
+  bool array = false;              ///< an array field: one element per entry below
+  std::vector<std::string> texts;  ///< kSymbol, kString
+  std::vector<double> numbers;     ///< kInteger, kFloat, kBool (0 or 1)
+};
+
+/// A blackboard interface skills wrote with Fawkes' API (`set_field(...)`, `write()`), e.g. the
+/// team's RobotinoLightInterface "Light determined".
+struct WrittenInterface {
+  std::string type;
+  std::string id;
+  std::int64_t serial = 0;             ///< counts the cycles in which skills wrote it
+  std::vector<InterfaceField> fields;  ///< every field, by name
 };
 
 /// What the engine knows about one skill file.
@@ -148,6 +177,11 @@ class SkillEngine {
   /// CHECK since 14.91 s, waiting for {"CHECK", "FINAL", cond="vars.arived"} (skill.lua:20);
   /// vars.arived is never set (did you mean vars.arrived?)"; "" if it is not running.
   std::string skill_wait(std::string_view skill) const;
+
+  /// The blackboard interfaces skills wrote since the last call (each once, in writing order),
+  /// as Fawkes' skiller wrote its writing interfaces after every loop: for the agent's
+  /// blackboard (sim's AgentBrain forwards them to a Fawkes-style agent).
+  std::vector<WrittenInterface> written_interfaces();
 
   /// Every skill file found, in name order.
   std::vector<SkillInfo> skills() const;

@@ -137,6 +137,9 @@ class AgentBrain final : public RobotBrain, private clips::SkillRunner {
   int rule_loops_ = 0;  // runaway cycles of the current agent
   int budget_stops_ = 0;
   std::optional<Halt> halt_;
+  // A Fawkes-style agent's RobotinoLightInterface "Light_State": since when no device is seen.
+  bool light_seen_ = false;
+  core::SimTime light_lost_since_;
   clips::TraceOptions trace_options_;  // set_trace(), for reloaded agents
   clips::TraceSink trace_sink_;
   std::unique_ptr<clips::AgentHost> agent_;
