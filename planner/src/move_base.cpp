@@ -570,6 +570,19 @@ std::size_t graph_index(const char* name) {
   return kGraphSize;
 }
 
+// The connections by node index, resolved from the names once.
+using GraphEdge = std::pair<std::size_t, std::size_t>;
+const std::array<GraphEdge, std::size(kGraphEdges)>& graph_edges() {
+  static const auto edges = [] {
+    std::array<GraphEdge, std::size(kGraphEdges)> e{};
+    for (std::size_t k = 0; k < e.size(); ++k) {
+      e[k] = {graph_index(kGraphEdges[k].first), graph_index(kGraphEdges[k].second)};
+    }
+    return e;
+  }();
+  return edges;
+}
+
 std::size_t closest_node(const Vec2& p) {
   std::size_t best = 0;
   double best_d = std::numeric_limits<double>::max();
@@ -610,8 +623,7 @@ void MoveBaseNavigator::build_route(SimTime now, const Pose2D& pose) {
     }
     if (u == kGraphSize || u == from) break;
     done[u] = true;
-    for (const auto& [a, b] : kGraphEdges) {
-      const std::size_t ia = graph_index(a), ib = graph_index(b);
+    for (const auto& [ia, ib] : graph_edges()) {
       const std::size_t v = ia == u ? ib : ib == u ? ia : kGraphSize;
       if (v == kGraphSize || done[v]) continue;
       const double d = dist[u] + std::hypot(kGraphNodes[u].x - kGraphNodes[v].x,
