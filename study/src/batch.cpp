@@ -352,6 +352,9 @@ BatchResult run_batch(const ScenarioFile& file, const std::string& scenario_hash
                                           .string();
             }
             RunResult r = run_game(*jobs[j].scenario, jobs[j].seed, run_hooks);
+            // Stop here, not only when the result is stored: the storing thread may lag
+            // behind a worker that plays short games, which would then play them all.
+            if (options.fail_fast && r.agent_error()) stop_workers = true;
             const std::lock_guard lock(mutex);
             queue.push_back({std::move(r)});
           } catch (...) {
