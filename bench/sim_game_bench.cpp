@@ -113,7 +113,7 @@ LLSF_BENCH(game,
 }
 
 LLSF_BENCH(game_move_base,
-           "bench/move_base_game.yaml (the default game under robotino-2013-move_base: the "
+           "bench/move_base_game.yaml (the default game under robotino-2013: the "
            "move_base-2013 navigation, the laser on), seed 1, in a child process: real-time "
            "factor, wall seconds and peak memory (median of 5)") {
   games_in_children("game_move_base", move_base_scenario());

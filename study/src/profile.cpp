@@ -11,11 +11,13 @@ namespace llsf::study {
 
 namespace {
 
-// The 2013 Carologistics Robotino as the thesis' Gazebo games show it. docs/profiles.md has the
-// same table with the reasoning; keep both in step.
-RobotProfile robotino_2013() {
+// The 2013 Carologistics Robotino as the thesis' Gazebo games show it, with an omniscient
+// navigator and jam dice: the experiment's profile until issue #32 (docs/validation.md, then
+// "robotino-2013"), kept to show both side by side. docs/profiles.md has the same table with
+// the reasoning; keep both in step.
+RobotProfile robotino_2013_omniscient() {
   RobotProfile p;
-  p.name = "robotino-2013";
+  p.name = "robotino-2013-omniscient";
   // Assumption: a 2013 Robotino on move_base (no source gives its speed; the sensitivity sweep
   // varies it); the turn rate halved with it.
   p.max_speed_mps = 0.5;
@@ -56,11 +58,11 @@ RobotProfile robotino_2013() {
 }
 
 // The 2013 Carologistics Robotino with the team's own navigation configuration
-// (carologistics/fawkes-robotino 6cffc15f2, cfg/move_base_robotino/; docs/profiles.md). Work in
-// progress (issue #32): not yet calibrated, not yet the experiment's profile.
-RobotProfile robotino_2013_move_base() {
-  RobotProfile p = robotino_2013();
-  p.name = "robotino-2013-move_base";
+// (carologistics/fawkes-robotino 6cffc15f2, cfg/move_base_robotino/) and the machines of the
+// team's Gazebo simulation. docs/profiles.md has the same table with the sources.
+RobotProfile robotino_2013() {
+  RobotProfile p = robotino_2013_omniscient();
+  p.name = "robotino-2013";
   // base_local_planner_params.yaml: max_vel_x 0.5, acc_lim_x/y 2.5, acc_lim_th 3.2 -- for
   // move_base and for the world's robot alike. move_base turns at most at max_rotational_vel
   // 0.78 rad/s (MoveBaseConfig); the base itself turned as fast as the skills' motor_move
@@ -76,23 +78,30 @@ RobotProfile robotino_2013_move_base() {
   // the laser is the only observation source), at the thesis' 5 Hz.
   p.navigation = sim::NavigationLevel::kMoveBase2013;
   p.laser = true;
+  // The machine model of the team's Gazebo simulation (carologistics/gazsim-models, as imported
+  // into robocup-logistics/gazebo-rcll 15878b3, models/machine/model.sdf): its collision parts
+  // span 0.11 m along the facing (x -0.03 .. 0.08) and 0.16 m across it.
+  p.machine_depth_m = 0.11;
+  p.machine_width_m = 0.16;
   // Jams at machines: contact and move_base, not dice (docs/profiles.md, "Failures").
   p.jam_probability = 0.0;
-  // Not yet recalibrated: robotino-2013's figure (docs/profiles.md).
-  p.align_s = 12.0;
+  // Calibrated: a single P1P2 robot's first complex product at 10:30 min (thesis §5.3.3). At
+  // this level move_base's goal approach and move_under_rfid's creep take the time; any extra
+  // alignment takes the robot further from the target (docs/validation.md, "Calibration").
+  p.align_s = 0.0;
   return p;
 }
 
 }  // namespace
 
 std::vector<std::string> RobotProfile::names() {
-  return {"ideal", "robotino-2013", "robotino-2013-move_base"};
+  return {"ideal", "robotino-2013", "robotino-2013-omniscient"};
 }
 
 RobotProfile RobotProfile::named(std::string_view name) {
   if (name == "ideal") return RobotProfile{};
   if (name == "robotino-2013") return robotino_2013();
-  if (name == "robotino-2013-move_base") return robotino_2013_move_base();
+  if (name == "robotino-2013-omniscient") return robotino_2013_omniscient();
   throw std::invalid_argument("unknown robot profile '" + std::string(name) + "'");
 }
 
@@ -127,6 +136,8 @@ void RobotProfile::validate() const {
   core::require(p + "blocked_timeout_s", blocked_timeout_s, core::positive());
   core::require(p + "blocked_timeout_s", blocked_timeout_s, core::at_most(3600.0));
   core::require(p + "jam_probability", jam_probability, core::probability());
+  core::require(p + "machine_depth_m", machine_depth_m, core::in_range(0.0, 1.0));
+  core::require(p + "machine_width_m", machine_width_m, core::in_range(0.0, 1.0));
 }
 
 void RobotProfile::apply(sim::GameConfig& game, lua::SkillEngineConfig& skills) const {
@@ -148,6 +159,14 @@ void RobotProfile::apply(sim::GameConfig& game, lua::SkillEngineConfig& skills) 
   game.world.sensors.laser.rate_hz = laser_rate_hz;
   game.world.sensors.laser.enabled = laser;
   game.levels.navigation = navigation;
+  for (int i = 0; i < kinematic::kDeviceCount; ++i) {
+    if (kinematic::device_kind(core::DeviceId(i)) == kinematic::DeviceKind::kDelivery) continue;
+    kinematic::DeviceConfig& d = game.world.devices[static_cast<std::size_t>(i)];
+    const double front = d.body_offset_m + 0.5 * d.body_depth_m;
+    if (machine_depth_m > 0.0) d.body_depth_m = machine_depth_m;
+    if (machine_width_m > 0.0) d.body_width_m = machine_width_m;
+    d.body_offset_m = front - 0.5 * d.body_depth_m;
+  }
   sim::LightDetectionConfig& l = game.levels.light;
   l.level = light;
   l.frame_rate_hz = light_frame_rate_hz;
@@ -195,6 +214,8 @@ constexpr NumberKey kNumbers[] = {
     {"backoff_max_s", &RobotProfile::backoff_max_s},
     {"blocked_timeout_s", &RobotProfile::blocked_timeout_s},
     {"jam_probability", &RobotProfile::jam_probability},
+    {"machine_depth_m", &RobotProfile::machine_depth_m},
+    {"machine_width_m", &RobotProfile::machine_width_m},
 };
 
 RobotProfile named_or_fail(const core::ConfigNode& n) {
@@ -202,7 +223,7 @@ RobotProfile named_or_fail(const core::ConfigNode& n) {
     return RobotProfile::named(n.as_string());
   } catch (const std::invalid_argument&) {
     n.fail("unknown profile '" + n.as_string() +
-           "' (known: ideal, robotino-2013, robotino-2013-move_base)");
+           "' (known: ideal, robotino-2013, robotino-2013-omniscient)");
   }
 }
 

@@ -237,7 +237,8 @@ TEST_CASE("recycle never: no consumed puck is taken, also when the storage looks
 TEST_CASE("production: a T3 that rejects the S0 has one: noted, and the next S0 goes elsewhere") {
   // An insert that failed half-way (the robot stuck after the puck reached the reader) still
   // counted at the machine; without noting it the agent brought S0 after S0 to the same T3,
-  // each rejected (yellow blinking), for the rest of the game (robotino-2013, seed 50).
+  // each rejected (yellow blinking), for the rest of the game (robotino-2013, now
+  // robotino-2013-omniscient, seed 50).
   Rules r;
   r.production("P1", "M3");
   r.f.agent().set_pose({2.0, 1.0, 0.0});

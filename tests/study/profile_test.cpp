@@ -36,7 +36,8 @@ std::string error_of(const test::TempDir& dir, const std::string& text) {
 
 }  // namespace
 
-TEST_CASE("profiles: ideal is the game loop's defaults, robotino-2013 sets its figures") {
+TEST_CASE(
+    "profiles: ideal is the game loop's defaults, the robotino-2013 profiles set their figures") {
   const sim::GameConfig defaults;
   sim::GameConfig g;
   lua::SkillEngineConfig skills;
@@ -53,10 +54,11 @@ TEST_CASE("profiles: ideal is the game loop's defaults, robotino-2013 sets its f
   CHECK(g.handling.stuck_detection);
   CHECK(skills.stuck_detection);
 
+  // The old robotino-2013: an omniscient navigator, jam dice, a calibrated alignment.
   sim::GameConfig t;
-  study::RobotProfile::named("robotino-2013").apply(t, skills);
-  CHECK(t.profile == "robotino-2013");
-  CHECK(skills.profile == "robotino-2013");
+  study::RobotProfile::named("robotino-2013-omniscient").apply(t, skills);
+  CHECK(t.profile == "robotino-2013-omniscient");
+  CHECK(skills.profile == "robotino-2013-omniscient");
   CHECK_FALSE(skills.stuck_detection);
   CHECK_FALSE(t.handling.stuck_detection);
   // Thesis §6.1.1: webcam 2 Hz, light detection about 1 s late, laser 5 Hz.
@@ -68,7 +70,36 @@ TEST_CASE("profiles: ideal is the game loop's defaults, robotino-2013 sets its f
   CHECK(t.world.robot.max_speed_mps < defaults.world.robot.max_speed_mps);
   CHECK(t.handling.align_s > 0.0);
   CHECK(t.handling.jam_probability > 0.0);
+  CHECK(t.levels.navigation == sim::NavigationLevel::kIdeal);
+  CHECK(t.world.devices[0].body_depth_m == defaults.world.devices[0].body_depth_m);
   CHECK_NOTHROW(t.validate());
+
+  // robotino-2013: the team's move_base, the laser, the Gazebo machines, no dice.
+  sim::GameConfig m;
+  study::RobotProfile::named("robotino-2013").apply(m, skills);
+  CHECK(m.profile == "robotino-2013");
+  CHECK_FALSE(m.handling.stuck_detection);
+  CHECK(m.levels.navigation == sim::NavigationLevel::kMoveBase2013);
+  CHECK(m.world.sensors.laser.enabled);
+  CHECK(m.world.robot.max_accel_mps2 == 2.5);
+  CHECK(m.world.robot.max_alpha_rps2 == 3.2);
+  CHECK(m.handling.jam_probability == 0.0);
+  // The machines' bodies change; their fronts (0.04 m behind the read zone) and the gates stay.
+  for (int i = 0; i < kinematic::kDeviceCount; ++i) {
+    const auto& d = m.world.devices[static_cast<std::size_t>(i)];
+    const auto& w = defaults.world.devices[static_cast<std::size_t>(i)];
+    CAPTURE(i);
+    CHECK(d.body_offset_m + 0.5 * d.body_depth_m ==
+          doctest::Approx(w.body_offset_m + 0.5 * w.body_depth_m));
+    CHECK(d.rfid_offset_m == w.rfid_offset_m);
+    if (kinematic::device_kind(core::DeviceId(i)) == kinematic::DeviceKind::kDelivery) {
+      CHECK(d.body_depth_m == w.body_depth_m);
+    } else {
+      CHECK(d.body_depth_m == 0.11);
+      CHECK(d.body_width_m == 0.16);
+    }
+  }
+  CHECK_NOTHROW(m.validate());
   CHECK_THROWS_AS(study::RobotProfile::named("robotino-2099"), std::invalid_argument);
 }
 
@@ -80,12 +111,13 @@ TEST_CASE("profiles: the scenario key, overrides, and keys that win over the pro
   CHECK(f.variants.front().game.controller.max_speed_mps == 0.5);
   CHECK_FALSE(f.variants.front().skills.stuck_detection);
 
-  f = load_text(dir,
-                head + "profile: {name: robotino-2013, max_speed_mps: 0.3, jam_probability: 0}\n");
+  f = load_text(dir, head +
+                         "profile: {name: robotino-2013-omniscient, max_speed_mps: 0.3, "
+                         "jam_probability: 0}\n");
   CHECK(f.variants.front().game.controller.max_speed_mps == 0.3);
   CHECK(f.variants.front().game.world.robot.max_speed_mps == 0.3);
   CHECK(f.variants.front().game.handling.jam_probability == 0.0);
-  CHECK(f.variants.front().game.handling.align_s > 0.0);  // the rest stays robotino-2013
+  CHECK(f.variants.front().game.handling.align_s > 0.0);  // the rest stays the profile's
 
   // world/navigation/levels keys are read on top of the profile.
   f = load_text(dir, head +
@@ -149,10 +181,13 @@ TEST_CASE("profiles: the ideal profile leaves the game as it was") {
   CHECK(plain.result_hash == ideal.result_hash);
   CHECK(ideal.profile == "ideal");
   CHECK(ideal.jams == 0);
-  const study::RunResult slow =
-      study::run_game(load_text(dir, body + "profile: robotino-2013\n").variants.front(), 3);
+  const study::RunResult slow = study::run_game(
+      load_text(dir, body + "profile: robotino-2013-omniscient\n").variants.front(), 3);
   CHECK(slow.result_hash != ideal.result_hash);
-  CHECK(slow.profile == "robotino-2013");
+  CHECK(slow.profile == "robotino-2013-omniscient");
+  // robotino-2013's navigation sees with the laser: a scenario that turns it off is told so.
+  CHECK(error_of(dir, body + "profile: robotino-2013\n")
+            .find("move_base-2013 sees obstacles only with the laser") != std::string::npos);
 }
 
 TEST_CASE("handling: the fine alignment holds the arrival back after a drive, not after a push") {

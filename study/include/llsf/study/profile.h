@@ -57,6 +57,12 @@ struct RobotProfile {
   double backoff_max_s = 3.0;
   double blocked_timeout_s = 30.0;
 
+  // The machines' bodies (M1..M10, R1, R2, TST) in the world: depth along the facing and width
+  // across it; 0 keeps the world's. The body's front stays where the world's is (0.04 m behind
+  // the read zone), so pucks rest where they did.
+  double machine_depth_m = 0.0;
+  double machine_width_m = 0.0;
+
   // Failures.
   double jam_probability = 0.0;  ///< HandlingConfig::jam_probability
   bool stuck_detection = true;   ///< HandlingConfig::stuck_detection
