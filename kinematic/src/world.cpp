@@ -507,8 +507,15 @@ struct World::Impl : public b2ContactListener {
   // --- sensors ------------------------------------------------------------------------------
   void refresh_circles() {
     robot_circles.clear();
-    for (int i = 0; i < static_cast<int>(robots.size()); ++i)
-      robot_circles.push_back({from_b2(robots[i].body->GetPosition()), cfg.robot.radius_m, i});
+    const RobotModelConfig& m = cfg.robot;
+    const double radius = m.laser_radius_m > 0.0 ? m.laser_radius_m : m.radius_m;
+    for (int i = 0; i < static_cast<int>(robots.size()); ++i) {
+      Vec2 centre = from_b2(robots[i].body->GetPosition());
+      if (m.laser_offset_m != 0.0) {
+        centre += core::rotate(Vec2(m.laser_offset_m, 0.0), robots[i].body->GetAngle());
+      }
+      robot_circles.push_back({centre, radius, i});
+    }
     puck_circles.clear();
     for (int i = 0; i < static_cast<int>(pucks.size()); ++i)
       if (!pucks[i].removed)

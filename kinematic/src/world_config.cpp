@@ -233,6 +233,8 @@ constexpr Key<RobotModelConfig> kRobotKeys[] = {
     {"max_accel_mps2", &RobotModelConfig::max_accel_mps2, positive_at_most(kMaxAccelMps2)},
     {"max_alpha_rps2", &RobotModelConfig::max_alpha_rps2, positive_at_most(kMaxAlphaRps2)},
     {"contact_friction", &RobotModelConfig::contact_friction, kFriction},
+    {"laser_radius_m", &RobotModelConfig::laser_radius_m, kGap},
+    {"laser_offset_m", &RobotModelConfig::laser_offset_m, kOffset},
 };
 // inner_width_m: at most kMaxLengthM here, wider than a puck in validate_robots().
 constexpr Key<HolderConfig> kHolderKeys[] = {

@@ -32,6 +32,10 @@ the robot stops, waits 3 s, takes the nearest puck it sees within 0.5 m and driv
 so that a robot does not cross the field for a stranger's puck. The puck stays in the holder unless the outcome was WAITING;
 then (and after a failure at the machine) the robot backs off 5 cm slowly (the holder keeps
 the puck below 0.02 m/s) so that it can turn away from the machine.
+With the profile's motions "carologistics-2013" (robotino-2013) the robot leaves a recycler
+with its S0 as the team's 2013 skill did (finish_puck_at.lua -> leave_area_recycle.lua at
+6cffc15f2): turn 45 degrees left, drive 0.4 m to the left, turn round (1.2 rad/s), 0.2 m on --
+motor moves that, without stuck detection, push against whatever is in the way for good.
 ]==]
 
 local PRE = 0.30          -- the approach stops this far before the input place
@@ -180,6 +184,14 @@ fsm:define_states{ export_to=_M,
    -- robot can turn away from the machine face with the puck.
    {"CLEAR",    SkillJumpState, skills={{motor_move}}, final_to="CLEARED", fail_to="CLEARED"},
    {"CLEARED",  JumpState},
+   -- carologistics-2013: leave_area_recycle's four motor moves.
+   {"RECYCLE_TURN",  SkillJumpState, skills={{motor_move}}, final_to="RECYCLE_LEFT",
+    fail_to="FAILED"},
+   {"RECYCLE_LEFT",  SkillJumpState, skills={{motor_move}}, final_to="RECYCLE_UTURN",
+    fail_to="FAILED"},
+   {"RECYCLE_UTURN", SkillJumpState, skills={{motor_move}}, final_to="RECYCLE_ON",
+    fail_to="FAILED"},
+   {"RECYCLE_ON",    SkillJumpState, skills={{motor_move}}, final_to="FINAL", fail_to="FAILED"},
    -- A puck lost on the way: stand, then fetch it again and drive on (take_puck_to).
    {"LOST",     JumpState},
    {"REFETCH",  SkillJumpState, skills={{take_puck}}, final_to="APPROACH", fail_to="FAILED"},
@@ -194,6 +206,10 @@ fsm:add_transitions{
    {"WAIT_LIGHT", "FAILED", cond=lost, desc="puck lost"},
    {"DECIDE", "ASIDE", cond="vars.outcome == 'WAITING'", desc="waiting for more"},
    {"DECIDE", "CLEAR", cond=true, desc="done or failed: keep the puck"},
+   {"CLEARED", "RECYCLE_TURN", cond=function(self, vars)
+      return vars.outcome == "DONE" and profile.motions == "carologistics-2013"
+         and (vars.place == "R1" or vars.place == "R2")
+   end, desc="done at a recycler: leave_area_recycle"},
    {"CLEARED", "FINAL", cond="vars.outcome == 'DONE'", desc="done"},
    {"CLEARED", "FAILED", cond=function(self, vars)
       self.fsm.error = vars.fail
@@ -244,6 +260,22 @@ end
 
 function DECIDE:init()
    if self.fsm.vars.outcome then self.fsm.result = self.fsm.vars.outcome end
+end
+
+function RECYCLE_TURN:init()
+   self.args["motor_move"] = {ori = math.pi / 4}
+end
+
+function RECYCLE_LEFT:init()
+   self.args["motor_move"] = {y = 0.4}
+end
+
+function RECYCLE_UTURN:init()
+   self.args["motor_move"] = {ori = math.pi, vel_rot = 1.2}
+end
+
+function RECYCLE_ON:init()
+   self.args["motor_move"] = {x = 0.2}
 end
 
 function CLEAR:init()

@@ -19,7 +19,25 @@ Fails: "motor_move: no progress for 2 s (blocked?)" when something holds the rob
 "motor_move: not there after N s", "motor_move needs numbers x, y, ori". Without stuck
 detection (profile.stuck_detection false, the robotino-2013 profile: the thesis' skills had
 none) it neither checks progress nor gives up: a robot held back keeps trying.
+With the profile's motions "carologistics-2013" (robotino-2013) it moves as the team's 2013
+motor_move did (carologistics/fawkes-robotino 6cffc15f2, src/lua/skills/robotino/motor_move.lua):
+each axis (x, y, ori) on its own, at most V_MAX 0.4 m/s and 2.2 rad/s (or vel_trans, vel_rot),
+accelerating by 0.05 m/s (0.10 rad/s) a cycle, decelerating as V_MAX/D_DECEL/5 times the
+distance left (D_DECEL 0.07 m, 0.2 rad), never slower than V_MIN 0.035 m/s (0.15 rad/s), and an
+axis within its tolerance (0.04 m, 0.05 rad; `tolerance` replaces the metres) is not moved at
+all: the move ends when no axis moves.
 ]==]
+
+-- The team's motor_move (6cffc15f2): per-axis limits, tolerances and ramps.
+local TEAM = {
+   V_MAX = {x = 0.4, y = 0.4, ori = 2.2},
+   V_MIN = {x = 0.035, y = 0.035, ori = 0.15},
+   TOLERANCE = {x = 0.04, y = 0.04, ori = 0.05},
+   D_DECEL = {x = 0.07, y = 0.07, ori = 0.2},
+   ACCEL = {x = 0.05, y = 0.05, ori = 0.10},
+}
+
+local function team() return profile.motions == "carologistics-2013" end
 
 local function field_goal(vars)
    local x, y, th = pose:get()
@@ -50,8 +68,32 @@ local function bad_args(self, vars)
    return false
 end
 
+-- The team's velocities for the errors (ex, ey, et): 0 on an axis within its tolerance.
+local function team_speeds(vars, ex, ey, et)
+   local d = {x = ex, y = ey, ori = et}
+   local out = {}
+   for _, k in ipairs{"x", "y", "ori"} do
+      local tol = TEAM.TOLERANCE[k]
+      if k ~= "ori" and vars.tolerance then tol = vars.tolerance end
+      if math.abs(d[k]) > tol then
+         local v_acc = vars.cycle * TEAM.ACCEL[k]
+         local v_dec = TEAM.V_MAX[k] / TEAM.D_DECEL[k] / 5 * math.abs(d[k])
+         local vmax = (k == "ori") and vars.wmax or vars.vmax
+         local v = math.min(vmax, math.max(TEAM.V_MIN[k], math.min(TEAM.V_MAX[k], v_acc, v_dec)))
+         out[k] = d[k] < 0 and -v or v
+      else
+         out[k] = 0
+      end
+   end
+   return out.x, out.y, out.ori
+end
+
 local function there(self, vars)
-   local _, _, et, d = errors(vars)
+   local ex, ey, et, d = errors(vars)
+   if team() then
+      local vx, vy, w = team_speeds(vars, ex, ey, et)
+      return vx == 0 and vy == 0 and w == 0
+   end
    return d <= vars.tol and math.abs(et) <= 0.03
 end
 
@@ -92,8 +134,9 @@ function MOVE:init()
    local v = self.fsm.vars
    v.gx, v.gy, v.gth = field_goal(v)
    v.tol = v.tolerance or 0.01
-   v.vmax = v.vel_trans or 0.3
-   v.wmax = v.vel_rot or 1.0
+   v.vmax = v.vel_trans or (team() and TEAM.V_MAX.x or 0.3)
+   v.wmax = v.vel_rot or (team() and TEAM.V_MAX.ori or 1.0)
+   v.cycle = 0
    local _, _, et, d = errors(v)
    v.best, v.best_at = d + 0.2 * math.abs(et), clock.now()
    v.limit = 5 + 3 * (d / v.vmax + math.abs(et) / v.wmax)
@@ -103,6 +146,11 @@ end
 function MOVE:loop()
    local v = self.fsm.vars
    local ex, ey, et, d = errors(v)
+   if team() then
+      v.cycle = v.cycle + 1
+      motor:set_velocity(team_speeds(v, ex, ey, et))
+      return
+   end
    local speed = 0
    if d > v.tol * 0.5 then speed = math.min(v.vmax, math.max(0.04, 1.5 * d)) end
    local vx, vy = 0, 0

@@ -2,7 +2,7 @@
 -- take_puck: drive onto a puck lying on the field so that it ends in the holder.
 name               = "take_puck"
 fsm                = SkillHSM:new{name=name, start="APPROACH"}
-depends_skills     = {"drive_to"}
+depends_skills     = {"drive_to", "motor_move"}
 depends_interfaces = {
    {v = "motor",  type = "MotorInterface", id = "Robotino"},
    {v = "pose",   type = "Position3DInterface", id = "Pose"},
@@ -14,6 +14,11 @@ point in front of it, re-measures it with the puck detection, then creeps onto i
 sensor feels it at the body.
 @param x, y  field position of the puck (metres)
 @param ori   heading to approach it with (rad; default: from where the robot stands)
+With the profile's motions "carologistics-2013" (robotino-2013) a puck within 0.5 m is taken as
+the team's 2013 fetch_puck took it (carologistics/fawkes-robotino 6cffc15f2,
+src/lua/skills/robotino/fetch_puck.lua: TURN_TO_PUCK, then GRAB): the robot turns on the spot to
+face it and creeps straight on, with no drive to a point in front of it -- so a puck lying beside
+the holder is pushed away by the turning robot (thesis §6.1.3) and then not seen where expected.
 Fails: "take_puck needs x=, y=", "take_puck: already holding a puck", drive_to's failure,
 "take_puck: the puck is gone (not seen where expected)", "take_puck: blocked 0.03 m before the
 puck (...)" (no progress for 1.5 s), "take_puck: did not reach the puck within 6 s (...)",
@@ -22,6 +27,7 @@ puck (...)" (no progress for 1.5 s), "take_puck: did not reach the puck within 6
 
 local OFFSET = 0.2225   -- robot centre to a held puck's centre
 local STANDOFF = 0.15   -- from the pre-position to the final pose
+local TEAM_REACH = 0.5  -- carologistics-2013: a puck this near is turned to, not driven to
 
 local function bad_args(self, vars)
    return type(vars.x) ~= "number" or type(vars.y) ~= "number"
@@ -33,6 +39,13 @@ local function to_robot(px, py)
    local dx, dy = px - x, py - y
    local c, s = math.cos(th), math.sin(th)
    return c * dx + s * dy, -s * dx + c * dy
+end
+
+-- carologistics-2013 motions and a puck within TEAM_REACH: turn to it on the spot (fetch_puck).
+local function team_turn(self, vars)
+   if profile.motions ~= "carologistics-2013" or bad_args(self, vars) then return false end
+   local ex, ey = to_robot(vars.x, vars.y)
+   return ex * ex + ey * ey <= TEAM_REACH * TEAM_REACH
 end
 
 local function heading(vars)
@@ -79,6 +92,7 @@ end
 
 fsm:define_states{ export_to=_M,
    {"APPROACH", SkillJumpState, skills={{drive_to}}, final_to="LOOK", fail_to="FAILED"},
+   {"TURN",     SkillJumpState, skills={{motor_move}}, final_to="LOOK", fail_to="FAILED"},
    {"LOOK",     JumpState},
    {"CREEP",    JumpState},
    {"SETTLE",   JumpState},
@@ -88,6 +102,7 @@ fsm:add_transitions{
    {"APPROACH", "FAILED", precond=bad_args, error="take_puck needs x=, y="},
    {"APPROACH", "FAILED", precond="sensor:puck_in_holder()",
     error="take_puck: already holding a puck"},
+   {"APPROACH", "TURN", precond=team_turn, desc="near: turn to it (carologistics-2013)"},
    {"LOOK", "CREEP", cond=function(self, vars) return remeasure(vars) end, desc="seen"},
    {"LOOK", "FAILED", timeout={1.0, error="take_puck: the puck is gone (not seen where expected)"}},
    {"CREEP", "SETTLE", cond=touching, desc="puck at the body"},
@@ -108,6 +123,11 @@ function APPROACH:init()
    local c, s = heading(v)
    local d = OFFSET + STANDOFF
    self.args["drive_to"] = {x = v.x - c * d, y = v.y - s * d, ori = v.ori, forward_only = true}
+end
+
+function TURN:init()
+   local ex, ey = to_robot(self.fsm.vars.x, self.fsm.vars.y)
+   self.args["motor_move"] = {ori = math.atan(ey, ex)}
 end
 
 function CREEP:init()

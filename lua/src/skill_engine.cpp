@@ -571,11 +571,13 @@ void SkillEngine::Impl::build() {
   luaL_setfuncs(L, natives, 0);
   lua_pushlstring(L, robot.name().data(), robot.name().size());
   lua_setfield(L, -2, "robot_name");
-  lua_createtable(L, 0, 2);
+  lua_createtable(L, 0, 3);
   lua_pushstring(L, config.profile.c_str());
   lua_setfield(L, -2, "name");
   lua_pushboolean(L, config.stuck_detection ? 1 : 0);
   lua_setfield(L, -2, "stuck_detection");
+  lua_pushstring(L, config.motions.c_str());
+  lua_setfield(L, -2, "motions");
   lua_setfield(L, -2, "profile");
   push_interfaces(L);  // sets native.interfaces, interface_names, clock
   push_pattern_functions(L);

@@ -83,6 +83,17 @@ RobotProfile robotino_2013() {
   // span 0.11 m along the facing (x -0.03 .. 0.08) and 0.16 m across it.
   p.machine_depth_m = 0.11;
   p.machine_width_m = 0.16;
+  // The Robotino of the team's Gazebo simulation (gazebo-rcll 15878b3, models/robotino/model.sdf;
+  // thesis §5.1.1: "The cylinder on laser height is smaller and shifted back so that it does not
+  // block the laser sensor"): the laser 0.085 m ahead of the centre, the robot at laser height a
+  // cylinder of radius 0.12 m whose centre is 0.05 m behind the robot's.
+  p.laser_mount_x_m = 0.085;
+  p.robot_laser_radius_m = 0.12;
+  p.robot_laser_offset_m = -0.05;
+  // The skills move at machines as the team's 2013 skills did (src/lua/skills/robotino/ at
+  // 6cffc15f2: fetch_puck turns to a puck first, leave_area_recycle, get_consumed's leave), so
+  // their failures come from contact, not dice (docs/profiles.md, "Failures").
+  p.motions = "carologistics-2013";
   // Jams at machines: contact and move_base, not dice (docs/profiles.md, "Failures").
   p.jam_probability = 0.0;
   // Calibrated: a single P1P2 robot's first complex product at 10:30 min (thesis §5.3.3). At
@@ -138,6 +149,9 @@ void RobotProfile::validate() const {
   core::require(p + "jam_probability", jam_probability, core::probability());
   core::require(p + "machine_depth_m", machine_depth_m, core::in_range(0.0, 1.0));
   core::require(p + "machine_width_m", machine_width_m, core::in_range(0.0, 1.0));
+  core::require(p + "laser_mount_x_m", laser_mount_x_m, core::in_range(-0.5, 0.5));
+  core::require(p + "robot_laser_radius_m", robot_laser_radius_m, core::in_range(0.0, 0.5));
+  core::require(p + "robot_laser_offset_m", robot_laser_offset_m, core::in_range(-0.5, 0.5));
 }
 
 void RobotProfile::apply(sim::GameConfig& game, lua::SkillEngineConfig& skills) const {
@@ -158,6 +172,9 @@ void RobotProfile::apply(sim::GameConfig& game, lua::SkillEngineConfig& skills) 
   c.blocked_timeout_s = blocked_timeout_s;
   game.world.sensors.laser.rate_hz = laser_rate_hz;
   game.world.sensors.laser.enabled = laser;
+  game.world.sensors.laser.mount_x_m = laser_mount_x_m;
+  game.world.robot.laser_radius_m = robot_laser_radius_m;
+  game.world.robot.laser_offset_m = robot_laser_offset_m;
   game.levels.navigation = navigation;
   for (int i = 0; i < kinematic::kDeviceCount; ++i) {
     if (kinematic::device_kind(core::DeviceId(i)) == kinematic::DeviceKind::kDelivery) continue;
@@ -184,6 +201,7 @@ void RobotProfile::apply(sim::GameConfig& game, lua::SkillEngineConfig& skills) 
   h.jam_probability = jam_probability;
   h.stuck_detection = stuck_detection;
   skills.stuck_detection = stuck_detection;
+  skills.motions = motions;
   skills.profile = name;
 }
 
@@ -216,6 +234,9 @@ constexpr NumberKey kNumbers[] = {
     {"jam_probability", &RobotProfile::jam_probability},
     {"machine_depth_m", &RobotProfile::machine_depth_m},
     {"machine_width_m", &RobotProfile::machine_width_m},
+    {"laser_mount_x_m", &RobotProfile::laser_mount_x_m},
+    {"robot_laser_radius_m", &RobotProfile::robot_laser_radius_m},
+    {"robot_laser_offset_m", &RobotProfile::robot_laser_offset_m},
 };
 
 RobotProfile named_or_fail(const core::ConfigNode& n) {
@@ -250,6 +271,10 @@ RobotProfile load_profile(const core::ConfigNode& node) {
   node.read("laser", p.laser);
   node.read("light_reads_states", p.light_reads_states);
   node.read("stuck_detection", p.stuck_detection);
+  node.read_enum("motions", p.motions,
+                 {{"llsfsim", std::string("llsfsim")},
+                  {"carologistics-2013", std::string("carologistics-2013")}},
+                 "skill motions");
   node.no_other_keys();
   try {
     p.validate();

@@ -547,6 +547,7 @@ Scenario read_scenario(const core::ConfigNode& root, const std::string& file) {
     s.skills = lua::SkillEngineConfig::from_config(n, dir);  // dirs relative to the file
     s.skills.profile = profile.name;
     s.skills.stuck_detection = profile.stuck_detection;
+    s.skills.motions = profile.motions;
   }
   read_tests(root["tests"], s);
   // `matrix` is read by the callers (load_scenario, read_scenario_map) on this document.

@@ -298,3 +298,48 @@ TEST_CASE("skill failures name their reason: bad arguments, unknown places, empt
   failed_with("recycle{}", "recycle: no puck in the holder");
   failed_with("motor_move{x=\"far\"}", "motor_move needs numbers");
 }
+
+TEST_CASE("carologistics-2013 motions: get_consumed and recycle move as the team's skills did") {
+  // lua/skills get_consumed.lua, take_puck.lua, finish_puck_at.lua with profile.motions
+  // "carologistics-2013" (the robotino-2013 profile): the front, the side move, the turn to the
+  // puck, the leave turn; leave_area_recycle at the recycler. No stuck detection, as the profile.
+  GameConfig c = ProductionGame::config(SkillLevel::kPhysical, 7);
+  c.handling.stuck_detection = false;
+  c.handling.motor_max_speed_mps = 0.4;
+  c.handling.motor_max_omega_rps = 2.2;
+  c.world.robot.max_accel_mps2 = 2.5;
+  c.world.robot.max_alpha_rps2 = 3.2;
+  c.world.robot.max_omega_rps = 2.2;
+  Game game(c);
+  test::start_phase(game, refbox::GamePhase::kProduction);
+  game.step();
+  lua::SkillEngineConfig skills;
+  skills.stuck_detection = false;
+  skills.motions = "carologistics-2013";
+  SkillBrain brain(game, 0, skills);
+  game.set_brain(0, &brain);
+  auto run = [&](const std::string& s) {
+    const Outcome o = run_skill(game, brain, s, 180);
+    MESSAGE(s, ": ", std::string(lua::to_string(o.status)), " after ", o.seconds, " s ", o.result,
+            " ", o.error, " holder ", game.puck_in_pocket(0).has_value());
+    return o;
+  };
+  auto m = test::machine_of_type(game.refbox(), refbox::MachineType::kT1, 150);
+  auto m2 = test::machine_of_type(game.refbox(), refbox::MachineType::kT2, 150);
+  REQUIRE(m);
+  REQUIRE(m2);
+  const std::string t1 = machine_name(*m);
+  const std::string t2 = machine_name(*m2);
+  REQUIRE_FINAL(run("get_s0{}"));
+  REQUIRE_FINAL(run("finish_puck_at{place=\"" + t1 + "\"}"));
+  REQUIRE(run("finish_puck_at{place=\"" + t2 + "\"}").result == "WAITING");
+  REQUIRE_FINAL(run("get_s0{}"));
+  REQUIRE(run("finish_puck_at{place=\"" + t2 + "\"}").result == "DONE");
+  REQUIRE_FINAL(run("drive_to{x=0.7, y=1.2, ori=math.pi}"));
+  REQUIRE_FINAL(run("leave_puck{}"));
+  const Outcome got = run("get_consumed{place=\"" + t2 + "\"}");
+  REQUIRE_FINAL(got);
+  CHECK(game.puck_in_pocket(0).has_value());
+  const Outcome r = run("finish_puck_at{place=\"R1\"}");
+  CHECK(r.status == lua::SkillStatus::kFinal);
+}

@@ -135,6 +135,11 @@ struct RobotModelConfig {
   double max_accel_mps2 = 1.0;  ///< translational acceleration limit
   double max_alpha_rps2 = 4.0;  ///< rotational acceleration limit (assumption)
   double contact_friction = 0.3;
+  /// The robot at laser height as other robots' lasers see it: a circle of this radius (0: the
+  /// body's `radius_m`) whose centre lies `laser_offset_m` ahead of the robot's (negative:
+  /// behind). The thesis' Gazebo Robotino has a smaller cylinder at laser height, shifted back.
+  double laser_radius_m = 0.0;
+  double laser_offset_m = 0.0;
   HolderConfig holder;
 };
 

@@ -66,6 +66,11 @@ struct SkillEngineConfig {
   std::string profile = "ideal";
   /// Whether skills give up when the robot makes no progress (their stall checks and timeouts).
   bool stuck_detection = true;
+  /// How the library's skills move at machines (`profile.motions`): "llsfsim" (their own moves)
+  /// or "carologistics-2013" (the team's 2013 skills' moves: turn to a puck before taking it,
+  /// leave a recycler and a consumed puck's machine as the team did; docs/profiles.md). Set by
+  /// the robot profile, not a YAML key.
+  std::string motions = "llsfsim";
   /// A skill file's real path (as found in `skill_dirs`, e.g. "/tmp/llsfex-1-1/s.lua") -> the
   /// path every message, warning and traceback of that file shows instead (e.g. the
   /// participant's "my_skill.lua" of which the file is a copy). Files not listed show their real

@@ -62,10 +62,18 @@ struct RobotProfile {
   // the read zone), so pucks rest where they did.
   double machine_depth_m = 0.0;
   double machine_width_m = 0.0;
+  /// The laser's mount ahead of the robot centre (world.sensors.laser.mount_x_m) and the robot
+  /// as other robots' lasers see it (world.robot.laser_radius_m, laser_offset_m; 0: the body).
+  double laser_mount_x_m = 0.0;
+  double robot_laser_radius_m = 0.0;
+  double robot_laser_offset_m = 0.0;
 
   // Failures.
   double jam_probability = 0.0;  ///< HandlingConfig::jam_probability
   bool stuck_detection = true;   ///< HandlingConfig::stuck_detection
+  /// How the skills move at machines (lua::SkillEngineConfig::motions): "llsfsim" or
+  /// "carologistics-2013".
+  std::string motions = "llsfsim";
 
   /// The names named() knows: "ideal", "robotino-2013", "robotino-2013-move_base".
   static std::vector<std::string> names();
