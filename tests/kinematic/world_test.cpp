@@ -286,6 +286,33 @@ TEST_CASE("the laser reads a known wall distance within its noise") {
   CHECK(scan.ranges[0] == doctest::Approx(2.70 - 1.12).epsilon(0.05));
 }
 
+TEST_CASE("other robots' lasers see the laser-height cylinder (robot.laser_radius_m, laser_offset_m)") {
+  // Robot 0 at (1.0, 0.6) looks along +x at robot 1 at (2.0, 0.6), which faces away (+x) or
+  // towards it (-x): beam 180 (angle 0) hits robot 1's body at 1.0 - 0.185 m, or, with the Gazebo
+  // Robotino's cylinder (radius 0.12 m, centre 0.05 m behind), at 1.0 - 0.05 - 0.12 m when robot
+  // 1 faces away and at 1.0 + 0.05 - 0.12 m when it faces robot 0.
+  auto distance = [](double radius, double offset, double other_heading) {
+    WorldConfig c = WorldConfig::default_2013();
+    c.sensors.laser.noise_std_m = 0.0;
+    c.robot.laser_radius_m = radius;
+    c.robot.laser_offset_m = offset;
+    c.robots = {{"a", {1.0, 0.6, 0.0}}, {"b", {2.0, 0.6, other_heading}}};
+    World w(c, core::Rng(2));
+    const auto& scan = w.sensors(RobotId(0)).laser;
+    while (scan.seq == 0) w.step();
+    const int beam = static_cast<int>(std::lround(-scan.angle_min_rad / scan.angle_increment_rad));
+    return static_cast<double>(scan.ranges[beam]);
+  };
+  CHECK(distance(0.0, 0.0, 0.0) == doctest::Approx(1.0 - 0.185).epsilon(0.001));
+  CHECK(distance(0.12, -0.05, 0.0) == doctest::Approx(1.0 - 0.05 - 0.12).epsilon(0.001));
+  CHECK(distance(0.12, -0.05, kPi) == doctest::Approx(1.0 + 0.05 - 0.12).epsilon(0.001));
+  // Bad figures are refused with their key.
+  WorldConfig bad = WorldConfig::default_2013();
+  bad.robot.laser_radius_m = -0.1;
+  CHECK_THROWS_WITH_AS(bad.validate(), doctest::Contains("robot.laser_radius_m"),
+                       core::ConfigError);
+}
+
 TEST_CASE("the optical sensors fire near the R1 corner walls") {
   // The thesis' recycling-corner problem: a robot in front of R1, slightly off to the side, has
   // one holder sensor looking past the machine's plate at the corner walls. With the sensor's

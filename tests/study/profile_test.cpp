@@ -71,6 +71,8 @@ TEST_CASE(
   CHECK(t.handling.align_s > 0.0);
   CHECK(t.handling.jam_probability > 0.0);
   CHECK(t.levels.navigation == sim::NavigationLevel::kIdeal);
+  CHECK(skills.motions == "llsfsim");
+  CHECK(t.world.robot.laser_radius_m == 0.0);
   CHECK(t.world.devices[0].body_depth_m == defaults.world.devices[0].body_depth_m);
   CHECK_NOTHROW(t.validate());
 
@@ -84,6 +86,10 @@ TEST_CASE(
   CHECK(m.world.robot.max_accel_mps2 == 2.5);
   CHECK(m.world.robot.max_alpha_rps2 == 3.2);
   CHECK(m.handling.jam_probability == 0.0);
+  CHECK(skills.motions == "carologistics-2013");
+  CHECK(m.world.sensors.laser.mount_x_m == 0.085);
+  CHECK(m.world.robot.laser_radius_m == 0.12);
+  CHECK(m.world.robot.laser_offset_m == -0.05);
   // The machines' bodies change; their fronts (0.04 m behind the read zone) and the gates stay.
   for (int i = 0; i < kinematic::kDeviceCount; ++i) {
     const auto& d = m.world.devices[static_cast<std::size_t>(i)];
@@ -147,6 +153,11 @@ TEST_CASE("profiles: the scenario key, overrides, and keys that win over the pro
   CHECK(e.find("unknown key 'top_speed'") != std::string::npos);
   e = error_of(dir, head + "profile: {jam_probability: 1.5}\n");
   CHECK(e.find("jam_probability") != std::string::npos);
+  e = error_of(dir, head + "profile: {name: robotino-2013, motions: festo}\n");
+  CHECK(e.find("unknown skill motions 'festo' (expected one of: llsfsim, carologistics-2013)") !=
+        std::string::npos);
+  f = load_text(dir, head + "profile: {name: robotino-2013, motions: llsfsim}\n");
+  CHECK(f.variants.front().skills.motions == "llsfsim");
   e = error_of(dir, head + "profile: {light: camera}\n");
   CHECK(e.find("unknown detection level 'camera' (expected one of: ground_truth, vision)") !=
         std::string::npos);
