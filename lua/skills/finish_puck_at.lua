@@ -32,7 +32,13 @@ the robot stops, waits 3 s, takes the nearest puck it sees within 0.5 m and driv
 so that a robot does not cross the field for a stranger's puck. The puck stays in the holder unless the outcome was WAITING;
 then (and after a failure at the machine) the robot backs off 5 cm slowly (the holder keeps
 the puck below 0.02 m/s) so that it can turn away from the machine.
-With the profile's motions "carologistics-2013" (robotino-2013) the robot leaves a recycler
+With the profile's motions "carologistics-2013" (robotino-2013) the robot, once at the reader,
+checks its position with the two optical sensors at the holder's arm tips as the team's
+move_under_rfid did (6cffc15f2, src/lua/skills/robotino/move_under_rfid.lua: CHECK_POSITION,
+CORRECT_POSITION, CORRECT_SENSOR_DELAY): if the right sensor sees something it moves right at
+0.03 m/s (at most 0.3 m) until the left one does, else if the left one sees something it moves
+left until the right one does, then 0.045 m back; a wall within the sensors' range beside a
+recycler misleads it (thesis §5.3.2). It leaves a recycler
 with its S0 as the team's 2013 skill did (finish_puck_at.lua -> leave_area_recycle.lua at
 6cffc15f2): turn 45 degrees left, drive 0.4 m to the left, turn round (1.2 rad/s), 0.2 m on --
 motor moves that, without stuck detection, push against whatever is in the way for good.
@@ -172,7 +178,14 @@ end
 fsm:define_states{ export_to=_M,
    {"APPROACH", SkillJumpState, skills={{drive_to}}, final_to="LOOK_SIDES", fail_to="FAILED"},
    {"LOOK_SIDES", JumpState},
-   {"INSERT",   SkillJumpState, skills={{drive_to}}, final_to="WAIT_LIGHT", fail_to="FAILED"},
+   {"INSERT",   SkillJumpState, skills={{drive_to}}, final_to="CHECK_POSITION",
+    fail_to="FAILED"},
+   -- carologistics-2013: move_under_rfid's correction on the optical sensors.
+   {"CHECK_POSITION", JumpState},
+   {"CORRECT_POSITION", SkillJumpState, skills={{motor_move}}, final_to="CORRECT_DELAY",
+    fail_to="FAILED"},
+   {"CORRECT_DELAY", SkillJumpState, skills={{motor_move}}, final_to="WAIT_LIGHT",
+    fail_to="FAILED"},
    {"WAIT_LIGHT", JumpState},
    {"DECIDE",   JumpState},
    {"ASIDE",    SkillJumpState, skills={{motor_move}}, final_to="LEAVE", fail_to="FAILED"},
@@ -202,6 +215,13 @@ fsm:add_transitions{
    {"APPROACH", "FAILED", precond="not sensor:puck_in_holder()",
     error="finish_puck_at: no puck in the holder"},
    {"LOOK_SIDES", "INSERT", timeout=0.3},
+   {"CHECK_POSITION", "WAIT_LIGHT", cond="profile.motions ~= 'carologistics-2013'"},
+   {"CHECK_POSITION", "WAIT_LIGHT", cond="vars.correct_dir == 0", desc="no sensor sees"},
+   {"CHECK_POSITION", "CORRECT_POSITION", cond=true, desc="a sensor sees: correct"},
+   {"CORRECT_POSITION", "CORRECT_DELAY", cond=function(self, vars)
+      if vars.correct_dir == -1 then return sensor:optical_left() end
+      return sensor:optical_right()
+   end, desc="the other sensor sees"},
    {"WAIT_LIGHT", "DECIDE", cond=watch, desc="light settled"},
    {"WAIT_LIGHT", "FAILED", cond=lost, desc="puck lost"},
    {"DECIDE", "ASIDE", cond="vars.outcome == 'WAITING'", desc="waiting for more"},
@@ -250,6 +270,25 @@ end
 
 function INSERT:init()
    self.args["drive_to"] = {place = self.fsm.vars.place .. "_input", forward_only = true}
+end
+
+function CHECK_POSITION:init()
+   local v = self.fsm.vars
+   if sensor:optical_right() then
+      v.correct_dir = -1
+   elseif sensor:optical_left() then
+      v.correct_dir = 1
+   else
+      v.correct_dir = 0
+   end
+end
+
+function CORRECT_POSITION:init()
+   self.args["motor_move"] = {y = self.fsm.vars.correct_dir * 0.3, vel_trans = 0.03}
+end
+
+function CORRECT_DELAY:init()
+   self.args["motor_move"] = {y = -self.fsm.vars.correct_dir * 0.045}
 end
 
 function WAIT_LIGHT:init()

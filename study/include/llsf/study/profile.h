@@ -67,6 +67,8 @@ struct RobotProfile {
   double laser_mount_x_m = 0.0;
   double robot_laser_radius_m = 0.0;
   double robot_laser_offset_m = 0.0;
+  /// The optical sensors' trigger range (world.sensors.optical.range_m); 0: the world's.
+  double optical_range_m = 0.0;
 
   // Failures.
   double jam_probability = 0.0;  ///< HandlingConfig::jam_probability
