@@ -36,6 +36,11 @@ inline std::string default_recordings_dir(const std::string& db) {
   return (p.parent_path() / (p.stem().string() + "-recordings")).string();
 }
 
+/// The summary of a run as `llsfsim run` prints it (docs/llsfsim.md): the metrics' lines as the
+/// metric table says (study/metrics.h), with the orders, the issues, the result hash and the
+/// test verdicts.
+void print_summary(const study::RunResult& r, std::ostream& out);
+
 /// `llsfsim skill`: one skill string (or several, in turn) on one robot in a fresh game.
 Action add_skill_command(CLI::App& app);
 /// `llsfsim run`: one game of a scenario with a summary and the test-case verdicts.

@@ -36,6 +36,7 @@
 #include "llsf/core/text.h"
 #include "llsf/sim/agent_brain.h"
 #include "llsf/sim/driver.h"
+#include "llsf/study/metrics.h"
 #include "llsf/study/recording.h"
 #include "llsf/study/runner.h"
 #include "llsf/study/scenario.h"
@@ -119,9 +120,8 @@ void print_issues(const study::RunResult& r, std::ostream& out) {
   std::map<std::string, std::pair<int, double>> failures;  // "robot skill: error" -> (n, first)
   for (const study::RunIssue& i : r.issues) {
     if (!i.is_mistake()) {
-      const std::string skill = i.text.substr(0, i.text.find('{'));
-      const std::size_t colon = i.text.find("}: ");
-      const std::string error = colon == std::string::npos ? i.text : i.text.substr(colon + 3);
+      const std::string skill = i.skill.substr(0, i.skill.find('{'));
+      const std::string& error = i.text;
       // (the engine's error starts with the skill's name already: named once)
       const bool named = error.compare(0, skill.size() + 2, skill + ": ") == 0;
       auto& f = failures[i.robot + " " + (named ? error : skill + ": " + error)];
@@ -131,9 +131,11 @@ void print_issues(const study::RunResult& r, std::ostream& out) {
     if (mistakes++ >= 10) continue;
     std::string where;
     if (!i.rule.empty()) where = " rule " + i.rule;
-    if (!i.place.empty()) where += " (" + i.place + ")";
-    out << fmt::format("issue      {:7.1f} s {} {}{}: {}\n", i.time_s, i.robot, i.kind, where,
-                       i.text);
+    if (!i.file.empty()) where += " (" + i.place() + ")";
+    // An unknown skill: its skill string before the engine's error.
+    const std::string text = i.skill.empty() ? i.text : i.skill + ": " + i.text;
+    out << fmt::format("issue      {:7.1f} s {} {}{}: {}\n", i.time_s, i.robot,
+                       study::to_string(i.kind), where, text);
   }
   // r.mistakes counts those not kept too (RunResult::kMaxIssues).
   if (r.mistakes > std::min(mistakes, 10)) {
@@ -157,60 +159,61 @@ void print_issues(const study::RunResult& r, std::ostream& out) {
   }
 }
 
+}  // namespace
+
 void print_summary(const study::RunResult& r, std::ostream& out) {
   out << fmt::format("scenario   {}{}  seed {}\n", r.scenario,
                      r.variant.empty() ? "" : " [" + r.variant + "]", r.seed);
-  out << fmt::format("points     {:4}   exploration {:4}   production {:4}\n", r.points,
-                     r.exploration_points, r.production_points);
-  out << fmt::format("explored   {:4} machines reported, {} correct\n", r.exploration_reports,
-                     r.exploration_correct);
-  out << fmt::format("products   P1 {}  P2 {}  P3 {}   recycled {}   deliveries {}\n",
-                     r.products_p1, r.products_p2, r.products_p3, r.recycled, r.deliveries);
-  if (!r.orders.empty()) {
-    out << "orders     ";
-    for (std::size_t i = 0; i < r.orders.size(); ++i) {
-      const study::OrderResult& o = r.orders[i];
-      out << fmt::format("{}#{} {} {}/{} [{}-{} s]", i ? "\n           " : "", o.id, o.product,
-                         o.delivered, o.requested, o.window_begin_s, o.window_end_s);
+  // The metrics' lines, as the metric table says (study/metrics.h): each metric's part in table
+  // order on its line; between them what is no metric (the orders, the issues, the hash).
+  using Show = study::SummaryLine::Show;
+  for (const study::SummaryLine& line : study::summary_lines()) {
+    std::string text;
+    bool nonzero = false;
+    std::vector<const study::Metric*> parts;
+    for (const study::Metric& m : study::metrics()) {
+      if (m.line == line.label) parts.push_back(&m);
     }
-    out << "\n";
-  }
-  out << fmt::format("robots     {} collisions, {} skill failures, {} agent runtime errors\n",
-                     r.collisions, r.skill_failures, r.agent_runtime_errors);
-  print_issues(r, out);
-  if (r.lock_grants + r.lock_refusals > 0) {
-    out << fmt::format(
-        "locks      {} grants, {} refusals; {} waits, {:.1f} s waited in all, longest {:.1f} s\n",
-        r.lock_grants, r.lock_refusals, r.lock_waits, r.lock_wait_s, r.lock_wait_max_s);
-  }
-  out << fmt::format(
-      "production first complex product {}, {} role changes{}, storage low {} pucks{}\n",
-      r.first_complex_production_s
-          ? fmt::format("at {:.0f} s of production", *r.first_complex_production_s)
-          : std::string("none"),
-      r.role_changes,
-      r.first_role_change_game_s
-          ? fmt::format(" (first at {:.0f} s of the game)", *r.first_role_change_game_s)
-          : std::string(),
-      r.storage_min,
-      r.storage_empty_game_s
-          ? fmt::format(" (empty at {:.0f} s of the game)", *r.storage_empty_game_s)
-          : std::string());
-  if (r.profile != "ideal" || r.jams > 0) {
-    out << fmt::format(
-        "profile    {}: {} jams, {} robots jammed at the end, {} failures of one "
-        "skill in a row at most\n",
-        r.profile, r.jams, r.jammed_at_end, r.skill_failure_streak_max);
-  }
-  out << fmt::format("radio      {} copies sent, {} dropped\n", r.messages_sent,
-                     r.messages_dropped);
-  out << fmt::format("speed      {:.0f} s of game in {:.2f} s CPU: {:.0f}x real time\n",
-                     r.game_time_s, r.cpu_s, r.real_time_factor);
-  out << fmt::format("result     {:016x}\n", r.result_hash);
-  for (const study::TestVerdict& t : r.tests) {
-    out << fmt::format("test       {}  {}: {}\n", t.passed ? "PASS" : "FAIL", t.name, t.detail);
+    std::stable_sort(parts.begin(), parts.end(),
+                     [](const study::Metric* a, const study::Metric* b) {
+                       return a->summary_rank < b->summary_rank;
+                     });
+    for (const study::Metric* part : parts) {
+      const study::Metric& m = *part;
+      const std::optional<double> v = m.value(r);
+      if (v && *v != 0.0 && m.json_form != study::JsonForm::kBool) nonzero = true;
+      if (!v) {
+        text += m.summary_absent;
+      } else if (m.json_form == study::JsonForm::kBool) {
+        text += fmt::format(fmt::runtime(m.summary), *v != 0.0 ? "yes" : "no");
+      } else {
+        text += fmt::format(fmt::runtime(m.summary), *v);
+      }
+    }
+    if (line.show == Show::kIfAnyNonZero && !nonzero) continue;
+    if (line.show == Show::kIfProfile) {
+      if (r.profile == "ideal" && r.jams == 0) continue;
+      text = r.profile + ": " + text;
+    }
+    out << fmt::format("{:<11}{}\n", line.label, text);
+    if (line.label == "orders") {
+      for (const study::OrderResult& o : r.orders) {
+        out << fmt::format("           #{} {} {}/{} [{}-{} s]\n", o.id, o.product, o.delivered,
+                           o.requested, o.window_begin_s, o.window_end_s);
+      }
+    } else if (line.label == "robots") {
+      print_issues(r, out);
+    } else if (line.label == "speed") {
+      out << fmt::format("result     {:016x}\n", r.result_hash);
+    } else if (line.label == "tests") {
+      for (const study::TestVerdict& t : r.tests) {
+        out << fmt::format("test       {}  {}: {}\n", t.passed ? "PASS" : "FAIL", t.name, t.detail);
+      }
+    }
   }
 }
+
+namespace {
 
 /// Prints the agent warnings `run` shows before its game (a confval nobody reads, a time read
 /// CLIPS never evaluates again, the sandbox

@@ -35,6 +35,24 @@ const char* to_string(SkillStatus status) {
   return "IDLE";
 }
 
+const char* to_string(AgentIssueKind kind) {
+  switch (kind) {
+    case AgentIssueKind::kRuntimeError:
+      return "runtime-error";
+    case AgentIssueKind::kRuleLoop:
+      return "rule-loop";
+  }
+  return "runtime-error";
+}
+
+const char* to_string(AgentEventKind kind) {
+  switch (kind) {
+    case AgentEventKind::kRoleChange:
+      return "role-change";
+  }
+  return "role-change";
+}
+
 const char* to_string(LogLevel level) {
   switch (level) {
     case LogLevel::kDebug:
@@ -118,8 +136,13 @@ struct AgentHost::Impl {
   std::string werror_rule;    // the rule whose actions ran when `werror` began ("" if none)
   std::string lines[4];       // partial output lines per level
   std::string budget_reason;  // set when the work budget stopped the cycle
-  std::unordered_map<std::string, std::string> rule_places;      // defrule name -> "file:line"
-  std::unordered_map<std::string, std::string> function_places;  // deffunction -> "file:line"
+  // Where a construct starts.
+  struct Place {
+    std::string file;
+    int line = 0;
+  };
+  std::unordered_map<std::string, Place> rule_places;      // defrule name -> its place
+  std::unordered_map<std::string, Place> function_places;  // deffunction -> its place
   std::int64_t max_steps_seen = 0;
   std::unique_ptr<detail::Tracer> tracer;  // set_trace()
   TimeReadCheck time_check;                // over the files in load order
@@ -268,14 +291,36 @@ struct AgentHost::Impl {
                                                                 : batch_place_ + ": " + text);
       return;
     }
-    const std::string rule = env.executing_rule();
+    report_runtime_error(env.executing_rule(), text);
+  }
+
+  // A runtime error: logged for people ("runtime error in rule NAME (FILE:LINE): text") and
+  // reported as data (AgentIo::issues), counted.
+  void report_runtime_error(const std::string& rule, const std::string& text) {
     if (rule.empty()) {
       emit(LogLevel::kError, "runtime error: " + text);
     } else {
       emit(LogLevel::kError,
            "runtime error in rule " + rule + place_of(rule_places, rule) + ": " + text);
     }
+    issue(AgentIssueKind::kRuntimeError, rule, text);
     ++runtime_errors;
+  }
+
+  // Reports an issue as data.
+  void issue(AgentIssueKind kind, const std::string& rule, std::string_view text) {
+    if (!state.io.issues) return;
+    AgentIssue i;
+    i.time = state.now;
+    i.kind = kind;
+    i.agent = state.config.robot_name;
+    i.rule = rule;
+    if (const auto it = rule_places.find(rule); !rule.empty() && it != rule_places.end()) {
+      i.file = it->second.file;
+      i.line = it->second.line;
+    }
+    i.text = text;
+    state.io.issues(i);
   }
 
   // CLIPS' (reset) for a Fawkes-style agent: the host's facts (ff-feature, robot-info, ...) are
@@ -545,22 +590,17 @@ struct AgentHost::Impl {
       msg = budget_reason;
       budget_reason.clear();
     }
-    if (rule.empty()) {
-      emit(LogLevel::kError, "runtime error: " + msg);
-    } else {
-      emit(LogLevel::kError,
-           "runtime error in rule " + rule + place_of(rule_places, rule) + ": " + msg);
-    }
+    report_runtime_error(rule, msg);
     werror.clear();
-    ++runtime_errors;
     return 1;
   }
 
   // " (file:line)" of a rule or function, or "" if its place is unknown.
-  static std::string place_of(const std::unordered_map<std::string, std::string>& places,
+  static std::string place_of(const std::unordered_map<std::string, Place>& places,
                               const std::string& name) {
     const auto it = places.find(name);
-    return it != places.end() ? " (" + it->second + ")" : std::string();
+    return it != places.end() ? " (" + it->second.file + ":" + std::to_string(it->second.line) + ")"
+                              : std::string();
   }
 
   // Where each defrule and deffunction (defgeneric, defmethod) of `text` starts ("file:line"),
@@ -594,8 +634,7 @@ struct AgentHost::Impl {
         std::size_t b = ke;
         while (b < text.size() && std::isspace(static_cast<unsigned char>(text[b])) != 0) ++b;
         const std::size_t e = token_end(b);
-        if (e > b)
-          (*places)[text.substr(b, e - b)] = std::string(source) + ":" + std::to_string(line);
+        if (e > b) (*places)[text.substr(b, e - b)] = Place{std::string(source), line};
       }
     }
   }
@@ -715,10 +754,11 @@ struct AgentHost::Impl {
       result.limit_reached = true;
       ++limit_hits;
       const std::string rule = env.next_rule();
-      emit(LogLevel::kWarn,
-           "rule firing limit of " + std::to_string(state.config.max_rules_per_cycle) +
-               " reached with rules still on the agenda (endless rule loop?); next: rule " + rule +
-               place_of(rule_places, rule));
+      const std::string what = "rule firing limit of " +
+                               std::to_string(state.config.max_rules_per_cycle) +
+                               " reached with rules still on the agenda (endless rule loop?)";
+      emit(LogLevel::kWarn, what + "; next: rule " + rule + place_of(rule_places, rule));
+      issue(AgentIssueKind::kRuleLoop, rule, what);
     }
   }
 };

@@ -51,9 +51,60 @@ class LogFeature final : public Feature {
       // string a million times).
       env.guard_concatenation(name);
     }
+    // (agent-event KIND ARG...): an outcome the agent declares as data (AgentIo::events,
+    // docs/clips.md, "Agent events"), checked here: a kind the host does not know or arguments
+    // that do not fit it are a runtime error, never a silent miss.
+    env.define_function("agent-event", "1**", [this](Args& a) {
+      std::string_view kind;
+      if (a.type(0) != Value::Type::kSymbol || !a.text(0, kind)) {
+        a.env().error(a.function(), "the first argument is the event's kind, a symbol (kinds: " +
+                                        kinds_text() + ")");
+        return Value::boolean(false);
+      }
+      AgentEvent e;
+      bool known = false;
+      for (const AgentEventKind k : kKinds) {
+        if (kind == to_string(k)) {
+          e.kind = k;
+          known = true;
+        }
+      }
+      if (!known) {
+        a.env().error(a.function(),
+                      "unknown kind '" + std::string(kind) + "' (kinds: " + kinds_text() + ")");
+        return Value::boolean(false);
+      }
+      for (int i = 1; i < a.count(); ++i) e.args.push_back(a.value(i));
+      switch (e.kind) {
+        case AgentEventKind::kRoleChange:
+          if (e.args.size() < 2 || e.args.size() > 3 || e.args[0].type != Value::Type::kSymbol ||
+              e.args[1].type != Value::Type::kSymbol) {
+            a.env().error(a.function(),
+                          "role-change takes FROM TO [WHY]: the roles as symbols, e.g. "
+                          "(agent-event role-change P1P2 P3 \"time is short\")");
+            return Value::boolean(false);
+          }
+          break;
+      }
+      if (s_.io.events) {
+        const std::string rule = a.env().executing_rule();
+        e.time = s_.now;
+        e.agent = s_.config.robot_name;
+        e.rule = rule;
+        s_.io.events(e);
+      }
+      return Value::boolean(true);
+    });
   }
 
  private:
+  static constexpr AgentEventKind kKinds[] = {AgentEventKind::kRoleChange};
+  static std::string kinds_text() {
+    std::string out;
+    for (const AgentEventKind k : kKinds)
+      out += std::string(out.empty() ? "" : ", ") + to_string(k);
+    return out;
+  }
   HostState& s_;
 };
 

@@ -29,6 +29,7 @@ local function navigator_failed(self)
          why = "by " .. navigator:blocked_by() .. (why ~= "" and (": " .. why) or "")
       end
       self.fsm.error = string.format("navigator %s: %s", status, why)
+      if status == "ABORTED" then self.fsm.reason = "aborted" end
       return true
    end
    return false

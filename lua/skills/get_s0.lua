@@ -85,6 +85,7 @@ local function no_puck(self, vars)
    vars.spot = vars.spot + 1
    if vars.spot > #vars.spots then
       self.fsm.error = string.format("get_s0: no puck seen at %s", table.concat(vars.spots, ", "))
+      self.fsm.reason = "not-found"  -- an empty storage: nothing wrong with the robot
       return true
    end
    return false
@@ -147,6 +148,7 @@ function RETRY:init()
    v.avoid[#v.avoid + 1] = {v.px, v.py}
    if v.attempts >= 4 then
       self.fsm.error = "get_s0: " .. tostring(self.fsm.states.TAKE.error or "take_puck failed")
+      self.fsm.reason = self.fsm.states.TAKE.reason  -- take_puck's, if it gave one
    end
 end
 

@@ -118,6 +118,7 @@ function NEXT_SPOT:init()
    local e = self.fsm.states.CARRY.error
    if self.fsm.vars.tried >= 3 then
       self.fsm.error = "leave_puck: " .. tostring(e or "no dump spot reached")
+      self.fsm.reason = self.fsm.states.CARRY.reason  -- drive_to's, if it gave one
    end
 end
 

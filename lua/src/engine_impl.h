@@ -106,6 +106,7 @@ struct SkillEngine::Impl {
 
   SkillStatus status = SkillStatus::kInactive;
   std::string error;
+  FailReason reason = FailReason::kNone;
   std::string result;  // fsm.result of the string's skills when it ended
   std::string skill_string;
   std::function<void(LogLevel, std::string_view)> log_sink;

@@ -12,6 +12,14 @@ local fmt, concat = string.format, table.concat
 local now_ns, exhausted, log = native.now_ns, native.exhausted, native.log
 
 local S_INACTIVE, S_FINAL, S_RUNNING, S_FAILED = 0, 1, 2, 3
+-- Entry points for the C++ engine (filled below). E.raised_reason: the reason code of the error
+-- last raised on purpose (an unknown skill), read by the engine when a string's run fails with
+-- an error (lua::FailReason; docs/skills.md, "Failure reasons").
+local E = {}
+-- The reasons fsm.reason may hold: those a skill declares ("aborted", "not-found") and those it
+-- hands on from a sub-skill (fail_to, or self.fsm.reason = self.fsm.states.X.reason).
+local kDeclaredReasons = {["aborted"] = true, ["not-found"] = true, ["failed"] = true,
+                          ["unknown-skill"] = true, ["error"] = true, ["budget"] = true}
 local fsms = setmetatable({}, {__mode = "k"})  -- every SkillHSM made by SkillHSM:new
 local kMaxStatesPerStep = 32
 
@@ -404,7 +412,10 @@ local function module_env(h)
         if type(dep) ~= "string" then
           error(fmt("depends_skills[%d]: expected a skill name (string)", i), 2)
         end
-        if not handles[dep] then error(fmt("depends_skills: unknown skill '%s'", dep), 2) end
+        if not handles[dep] then
+          h.load_reason = "unknown-skill"
+          error(fmt("depends_skills: unknown skill '%s'", dep), 2)
+        end
         if dep == h.name then error("depends_skills: a skill cannot depend on itself", 2) end
         h.bindings[dep] = proxies[dep]
         h.depends[#h.depends + 1] = dep
@@ -800,7 +811,7 @@ local function run_subskills(fsm, st)
     local status = call_skill(h, st.call_args[i] or st.args[h.name] or fsm.vars)
     if status == S_FAILED then
       return fsm.states[st.fail_to], fmt("%s()/%s failed: %s", st.name, h.name,
-                                          tostring(h.error))
+                                          tostring(h.error)), h.reason
     elseif status ~= S_FINAL then
       all_final = false
     end
@@ -851,7 +862,7 @@ local function enter(fsm, st, now)
   st.entered_ns = now
   st.waited = nil
   st.args = setmetatable({}, st.args_mt)
-  st.error = nil
+  st.error, st.reason = nil, nil
   fsm.current = st
   fsm.running = st
   if st.subskills then
@@ -862,13 +873,16 @@ local function enter(fsm, st, now)
   return st
 end
 
-local function leave(fsm, st, to, tr, err)
+-- `reason`: a failed sub-skill's reason code, taken over with its error (fail_to).
+local function leave(fsm, st, to, tr, err, reason)
   if st.exit then fsm.running = st; st:exit() end
   local e = err or (tr and tr.error)
   if to == fsm.failed and not fsm.error then
     fsm.error = e or fmt("%s: %s", st.name, tr and tr.label or "failed")
+    if err and reason and fsm.reason == nil then fsm.reason = reason end
   elseif e then
     st.error = e
+    if err then st.reason = reason end
   end
   if fsm.debug then
     log(0, fmt("%s: %s -> %s (%s)", fsm.name, st.name, to.name, tr and tr.label or "skills"))
@@ -956,11 +970,11 @@ local function fsm_step(fsm)
     st.visit = fsm.step_id
     fsm.running = st
     if st.loop then st:loop() end
-    local to, tr, err = nil, nil, nil
+    local to, tr, err, sub_reason = nil, nil, nil, nil
     if fsm.error == nil then
       if st.subskills then
         progress = true
-        to, err = run_subskills(fsm, st)
+        to, err, sub_reason = run_subskills(fsm, st)
       end
       -- The state's transitions, then the defaults: the first whose timeout passed or whose
       -- condition holds (written out, no call per transition: this runs in every step).
@@ -992,7 +1006,7 @@ local function fsm_step(fsm)
       trs[#trs + 1] = err and "fail_to" or (st.subskills and fsm.error == nil and "final_to") or
                       "error"
     end
-    leave(fsm, st, to, tr, err)
+    leave(fsm, st, to, tr, err, sub_reason)
     st = enter(fsm, to, now)
     path[#path + 1] = st.name
   end
@@ -1050,13 +1064,14 @@ reset_skill = function(h)
   end
   if h.fsm then
     h.fsm.current, h.fsm.error, h.fsm.result, h.fsm.vars = nil, nil, nil, {}
+    h.fsm.reason = nil
     -- fsm.passed(_by) stay: the last step's states are still to be reported when the string
     -- ended in it (its step number tells them from a new step's).
     h.fsm.misses = nil
     h.fsm.spin = nil
     for _, st in ipairs(h.fsm.state_list) do st.visit = 0 end
   end
-  h.active, h.status, h.error, h.vars = false, S_INACTIVE, nil, nil
+  h.active, h.status, h.error, h.vars, h.reason = false, S_INACTIVE, nil, nil, nil
   for i = #h.children, 1, -1 do
     local c = h.children[i]
     h.children[i] = nil
@@ -1071,6 +1086,7 @@ call_skill = function(h, args)
               h.path or h.name), 0)
   end
   if h.load_error then
+    E.raised_reason = h.load_reason or "error"
     error(fmt("skill '%s' is not available: %s", h.name, h.load_error), 0)
   end
   if h.in_call then error(fmt("recursive call of skill '%s'", h.name), 0) end
@@ -1106,10 +1122,23 @@ call_skill = function(h, args)
   cond_fsm, cond_tr = nil, nil  -- a condition that raised an error left them set
   if ok then
     h.status = status
-    if status == S_FAILED then h.error = err == nil and "failed" or error_text(err) end
+    if status == S_FAILED then
+      h.error = err == nil and "failed" or error_text(err)
+      -- The skill's own failure: the reason it declared (fsm.reason), if any.
+      local r = fsm and fsm.reason
+      if r ~= nil and not kDeclaredReasons[r] then
+        h.error = fmt("%s; fsm.reason must be \"aborted\" or \"not-found\" (or a sub-skill's " ..
+                      "reason), not %s", h.error, tostring(r))
+        h.reason = "error"
+      else
+        h.reason = r or "failed"
+      end
+    end
     return status
   end
   local running = h.fsm and h.fsm.running
+  h.reason = exhausted() and "budget" or E.raised_reason or "error"
+  E.raised_reason = nil
   h.status = S_FAILED
   h.error = running and (running.name .. ": " .. error_text(status)) or error_text(status)
   if h.fsm then
@@ -1149,8 +1178,7 @@ end
 proxy_mt.__call = function(p, args) return handle_mt.__call(real_of[p], args) end
 proxy_mt.__tostring = function(p) return "skill " .. real_of[p].name end
 
--- Entry points for the C++ engine ------------------------------------------------------------
-local E = {}
+-- Entry points for the C++ engine (E: declared at the top) -----------------------------------
 
 function E.declare_skills(names)
   for _, name in ipairs(names) do
@@ -1354,7 +1382,10 @@ end
 local string_env = setmetatable({}, {
   __index = function(t, k)
     local v = proxies[k] or base[k]
-    if v == nil then error(fmt("unknown skill '%s'", tostring(k)), 2) end
+    if v == nil then
+      E.raised_reason = "unknown-skill"
+      error(fmt("unknown skill '%s'", tostring(k)), 2)
+    end
     rawset(t, k, v)
     return v
   end,
@@ -1367,13 +1398,14 @@ end
 local fawkes_poll = fawkes.poll
 
 function E.run_cycle(chunk)
+  E.raised_reason = nil
   cycle_id = cycle_id + 1
   cycle_now_ns = now_ns()
   fawkes_poll()
   for i = #called, 1, -1 do called[i] = nil end
   depth, caller = 0, nil
   chunk()
-  local status, errors, results = S_FINAL, nil, nil
+  local status, errors, results, reason = S_FINAL, nil, nil, nil
   for i = 1, #called do
     local h = called[i]
     local r = h.fsm and h.fsm.result
@@ -1381,12 +1413,14 @@ function E.run_cycle(chunk)
       h.status = S_FAILED
       h.error = fmt("fsm.result must be a string (e.g. \"1.20 3.40\") or a number, not a %s",
                     type(r))
+      h.reason = "error"
     elseif r ~= nil and h.status ~= S_RUNNING then
       results = results or {}
       results[#results + 1] = tostring(r)
     end
     if h.status == S_FAILED then
       status = S_FAILED
+      reason = reason or h.reason or "failed"
       errors = errors or {}
       -- (named once: the library's skills start their own messages with their name)
       local e, prefix = tostring(h.error), h.name .. ": "
@@ -1395,7 +1429,8 @@ function E.run_cycle(chunk)
       status = S_RUNNING
     end
   end
-  return status, errors and concat(errors, "; ") or nil, results and concat(results, "; ") or ""
+  return status, errors and concat(errors, "; ") or nil, results and concat(results, "; ") or "",
+         reason
 end
 
 -- The blackboard interfaces skills wrote since the last call (fawkes.lua, F.written).

@@ -43,6 +43,43 @@ const char* to_string(SkillStatus status) {
   return "?";
 }
 
+const char* to_string(FailReason reason) {
+  switch (reason) {
+    case FailReason::kNone:
+      return "none";
+    case FailReason::kFailed:
+      return "failed";
+    case FailReason::kAborted:
+      return "aborted";
+    case FailReason::kNotFound:
+      return "not-found";
+    case FailReason::kUnknownSkill:
+      return "unknown-skill";
+    case FailReason::kBadString:
+      return "bad-string";
+    case FailReason::kError:
+      return "error";
+    case FailReason::kBudget:
+      return "budget";
+  }
+  return "none";
+}
+
+namespace {
+
+// The reason the prelude names (E.run_cycle's fourth result, E.raised_reason); kError for a
+// name it should not give.
+FailReason reason_named(const char* name) {
+  if (name == nullptr) return FailReason::kError;
+  for (const FailReason r : {FailReason::kFailed, FailReason::kAborted, FailReason::kNotFound,
+                             FailReason::kUnknownSkill, FailReason::kError, FailReason::kBudget}) {
+    if (std::strcmp(name, to_string(r)) == 0) return r;
+  }
+  return FailReason::kError;
+}
+
+}  // namespace
+
 // ---- config ------------------------------------------------------------------------------------
 
 namespace {
@@ -725,12 +762,14 @@ ExecResult SkillEngine::exec(std::string_view skill_string) {
   }
   e.skill_string.assign(skill_string);
   e.error.clear();
+  e.reason = FailReason::kNone;
   e.result.clear();
   lua_pushlstring(e.L, skill_string.data(), skill_string.size());
   if (e.call_entry("compile", 1, 2) != LUA_OK || lua_isnil(e.L, -2)) {
     e.error = lua_isstring(e.L, -1) ? lua_tostring(e.L, -1) : "cannot compile the skill string";
     lua_settop(e.L, 0);
     e.status = SkillStatus::kFailed;
+    e.reason = FailReason::kBadString;
     return {false, e.error};
   }
   lua_pop(e.L, 1);
@@ -744,6 +783,7 @@ void SkillEngine::stop() {
   e.abort_running();
   e.status = SkillStatus::kInactive;
   e.error.clear();
+  e.reason = FailReason::kNone;
   e.result.clear();
   e.skill_string.clear();
   e.robot.stop();
@@ -753,20 +793,30 @@ SkillStatus SkillEngine::cycle() {
   Impl& e = *impl_;
   if (e.status != SkillStatus::kRunning) return e.status;
   lua_rawgeti(e.L, LUA_REGISTRYINDEX, e.chunk_ref);
-  if (e.call_entry("run_cycle", 1, 3) != LUA_OK) {
+  if (e.call_entry("run_cycle", 1, 4) != LUA_OK) {
     e.status = SkillStatus::kFailed;
     e.error = e.full_paths(e.explain(pop_message(e.L)));
+    // What the prelude noted when it raised the error (an unknown skill), read without a call.
+    if (any_budget_exhausted(e)) {
+      e.reason = FailReason::kBudget;
+    } else {
+      lua_rawgeti(e.L, LUA_REGISTRYINDEX, e.engine_ref);
+      lua_getfield(e.L, -1, "raised_reason");
+      e.reason = lua_isstring(e.L, -1) ? reason_named(lua_tostring(e.L, -1)) : FailReason::kError;
+      lua_pop(e.L, 2);
+    }
   } else {
-    const lua_Integer s = lua_tointeger(e.L, -3);
+    const lua_Integer s = lua_tointeger(e.L, -4);
     e.status = static_cast<SkillStatus>(std::clamp<lua_Integer>(s, 0, 3));
     if (e.status == SkillStatus::kFailed) {
-      e.error = e.full_paths(e.explain(lua_isstring(e.L, -2) ? lua_tostring(e.L, -2) : "FAILED"));
+      e.error = e.full_paths(e.explain(lua_isstring(e.L, -3) ? lua_tostring(e.L, -3) : "FAILED"));
+      e.reason = reason_named(lua_tostring(e.L, -1));
     }
     if (e.status != SkillStatus::kRunning) {
-      const char* r = lua_tostring(e.L, -1);
+      const char* r = lua_tostring(e.L, -2);
       e.result = r != nullptr ? r : "";
     }
-    lua_pop(e.L, 3);
+    lua_pop(e.L, 4);
   }
   if (e.status != SkillStatus::kRunning) e.abort_running();
   return e.status;
@@ -774,6 +824,9 @@ SkillStatus SkillEngine::cycle() {
 
 SkillStatus SkillEngine::status() const { return impl_->status; }
 const std::string& SkillEngine::error() const { return impl_->error; }
+FailReason SkillEngine::fail_reason() const {
+  return impl_->status == SkillStatus::kFailed ? impl_->reason : FailReason::kNone;
+}
 const std::string& SkillEngine::result() const { return impl_->result; }
 const std::string& SkillEngine::skill_string() const { return impl_->skill_string; }
 core::SimTime SkillEngine::cycle_period() const {

@@ -18,7 +18,7 @@ std::vector<std::string> agent_files(const std::vector<std::string>& entries) {
 }
 
 AgentBrain::AgentBrain(Game& game, int index, AgentBrainConfig config, clips::LogSink log,
-                       clips::LockListener locks) {
+                       clips::LockListener locks, AgentReports reports) {
   skills_ = std::make_unique<SkillBrain>(game, index, std::move(config.skills));
   const RobotStack& stack = game.robot(index);
   clips::AgentConfig ac;
@@ -55,6 +55,8 @@ AgentBrain::AgentBrain(Game& game, int index, AgentBrainConfig config, clips::Lo
   io.motor = [robot](bool on) { robot->set_motor_enabled(on); };
   io.log = std::move(log);
   io.lock_events = std::move(locks);
+  io.issues = std::move(reports.issues);
+  io.events = std::move(reports.events);
   file_entries_ = std::move(config.agent_files);
   locks_ = config.locks;
   host_config_ = std::move(ac);

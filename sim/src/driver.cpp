@@ -20,10 +20,10 @@ GameDriver::Owned& GameDriver::slot(int index) {
 }
 
 AgentBrain& GameDriver::plug_agent(int index, AgentBrainConfig config, clips::LogSink log,
-                                   clips::LockListener locks) {
+                                   clips::LockListener locks, AgentReports reports) {
   Owned& s = slot(index);
   auto brain = std::make_unique<AgentBrain>(*game_, index, std::move(config), std::move(log),
-                                            std::move(locks));
+                                            std::move(locks), std::move(reports));
   game_->set_brain(index, brain.get());
   s.skills.reset();
   s.agent = std::move(brain);

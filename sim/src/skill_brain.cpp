@@ -107,7 +107,10 @@ void SkillBrain::report() {
   c.robot = std::string(game_.robot(index_).name());
   c.skill_string = engine_.skill_string();
   c.status = s;
-  if (s == lua::SkillStatus::kFailed) c.error = engine_.error();
+  if (s == lua::SkillStatus::kFailed) {
+    c.error = engine_.error();
+    c.reason = engine_.fail_reason();
+  }
   c.result = engine_.result();
   listener_(c);
 }

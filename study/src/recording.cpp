@@ -468,9 +468,11 @@ void Recorder::lock(const std::string& robot, const clips::LockEvent& e) {
 void Recorder::issue(core::SimTime t, const RunIssue& i) {
   Json j = Impl::event(t, "issue");
   j["robot"] = i.robot;
-  j["kind"] = i.kind;
+  j["kind"] = to_string(i.kind);
   if (!i.rule.empty()) j["rule"] = i.rule;
-  if (!i.place.empty()) j["place"] = i.place;
+  if (!i.file.empty()) j["place"] = i.place();
+  if (!i.skill.empty()) j["skill"] = i.skill;
+  if (i.reason != lua::FailReason::kNone) j["reason"] = lua::to_string(i.reason);
   j["text"] = i.text;
   // Noticed later than it happened (a lock held too long is found at the end).
   if (fixed(i.time_s, 2) < fixed(t.seconds(), 2)) j["time_s"] = fixed(i.time_s, 2);

@@ -19,6 +19,7 @@
 #include "llsf/refbox/protocol.h"
 #include "llsf/sim/agent_brain.h"
 #include "llsf/sim/driver.h"
+#include "llsf/study/metrics.h"
 #include "llsf/study/recording.h"
 
 namespace llsf::study {
@@ -31,6 +32,22 @@ std::string fmt_s(double v) {
   o.precision(1);
   o << v;
   return o.str();
+}
+
+/// `format` ("{} points", "{:.1f} s the longest lock hold") with its one field replaced by
+/// `v`: "{}" as a stream prints a double, "{:.Nf}" with N decimals.
+std::string format_value(std::string_view format, double v) {
+  const std::size_t open = format.find('{');
+  const std::size_t close = format.find('}', open);
+  if (open == std::string_view::npos || close == std::string_view::npos) return std::string(format);
+  std::ostringstream o;
+  const std::string_view spec = format.substr(open + 1, close - open - 1);
+  if (spec.starts_with(":.") && spec.ends_with('f')) {
+    o.setf(std::ios::fixed);
+    o.precision(std::stoi(std::string(spec.substr(2, spec.size() - 3))));
+  }
+  o << v;
+  return std::string(format.substr(0, open)) + o.str() + std::string(format.substr(close + 1));
 }
 
 double cpu_seconds() {
@@ -54,12 +71,6 @@ std::optional<refbox::GamePhase> start_phase(StartMode start) {
       break;
   }
   return refbox::GamePhase::kPreGame;
-}
-
-int deliveries_of(const refbox::Refbox& rb) {
-  int n = 0;
-  for (const auto& o : rb.orders()) n += o.quantity_delivered;
-  return n;
 }
 
 // Lock waits of the team. A wait opens with a request and closes with the grant. A refusal ends
@@ -185,11 +196,9 @@ class FailureStreaks {
     const std::string skill = ch.skill_string.substr(0, ch.skill_string.find('{'));
     int& n = runs_[{ch.robot, skill}];
     if (ch.status == lua::SkillStatus::kFailed) {
-      // A skill aborted by a newer skill string did not fail on its own; an empty storage is
+      // A skill whose navigation goal was aborted did not fail on its own; an empty storage is
       // no livelock (the agents wait before they look again).
-      if (ch.error.find("aborted") != std::string::npos ||
-          ch.error.find("no puck seen") != std::string::npos)
-        return;
+      if (ch.reason == lua::FailReason::kAborted || ch.reason == lua::FailReason::kNotFound) return;
       max_ = std::max(max_, ++n);
     } else if (ch.status == lua::SkillStatus::kFinal) {
       n = 0;
@@ -218,44 +227,18 @@ int pucks_in(const sim::Game& g, const kinematic::Rect& area) {
   return n;
 }
 
-/// The issue an agent's log line reports (docs/llsfsim.md, "Issues"), if any: the host's
-/// "runtime error in rule NAME (FILE:LINE): text" / "runtime error: text" and its firing-limit
-/// warning "... (endless rule loop?); next: rule NAME (FILE:LINE)".
-std::optional<RunIssue> issue_of(const clips::LogRecord& rec) {
-  const std::string_view text = rec.text;
+/// The issue the agent host reported as data.
+RunIssue issue_of(const clips::AgentIssue& i) {
   RunIssue issue;
-  issue.time_s = rec.time.seconds();
-  issue.robot = std::string(rec.agent);
-  // "NAME (PLACE)" or "NAME" at the start of `s`; returns the rest after it.
-  auto rule_at = [&issue](std::string_view s) {
-    const std::size_t end = s.find_first_of(" :");
-    issue.rule = std::string(s.substr(0, end));
-    s = end == std::string_view::npos ? std::string_view() : s.substr(end);
-    if (s.starts_with(" (")) {
-      const std::size_t close = s.find(')');
-      if (close != std::string_view::npos) {
-        issue.place = std::string(s.substr(2, close - 2));
-        s = s.substr(close + 1);
-      }
-    }
-    return s;
-  };
-  if (rec.level == clips::LogLevel::kError && text.starts_with("runtime error")) {
-    issue.kind = "runtime-error";
-    std::string_view rest = text.substr(std::string_view("runtime error").size());
-    if (rest.starts_with(" in rule ")) rest = rule_at(rest.substr(9));
-    if (rest.starts_with(": ")) rest.remove_prefix(2);
-    issue.text = std::string(rest);
-    return issue;
-  }
-  if (rec.level == clips::LogLevel::kWarn && text.starts_with("rule firing limit")) {
-    issue.kind = "rule-loop";
-    const std::size_t next = text.find("; next: rule ");
-    issue.text = std::string(text.substr(0, next));
-    if (next != std::string_view::npos) rule_at(text.substr(next + 13));
-    return issue;
-  }
-  return std::nullopt;
+  issue.time_s = i.time.seconds();
+  issue.robot = std::string(i.agent);
+  issue.kind =
+      i.kind == clips::AgentIssueKind::kRuleLoop ? IssueKind::kRuleLoop : IssueKind::kRuntimeError;
+  issue.rule = std::string(i.rule);
+  issue.file = std::string(i.file);
+  issue.line = i.line;
+  issue.text = std::string(i.text);
+  return issue;
 }
 
 /// The trace request for robot `name` (all requests that name it or "all", merged); nullopt if
@@ -351,10 +334,37 @@ void check_trace_requests(const Scenario& scenario, const std::vector<TraceReque
   }
 }
 
+const char* to_string(IssueKind kind) {
+  switch (kind) {
+    case IssueKind::kRuntimeError:
+      return "runtime-error";
+    case IssueKind::kRuleLoop:
+      return "rule-loop";
+    case IssueKind::kSkillFailure:
+      return "skill-failure";
+    case IssueKind::kUnknownSkill:
+      return "unknown-skill";
+    case IssueKind::kLockHold:
+      return "lock-hold";
+    case IssueKind::kAgentHalted:
+      return "agent-halted";
+  }
+  return "runtime-error";
+}
+
+std::string RunIssue::place() const {
+  if (file.empty()) return "";
+  return file + ":" + std::to_string(line);
+}
+
+int delivered_products(const refbox::Refbox& refbox) {
+  return static_cast<int>(refbox.report().deliveries.size());
+}
+
 bool RunResult::agent_error() const {
   if (agent_runtime_errors > 0) return true;
   return std::any_of(issues.begin(), issues.end(),
-                     [](const RunIssue& i) { return i.kind == "agent-halted"; });
+                     [](const RunIssue& i) { return i.kind == IssueKind::kAgentHalted; });
 }
 
 bool RunResult::passed() const {
@@ -390,7 +400,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   auto add_issue = [&issues, &issues_dropped, &mistakes, &recorder, &game](RunIssue i) {
     if (i.is_mistake()) ++mistakes;
     // A halt (at most one per robot) is always kept: RunResult::agent_error() reads it.
-    if (issues.size() < RunResult::kMaxIssues || i.kind == "agent-halted") {
+    if (issues.size() < RunResult::kMaxIssues || i.kind == IssueKind::kAgentHalted) {
       if (recorder) recorder->issue(game.time(), i);  // the viewer's timeline marks it
       issues.push_back(std::move(i));
     } else {
@@ -409,23 +419,28 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
     c.fawkes = spec.fawkes;
     c.agent_dir = spec.agent_dir;
     const std::string name(game.robot(i).name());
-    // The agent's decisions (info and above) go into the recording; the team agent's role
-    // changes are counted.
-    clips::LogSink log = [&recorder, &role_changes, &first_role_change_game_s,
-                          &add_issue](const clips::LogRecord& rec) {
+    // The agent's decisions (info and above) go into the recording. Its issues and events
+    // come as data (clips::AgentIo::issues, ::events): the role changes it declares are
+    // counted, whatever its log lines say.
+    clips::LogSink log = [&recorder](const clips::LogRecord& rec) {
       if (rec.level == clips::LogLevel::kDebug) return;
       if (recorder) recorder->agent(rec);
-      if (std::optional<RunIssue> issue = issue_of(rec)) add_issue(std::move(*issue));
-      if (rec.text.find("production: role change") != std::string_view::npos) {
-        if (role_changes++ == 0) first_role_change_game_s = rec.time.seconds();
-      }
+    };
+    sim::AgentReports reports;
+    reports.issues = [&add_issue](const clips::AgentIssue& reported) {
+      add_issue(issue_of(reported));
+    };
+    reports.events = [&role_changes, &first_role_change_game_s](const clips::AgentEvent& e) {
+      if (e.kind != clips::AgentEventKind::kRoleChange) return;
+      if (role_changes++ == 0) first_role_change_game_s = e.time.seconds();
     };
     auto locks = [&recorder, &lock_waits, &lock_holds, &game, i, name](const clips::LockEvent& e) {
       lock_waits.on(name, e);
       lock_holds.on(name, e, game.robot(i).jammed());
       if (recorder) recorder->lock(name, e);
     };
-    sim::AgentBrain& brain = driver.plug_agent(i, c, std::move(log), std::move(locks));
+    sim::AgentBrain& brain =
+        driver.plug_agent(i, c, std::move(log), std::move(locks), std::move(reports));
     // The agent's trace: --trace lines and the agent's facts and firings in the recording.
     const std::optional<TraceRequest> trace =
         hooks.trace_sink ? trace_for(hooks.trace, name) : std::nullopt;
@@ -461,9 +476,11 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
         issue.time_s = ch.time.seconds();
         issue.robot = ch.robot;
         // A skill name the library does not have is the agent's mistake.
-        issue.kind = ch.error.find("unknown skill '") != std::string::npos ? "unknown-skill"
-                                                                           : "skill-failure";
-        issue.text = ch.skill_string + ": " + ch.error;
+        issue.kind = ch.reason == lua::FailReason::kUnknownSkill ? IssueKind::kUnknownSkill
+                                                                 : IssueKind::kSkillFailure;
+        issue.skill = ch.skill_string;
+        issue.reason = ch.reason;
+        issue.text = ch.error;
         add_issue(std::move(issue));
       }
       // A jammed robot's failures are the jam's (robot profiles), not a livelock's.
@@ -480,69 +497,35 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
           });
     }
   }
-  double lock_hold_max_s = 0.0;  // set at the end, before the test cases without a deadline
   // Test cases with a deadline are judged when the game passes it.
   std::vector<TestVerdict> verdicts(scenario.tests.size());
   std::vector<bool> judged(scenario.tests.size(), false);
-  auto judge = [&](std::size_t i, int points, int deliveries) {
+  // `now`: the result so far (during the game only the metrics that may be judged by a
+  // deadline, Metric::test_by_s, are filled in).
+  auto judge = [&](std::size_t i, const RunResult& now) {
     const TestCase& t = scenario.tests[i];
     TestVerdict& v = verdicts[i];
     v.name = t.name;
-    const sim::GameSummary s = game.summary();
     std::ostringstream d;
-    double value = 0.0;
-    switch (t.kind) {
-      case TestCase::Kind::kPointsAtLeast:
-        value = points;
-        d << points << " points";
-        break;
-      case TestCase::Kind::kExplorationPointsAtLeast:
-        value = s.exploration_points;
-        d << value << " exploration points";
-        break;
-      case TestCase::Kind::kProductionPointsAtLeast:
-        value = s.production_points;
-        d << value << " production points";
-        break;
-      case TestCase::Kind::kDeliveriesAtLeast:
-        value = deliveries;
-        d << deliveries << " deliveries";
-        break;
-      case TestCase::Kind::kCollisionsAtMost:
-        value = s.collisions_robot_robot + s.collisions_robot_wall + s.collisions_robot_device;
-        d << value << " collisions";
-        break;
-      case TestCase::Kind::kNoAgentErrors: {
-        // Runtime errors, and halted agents (a rule loop cut by the firing limit is no runtime
-        // error, but an agent halted for it is).
-        int errors = 0;
-        int halts = 0;
-        for (int k = 0; k < game.robot_count(); ++k) {
-          if (const sim::AgentBrain* b = driver.agent(k)) {
-            errors += b->runtime_errors();
-            halts += b->halt() ? 1 : 0;
-          }
+    if (t.no_agent_errors()) {
+      // Runtime errors, and halted agents (a rule loop cut by the firing limit is no runtime
+      // error, but an agent halted for it is).
+      int errors = 0;
+      int halts = 0;
+      for (int k = 0; k < game.robot_count(); ++k) {
+        if (const sim::AgentBrain* b = driver.agent(k)) {
+          errors += b->runtime_errors();
+          halts += b->halt() ? 1 : 0;
         }
-        value = errors + halts;
-        d << errors << " agent runtime errors";
-        if (halts > 0) d << ", " << halts << " agent(s) halted";
-        break;
       }
-      case TestCase::Kind::kSkillFailureStreakAtMost:
-        value = streaks.max();
-        d << value << " failures of one skill in a row";
-        break;
-      case TestCase::Kind::kLockHoldAtMost:
-        value = lock_hold_max_s;
-        d << fmt_s(value) << " s the longest lock hold";
-        break;
+      d << errors << " agent runtime errors";
+      if (halts > 0) d << ", " << halts << " agent(s) halted";
+      v.passed = errors + halts == 0;
+    } else {
+      const double value = t.metric->value(now).value_or(0.0);
+      d << format_value(t.metric->test_value, value);
+      v.passed = t.metric->bound == Bound::kAtMost ? value <= t.value : value >= t.value;
     }
-    const bool at_most = t.kind == TestCase::Kind::kCollisionsAtMost ||
-                         t.kind == TestCase::Kind::kSkillFailureStreakAtMost ||
-                         t.kind == TestCase::Kind::kLockHoldAtMost;
-    v.passed = at_most                                    ? value <= t.value
-               : t.kind == TestCase::Kind::kNoAgentErrors ? value == 0.0
-                                                          : value >= t.value;
     d << " (need " << describe(t) << ")";
     v.detail = d.str();
     v.at_s = game.time().seconds();
@@ -590,7 +573,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
       RunIssue issue;
       issue.time_s = h->time.seconds();
       issue.robot = robot;
-      issue.kind = "agent-halted";
+      issue.kind = IssueKind::kAgentHalted;
       issue.text = h->text;
       add_issue(std::move(issue));
       if (recorder) recorder->note(h->time, robot, h->text);
@@ -635,7 +618,10 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
     for (std::size_t i = 0; i < scenario.tests.size(); ++i) {
       const auto& by = scenario.tests[i].by_s;
       if (!judged[i] && by && game.time() >= core::SimTime::from_seconds(*by)) {
-        judge(i, game.refbox().points(), deliveries_of(game.refbox()));
+        RunResult now;  // what a deadline may judge (Metric::test_by_s)
+        now.points = game.refbox().points();
+        now.deliveries = delivered_products(game.refbox());
+        judge(i, now);
       }
     }
     if (hooks.progress && game.time() >= next_progress) {
@@ -703,25 +689,24 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
                         o.quantity_requested, o.quantity_delivered, o.window_begin_s,
                         o.window_end_s});
   }
-  r.deliveries = static_cast<int>(rb.report().deliveries.size());
+  r.deliveries = delivered_products(rb);
   r.collisions = s.collisions_robot_robot + s.collisions_robot_wall + s.collisions_robot_device;
   r.skill_failures = skill_failures;
   for (int k = 0; k < game.robot_count(); ++k) {
     if (const sim::AgentBrain* b = driver.agent(k)) r.agent_runtime_errors += b->runtime_errors();
   }
   lock_waits.finish(game.time(), r);
-  lock_hold_max_s = lock_holds.finish(game.time(), [&game](const std::string& robot) {
+  r.lock_hold_max_s = lock_holds.finish(game.time(), [&game](const std::string& robot) {
     for (int i = 0; i < game.robot_count(); ++i) {
       if (game.robot(i).name() == robot) return game.robot(i).jammed();
     }
     return false;
   });
-  r.lock_hold_max_s = lock_hold_max_s;
   for (const LockHolds::LongHold& h : lock_holds.long_holds()) {
     RunIssue issue;
     issue.time_s = h.to.seconds();
     issue.robot = h.robot;
-    issue.kind = "lock-hold";
+    issue.kind = IssueKind::kLockHold;
     issue.text = "held the lock on " + h.resource + " for " + fmt_s((h.to - h.from).seconds()) +
                  " s (from " + fmt_s(h.from.seconds()) + " s; more than " +
                  fmt_s(RunIssue::kLongLockHold_s) + " s)";
@@ -752,7 +737,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   mix(s.comm.sent);
   r.result_hash = h;
   for (std::size_t i = 0; i < scenario.tests.size(); ++i) {
-    if (!judged[i]) judge(i, s.points, deliveries_of(rb));
+    if (!judged[i]) judge(i, r);
   }
   if (scenario.strict) {
     // Strict (scenario key `strict`, `run --strict`): any agent mistake fails the run.
@@ -807,10 +792,6 @@ std::string to_json(const RunResult& r) {
   using Json = nlohmann::ordered_json;  // keys in the order documented (docs/llsfsim.md)
   // JSON has no NaN or infinity: null instead.
   auto number = [](double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); };
-  // Absent (it did not happen) is null, like a number that is not finite.
-  auto optional_number = [&number](const std::optional<double>& v) {
-    return v ? number(*v) : Json(nullptr);
-  };
   Json orders = Json::array();
   for (const OrderResult& x : r.orders) {
     orders.push_back({{"id", x.id},
@@ -825,54 +806,48 @@ std::string to_json(const RunResult& r) {
   }
   char hash[17];
   std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(r.result_hash));
-  Json j = {{"scenario", r.scenario},
-            {"variant", r.variant},
-            {"seed", r.seed},
-            {"profile", r.profile},
-            {"game_time_s", number(r.game_time_s)},
-            {"points", r.points},
-            {"exploration_points", r.exploration_points},
-            {"production_points", r.production_points},
-            {"exploration_reports", r.exploration_reports},
-            {"exploration_correct", r.exploration_correct},
-            {"deliveries", r.deliveries},
-            {"orders", std::move(orders)},
-            {"products", {{"P1", r.products_p1}, {"P2", r.products_p2}, {"P3", r.products_p3}}},
-            {"recycled", r.recycled},
-            {"recycle_points", r.recycle_points},
-            {"collisions", r.collisions},
-            {"skill_failures", r.skill_failures},
-            {"agent_runtime_errors", r.agent_runtime_errors},
-            {"locks",
-             {{"grants", r.lock_grants},
-              {"refusals", r.lock_refusals},
-              {"waits", r.lock_waits},
-              {"wait_s", number(r.lock_wait_s)},
-              {"wait_max_s", number(r.lock_wait_max_s)},
-              {"hold_max_s", number(r.lock_hold_max_s)}}},
-            {"first_complex_production_s", optional_number(r.first_complex_production_s)},
-            {"role_changes", r.role_changes},
-            {"first_role_change_game_s", optional_number(r.first_role_change_game_s)},
-            {"storage_min", r.storage_min},
-            {"storage_empty_game_s", optional_number(r.storage_empty_game_s)},
-            {"jams", r.jams},
-            {"jammed_at_end", r.jammed_at_end},
-            {"skill_failure_streak_max", r.skill_failure_streak_max},
-            {"messages_sent", r.messages_sent},
-            {"messages_dropped", r.messages_dropped},
-            {"cpu_s", number(r.cpu_s)},
-            {"real_time_factor", number(r.real_time_factor)},
-            {"result_hash", hash},
-            {"passed", r.passed()},
-            {"tests", std::move(tests)}};
+  Json j = {
+      {"scenario", r.scenario}, {"variant", r.variant}, {"seed", r.seed}, {"profile", r.profile}};
+  // The metrics, as the metric table says (metrics.h): "locks.grants" is the key grants of an
+  // object locks; absent (it did not happen) is null, like a number that is not finite.
+  for (const Metric& m : metrics()) {
+    const std::optional<double> v = m.value(r);
+    Json* at = &j;
+    std::string_view path = m.json;
+    for (std::size_t dot = path.find('.'); dot != std::string_view::npos; dot = path.find('.')) {
+      at = &(*at)[std::string(path.substr(0, dot))];
+      path.remove_prefix(dot + 1);
+    }
+    Json& slot = (*at)[std::string(path)];
+    switch (m.json_form) {
+      case JsonForm::kInteger:
+        slot = v ? Json(static_cast<std::int64_t>(*v)) : Json(nullptr);
+        break;
+      case JsonForm::kNumber:
+        slot = v ? number(*v) : Json(nullptr);
+        break;
+      case JsonForm::kBool:
+        slot = v && *v != 0.0;
+        break;
+      case JsonForm::kArrayLength:
+        slot = m.json == "orders" ? std::move(orders) : std::move(tests);
+        break;
+    }
+  }
+  j["result_hash"] = hash;
   Json issues = Json::array();
   for (const RunIssue& i : r.issues) {
-    issues.push_back({{"time_s", number(i.time_s)},
-                      {"robot", i.robot},
-                      {"kind", i.kind},
-                      {"rule", i.rule},
-                      {"place", i.place},
-                      {"text", i.text}});
+    issues.push_back(
+        {{"time_s", number(i.time_s)},
+         {"robot", i.robot},
+         {"kind", to_string(i.kind)},
+         {"rule", i.rule},
+         {"place", i.place()},
+         {"skill", i.skill},
+         {"reason", i.kind == IssueKind::kSkillFailure || i.kind == IssueKind::kUnknownSkill
+                        ? lua::to_string(i.reason)
+                        : ""},
+         {"text", i.text}});
   }
   j["issues"] = std::move(issues);
   j["issues_dropped"] = r.issues_dropped;

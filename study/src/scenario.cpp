@@ -314,33 +314,32 @@ void read_tests(const core::ConfigNode& n, Scenario& s) {
     t.require_map();
     TestCase tc;
     int kinds = 0;
-    auto kind = [&](const char* key, TestCase::Kind k) {
-      const core::ConfigNode c = t[key];
-      if (!c.defined()) return;
+    // The conditions: one per metric with a test case (the metric table, metrics.h), and
+    // no_agent_errors.
+    for (const Metric& m : metrics()) {
+      if (m.test_key.empty()) continue;
+      const core::ConfigNode c = t[std::string(m.test_key).c_str()];
+      if (!c.defined()) continue;
       ++kinds;
-      tc.kind = k;
-      if (k == TestCase::Kind::kNoAgentErrors) {
-        if (!c.as_bool()) c.fail("only 'true' makes sense");
-      } else {
-        tc.value = c.as_double(core::non_negative());
-      }
-    };
-    kind("points_at_least", TestCase::Kind::kPointsAtLeast);
-    kind("exploration_points_at_least", TestCase::Kind::kExplorationPointsAtLeast);
-    kind("production_points_at_least", TestCase::Kind::kProductionPointsAtLeast);
-    kind("deliveries_at_least", TestCase::Kind::kDeliveriesAtLeast);
-    kind("collisions_at_most", TestCase::Kind::kCollisionsAtMost);
-    kind("no_agent_errors", TestCase::Kind::kNoAgentErrors);
-    kind("skill_failure_streak_at_most", TestCase::Kind::kSkillFailureStreakAtMost);
-    kind("lock_hold_at_most_s", TestCase::Kind::kLockHoldAtMost);
+      tc.metric = &m;
+      tc.value = c.as_double(core::non_negative());
+    }
+    if (const core::ConfigNode c = t["no_agent_errors"]; c.defined()) {
+      ++kinds;
+      tc.metric = nullptr;
+      if (!c.as_bool()) c.fail("only 'true' makes sense");
+    }
     const core::ConfigNode by = t["by_s"];
     const core::ConfigNode name = t["name"];
     t.no_other_keys();  // before the condition count: a misspelt condition is the likely cause
     if (kinds != 1) t.fail("a test case needs exactly one condition (e.g. points_at_least: 30)");
     if (by.defined()) {
-      if (tc.kind != TestCase::Kind::kPointsAtLeast &&
-          tc.kind != TestCase::Kind::kDeliveriesAtLeast) {
-        by.fail("by_s works with points_at_least and deliveries_at_least");
+      if (tc.metric == nullptr || !tc.metric->test_by_s) {
+        std::string with;
+        for (const Metric& m : metrics()) {
+          if (m.test_by_s) with += (with.empty() ? "" : " and ") + std::string(m.test_key);
+        }
+        by.fail("by_s works with " + with);
       }
       tc.by_s = by.as_double(core::positive());
       const double duration_s = static_cast<double>(s.duration.ns()) / 1e9;
@@ -573,31 +572,16 @@ Scenario read_scenario(const core::ConfigNode& root, const std::string& file) {
 
 std::string describe(const TestCase& t) {
   std::ostringstream ss;
-  switch (t.kind) {
-    case TestCase::Kind::kPointsAtLeast:
-      ss << ">= " << t.value << " points";
-      break;
-    case TestCase::Kind::kExplorationPointsAtLeast:
-      ss << ">= " << t.value << " exploration points";
-      break;
-    case TestCase::Kind::kProductionPointsAtLeast:
-      ss << ">= " << t.value << " production points";
-      break;
-    case TestCase::Kind::kDeliveriesAtLeast:
-      ss << ">= " << t.value << " deliveries";
-      break;
-    case TestCase::Kind::kCollisionsAtMost:
-      ss << "<= " << t.value << " collisions";
-      break;
-    case TestCase::Kind::kNoAgentErrors:
-      ss << "no agent runtime errors";
-      break;
-    case TestCase::Kind::kSkillFailureStreakAtMost:
-      ss << "<= " << t.value << " failures of one skill in a row";
-      break;
-    case TestCase::Kind::kLockHoldAtMost:
-      ss << "no lock held longer than " << t.value << " s";
-      break;
+  if (t.metric == nullptr) {
+    ss << "no agent runtime errors";
+  } else {
+    // The metric's condition text ("<= {} collisions") with the limit as a stream prints it.
+    std::ostringstream limit;
+    limit << t.value;
+    const std::string_view need = t.metric->test_need;
+    const std::size_t field = need.find("{}");
+    ss << need.substr(0, field) << limit.str()
+       << (field == std::string_view::npos ? std::string_view() : need.substr(field + 2));
   }
   if (t.by_s) ss << " by " << *t.by_s << " s";
   return ss.str();

@@ -16,6 +16,7 @@
 #include "llsf/core/version.h"
 #include "llsf/sim/agent_brain.h"
 #include "llsf/sim/skill_brain.h"
+#include "llsf/study/metrics.h"
 #include "stats_backend.h"
 
 namespace llsf::study {
@@ -275,79 +276,11 @@ std::string resolved_recording_path(const std::string& db_path, const std::strin
   return (fs::path(db_path).parent_path() / p).lexically_normal().string();
 }
 
-namespace {
-
-/// Every statistic of `r`, absent ones included (a value of nullopt), each with whether it may
-/// be absent.
-std::vector<std::pair<StatisticInfo, std::optional<double>>> all_statistics(const RunResult& r) {
-  int requested = 0;
-  int delivered = 0;
-  for (const OrderResult& o : r.orders) {
-    requested += o.requested;
-    delivered += o.delivered;
-  }
-  int tests_failed = 0;
-  for (const TestVerdict& t : r.tests) tests_failed += t.passed ? 0 : 1;
-  using Entry = std::pair<StatisticInfo, std::optional<double>>;
-  // v: a statistic every game has; maybe: one a game may lack; flag: a 0/1 share.
-  auto v = [](const char* name, double x) { return Entry{{name, false}, x}; };
-  auto maybe = [](const char* name, const std::optional<double>& x) {
-    return Entry{{name, true}, x};
-  };
-  auto flag = [](const char* name, bool b) { return Entry{{name, false}, b ? 1.0 : 0.0}; };
-  auto d = [](auto x) { return static_cast<double>(x); };
-  return {
-      v("game_time_s", r.game_time_s),
-      v("points", d(r.points)),
-      v("exploration_points", d(r.exploration_points)),
-      v("production_points", d(r.production_points)),
-      v("exploration_reports", d(r.exploration_reports)),
-      v("exploration_correct", d(r.exploration_correct)),
-      v("deliveries", d(r.deliveries)),
-      v("products_p1", d(r.products_p1)),
-      v("products_p2", d(r.products_p2)),
-      v("products_p3", d(r.products_p3)),
-      v("recycled", d(r.recycled)),
-      v("recycle_points", d(r.recycle_points)),
-      v("collisions", d(r.collisions)),
-      v("skill_failures", d(r.skill_failures)),
-      v("agent_runtime_errors", d(r.agent_runtime_errors)),
-      v("lock_grants", d(r.lock_grants)),
-      v("lock_refusals", d(r.lock_refusals)),
-      v("lock_waits", d(r.lock_waits)),
-      v("lock_wait_s", r.lock_wait_s),
-      v("lock_wait_max_s", r.lock_wait_max_s),
-      v("lock_hold_max_s", r.lock_hold_max_s),
-      flag("complex_made", r.first_complex_production_s.has_value()),
-      maybe("first_complex_production_s", r.first_complex_production_s),
-      v("role_changes", d(r.role_changes)),
-      maybe("first_role_change_game_s", r.first_role_change_game_s),
-      v("storage_min", d(r.storage_min)),
-      flag("storage_ran_empty", r.storage_empty_game_s.has_value()),
-      maybe("storage_empty_game_s", r.storage_empty_game_s),
-      v("jams", d(r.jams)),
-      v("jammed_at_end", d(r.jammed_at_end)),
-      v("skill_failure_streak_max", d(r.skill_failure_streak_max)),
-      v("messages_sent", d(r.messages_sent)),
-      v("messages_dropped", d(r.messages_dropped)),
-      v("cpu_s", r.cpu_s),
-      v("real_time_factor", r.real_time_factor),
-      v("orders", d(r.orders.size())),
-      v("order_units_requested", d(requested)),
-      v("order_units_delivered", d(delivered)),
-      v("awards", d(r.awards.size())),
-      v("tests", d(r.tests.size())),
-      v("tests_failed", d(tests_failed)),
-      flag("passed", r.passed()),
-  };
-}
-
-}  // namespace
-
 std::vector<std::pair<std::string, double>> numeric_statistics(const RunResult& r) {
+  // The metric table (metrics.h) in its order; an absent metric has no row.
   std::vector<std::pair<std::string, double>> out;
-  for (const auto& [info, value] : all_statistics(r)) {
-    if (value) out.emplace_back(info.name, *value);
+  for (const Metric& m : metrics()) {
+    if (const std::optional<double> v = m.value(r)) out.emplace_back(std::string(m.name), *v);
   }
   return out;
 }
@@ -355,7 +288,7 @@ std::vector<std::pair<std::string, double>> numeric_statistics(const RunResult& 
 const std::vector<StatisticInfo>& statistic_infos() {
   static const std::vector<StatisticInfo> infos = [] {
     std::vector<StatisticInfo> out;
-    for (const auto& [info, value] : all_statistics(RunResult{})) out.push_back(info);
+    for (const Metric& m : metrics()) out.push_back({std::string(m.name), m.may_be_absent});
     return out;
   }();
   return infos;

@@ -30,19 +30,26 @@ struct AgentGame {
                        LLSF_SOURCE_DIR "/clips/agents/llsf2013"};
       c.config = config;
       c.locks = locks;
-      brains.push_back(&driver.plug_agent(i, c, [this, print](const clips::LogRecord& r) {
-        if (r.level >= clips::LogLevel::kWarn) ++warnings;
-        const std::string_view text = r.text;
-        if (text.find("task GET_S0 failed") != std::string_view::npos) {
-          get_s0_failures.emplace_back(text);
-        }
-        if (text.find("role change") != std::string_view::npos) ++role_changes;
-        if (text.find("took a consumed puck") != std::string_view::npos) ++consumed_taken;
-        if (print || r.level == clips::LogLevel::kError) {
-          std::printf("%8.2f %s %s: %.*s\n", r.time.seconds(), std::string(r.agent).c_str(),
-                      clips::to_string(r.level), static_cast<int>(r.text.size()), r.text.data());
-        }
-      }));
+      brains.push_back(&driver.plug_agent(
+          i, c,
+          [this, print](const clips::LogRecord& r) {
+            if (r.level >= clips::LogLevel::kWarn) ++warnings;
+            const std::string_view text = r.text;
+            if (text.find("task GET_S0 failed") != std::string_view::npos) {
+              get_s0_failures.emplace_back(text);
+            }
+            if (text.find("took a consumed puck") != std::string_view::npos) ++consumed_taken;
+            if (print || r.level == clips::LogLevel::kError) {
+              std::printf("%8.2f %s %s: %.*s\n", r.time.seconds(), std::string(r.agent).c_str(),
+                          clips::to_string(r.level), static_cast<int>(r.text.size()),
+                          r.text.data());
+            }
+          },
+          {}, AgentReports{{}, [this](const clips::AgentEvent& e) {
+                             // Role changes as the agent declares them (agent-event), not as it
+                             // words its log.
+                             if (e.kind == clips::AgentEventKind::kRoleChange) ++role_changes;
+                           }}));
     }
   }
   static GameConfig make_config(int robots, std::uint64_t seed) {

@@ -53,28 +53,30 @@ TEST_CASE(
   bool budget = false;
   for (const RunIssue& i : r.issues) {
     CHECK(i.robot == "robot1");
-    if (i.kind == "runtime-error") {
+    if (i.kind == IssueKind::kRuntimeError) {
       ++runtime;
       if (i.rule == "broken-eval") {
-        CHECK(i.place.ends_with("mistakes.clp:2"));
+        CHECK(i.place().ends_with("mistakes.clp:2"));
         CHECK(i.text.find("no-such-fn") != std::string::npos);
         CHECK(i.is_mistake());
       }
       if (i.rule == "forever") {
         budget = true;
-        CHECK(i.place.ends_with("mistakes.clp:4"));
+        CHECK(i.place().ends_with("mistakes.clp:4"));
         CHECK(i.text.find("steps of work in one agent cycle") != std::string::npos);
         CHECK(i.time_s >= 2.0);
       }
-    } else if (i.kind == "rule-loop") {
+    } else if (i.kind == IssueKind::kRuleLoop) {
       ++loops;
       CHECK(i.rule == "spin");
-      CHECK(i.place.ends_with("mistakes.clp:6"));
-    } else if (i.kind == "unknown-skill") {
+      CHECK(i.place().ends_with("mistakes.clp:6"));
+    } else if (i.kind == IssueKind::kUnknownSkill) {
       ++skills;
       CHECK(i.text.find("unknown skill 'no_such_skill'") != std::string::npos);
+      CHECK(i.reason == lua::FailReason::kUnknownSkill);
+      CHECK(i.skill.starts_with("no_such_skill"));
       CHECK(i.is_mistake());
-    } else if (i.kind == "skill-failure") {
+    } else if (i.kind == IssueKind::kSkillFailure) {
       ++skills;
       CHECK_FALSE(i.is_mistake());
     }

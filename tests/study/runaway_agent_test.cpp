@@ -70,8 +70,8 @@ TEST_CASE("a rule that re-fires forever: the agent is halted, its robot stops, t
   int loops = 0;
   int halts = 0;
   for (const RunIssue& i : r.issues) {
-    if (i.kind == "rule-loop") ++loops;
-    if (i.kind == "agent-halted") {
+    if (i.kind == IssueKind::kRuleLoop) ++loops;
+    if (i.kind == IssueKind::kAgentHalted) {
       ++halts;
       CHECK(i.robot == "robot1");
       CHECK(i.is_mistake());
@@ -102,8 +102,8 @@ TEST_CASE("an endless loop in every cycle's actions: halted after the same bound
   int budget = 0;
   int halts = 0;
   for (const RunIssue& i : r.issues) {
-    if (i.kind == "runtime-error" && i.rule == "forever") ++budget;
-    if (i.kind == "agent-halted") ++halts;
+    if (i.kind == IssueKind::kRuntimeError && i.rule == "forever") ++budget;
+    if (i.kind == IssueKind::kAgentHalted) ++halts;
   }
   CHECK(budget == sim::AgentBrainConfig{}.max_runaway_cycles);
   CHECK(halts == 1);

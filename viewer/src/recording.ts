@@ -490,7 +490,9 @@ export class Recording {
       this.markers.push({
         t: typeof line.time_s === "number" ? line.time_s : line.t,
         kind: "agent",
-        label: `${line.robot ?? ""} ${line.kind ?? "issue"}${where}: ${line.text ?? ""}`,
+        // An unknown skill: its skill string (`skill`) before the engine's error.
+        label: `${line.robot ?? ""} ${line.kind ?? "issue"}${where}: ` +
+          `${line.skill ? `${line.skill}: ` : ""}${line.text ?? ""}`,
       });
     } else if (line.e === "jam" && line.jammed) {
       // Robot profiles: a robot jammed at a device (docs/profiles.md).

@@ -166,6 +166,9 @@
 )
 
 (deffunction change-role (?r ?why)
+  ; The outcome as data (the role_changes statistic counts these, docs/statistics.md); the log
+  ; line is for people and may say anything.
+  (agent-event role-change (fact-slot-value ?r name) P3 ?why)
   (log-info "production: role change " (fact-slot-value ?r name) " -> P3 (" ?why ")")
   (modify ?r (name P3) (target NONE))
 )

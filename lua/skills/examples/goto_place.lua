@@ -18,6 +18,7 @@ local function navigator_failed(self)
    if navigator:failed() then
       self.fsm.error = string.format("navigator %s: %s", navigator:status(),
                                      navigator:error_message())
+      if navigator:status() == "ABORTED" then self.fsm.reason = "aborted" end
       return true
    end
    return false

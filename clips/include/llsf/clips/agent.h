@@ -54,6 +54,47 @@ struct LogRecord {
 };
 using LogSink = std::function<void(const LogRecord&)>;
 
+/// The kinds of mistakes the host reports as data (AgentIo::issues; docs/clips.md, "Issues").
+enum class AgentIssueKind : std::uint8_t {
+  kRuntimeError,  ///< a rule's actions failed (also stopped by the work budget)
+  kRuleLoop,      ///< the firing limit of a cycle was reached with rules still on the agenda
+};
+/// "runtime-error", "rule-loop".
+const char* to_string(AgentIssueKind kind);
+
+/// One mistake of the agent, as data: the host logs the same as a line for people, but a reader
+/// of outcomes takes it from here (the line's wording may change). Views are valid during the
+/// sink call only.
+struct AgentIssue {
+  core::SimTime time;  ///< simulated time of the cycle
+  AgentIssueKind kind = AgentIssueKind::kRuntimeError;
+  std::string_view agent;  ///< the robot's name
+  std::string_view rule;   ///< the rule running (kRuntimeError) or next (kRuleLoop); "" if none
+  std::string_view file;   ///< the file the rule was loaded from; "" if unknown
+  int line = 0;            ///< its line in `file`; 0 if unknown
+  std::string_view text;   ///< what happened, without the rule and its place
+};
+using IssueSink = std::function<void(const AgentIssue&)>;
+
+/// The kinds of events an agent declares with (agent-event KIND ...) (docs/clips.md, "Agent
+/// events"). The host refuses a kind it does not know (a runtime error naming the kinds).
+enum class AgentEventKind : std::uint8_t {
+  /// (agent-event role-change FROM TO [WHY]): the robot's role changed from FROM to TO (symbols).
+  kRoleChange,
+};
+/// "role-change".
+const char* to_string(AgentEventKind kind);
+
+/// One event an agent declared. Views are valid during the sink call only.
+struct AgentEvent {
+  core::SimTime time;  ///< simulated time of the cycle
+  AgentEventKind kind = AgentEventKind::kRoleChange;
+  std::string_view agent;   ///< the robot's name
+  std::string_view rule;    ///< the rule that declared it ("" if none)
+  std::vector<Value> args;  ///< the arguments after the kind, as given
+};
+using EventSink = std::function<void(const AgentEvent&)>;
+
 /// Hands a message built by (pb-broadcast ?m) to the radio (sim plugs in RobotRadio::broadcast).
 /// The message is borrowed for the duration of the call.
 using BroadcastFn = std::function<void(const google::protobuf::Message&)>;
@@ -128,6 +169,8 @@ struct AgentIo {
   BroadcastFn broadcast;
   LogSink log;
   LockListener lock_events;  ///< every lock state change of this robot (with locks on)
+  IssueSink issues;          ///< every runtime error and rule loop, as data (also logged)
+  EventSink events;          ///< every (agent-event ...) the agent declares
   /// (motor-enable) / (motor-disable): switches the robot's motors (Fawkes' motor-switch).
   std::function<void(bool on)> motor;
   /// (pb-send ?client ?msg): a message to the stream server the agent connected to with

@@ -23,6 +23,24 @@ enum class SkillStatus : std::uint8_t { kInactive = 0, kFinal = 1, kRunning = 2,
 /// "INACTIVE", "FINAL", "RUNNING" or "FAILED".
 const char* to_string(SkillStatus status);
 
+/// Why a skill string failed, as data (docs/skills.md, "Failure reasons"): a reader of outcomes
+/// takes it from here, never from the error text, whose wording may change.
+enum class FailReason : std::uint8_t {
+  kNone,          ///< it did not fail
+  kFailed,        ///< a skill ended FAILED for its own reasons (fsm.error, execute's S_FAILED)
+  kAborted,       ///< declared by the skill (fsm.reason = "aborted"): what it waited for was
+                  ///< aborted (the navigator's goal)
+  kNotFound,      ///< declared by the skill (fsm.reason = "not-found"): nothing where it looked
+                  ///< (get_s0: no puck in the input storage)
+  kUnknownSkill,  ///< the string (or a skill it calls) names a skill the library does not have
+  kBadString,     ///< the skill string does not compile
+  kError,         ///< a Lua error in a skill or the string, or a skill that did not load
+  kBudget,        ///< the instruction, wall-time or memory budget stopped it
+};
+
+/// "none", "failed", "aborted", "not-found", "unknown-skill", "bad-string", "error", "budget".
+const char* to_string(FailReason reason);
+
 /// Severity of a line a skill logs (print_debug, print/print_info, print_warn, print_error).
 enum class LogLevel : std::uint8_t { kDebug = 0, kInfo = 1, kWarn = 2, kError = 3 };
 
@@ -152,6 +170,9 @@ class SkillEngine {
   SkillStatus status() const;
   /// Why the skill string failed ("skill: STATE: file:line: ..."); empty unless FAILED.
   const std::string& error() const;
+  /// Why the skill string failed, as a reason code (that of its first failed skill); kNone
+  /// unless FAILED.
+  FailReason fail_reason() const;
   /// What the string's skills reported when it ended (FINAL or FAILED): the `fsm.result` of
   /// each skill it called that set one, joined by "; " (e.g. "WAITING", "R:ON Y:OFF G:BLINK");
   /// empty while RUNNING or if none did.

@@ -52,6 +52,13 @@ struct AgentBrainConfig {
   int lock_team_size = 0;
 };
 
+/// What an agent reports as data besides its log (clips::AgentIo::issues and ::events): its
+/// runtime errors and rule loops, and the events it declares with (agent-event ...).
+struct AgentReports {
+  clips::IssueSink issues;
+  clips::EventSink events;
+};
+
 /// `entries` with every directory replaced by its *.clp files in name order.
 std::vector<std::string> agent_files(const std::vector<std::string>& entries);
 
@@ -62,9 +69,10 @@ class AgentBrain final : public RobotBrain, private clips::SkillRunner {
  public:
   /// Loads the agent files; throws clips::AgentLoadError for bad agent code and
   /// core::ConfigError for a bad skill-engine config. `log` receives the agent's output,
-  /// `locks` every change of the robot's lock states (with locks on).
+  /// `locks` every change of the robot's lock states (with locks on), `reports` its issues and
+  /// events as data.
   AgentBrain(Game& game, int index, AgentBrainConfig config, clips::LogSink log = {},
-             clips::LockListener locks = {});
+             clips::LockListener locks = {}, AgentReports reports = {});
   ~AgentBrain() override;
   AgentBrain(const AgentBrain&) = delete;
   AgentBrain& operator=(const AgentBrain&) = delete;

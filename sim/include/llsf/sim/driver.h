@@ -36,7 +36,7 @@ class GameDriver {
   /// and plugs it in in place of an earlier brain of that robot. Throws clips::AgentLoadError
   /// for bad agent code, core::ConfigError for a bad skill-engine config.
   AgentBrain& plug_agent(int index, AgentBrainConfig config, clips::LogSink log = {},
-                         clips::LockListener locks = {});
+                         clips::LockListener locks = {}, AgentReports reports = {});
   /// Builds a skill engine as robot `index`'s brain (no agent: the caller exec()s skill
   /// strings), owned by the driver, and plugs it in. Throws core::ConfigError.
   SkillBrain& plug_skills(int index, lua::SkillEngineConfig config = {});

@@ -26,7 +26,9 @@ struct SkillStatusChange {
   std::string robot;
   std::string skill_string;
   lua::SkillStatus status = lua::SkillStatus::kInactive;
-  std::string error;   ///< set when FAILED
+  std::string error;  ///< set when FAILED
+  /// Why it failed, as data (lua::FailReason; kNone unless FAILED): read this, not `error`.
+  lua::FailReason reason = lua::FailReason::kNone;
   std::string result;  ///< what the skills reported when the string ended
 };
 

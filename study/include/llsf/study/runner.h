@@ -48,24 +48,39 @@ struct OrderResult {
   int window_end_s = 0;
 };
 
-/// A mistake or anomaly of a run that an agent or skill author should see, with its place.
+/// The kinds of issues of a run (docs/llsfsim.md, "Issues").
+enum class IssueKind : std::uint8_t {
+  kRuntimeError,  ///< a rule's actions failed, incl. a work budget that stopped them
+  kRuleLoop,      ///< the firing limit of a cycle was reached
+  kSkillFailure,  ///< a skill string ended FAILED (`skill`, `reason`, `text` its error)
+  kUnknownSkill,  ///< it failed because the library has no such skill (reason kUnknownSkill)
+  kLockHold,      ///< one robot held one lock longer than RunIssue::kLongLockHold_s (not
+                  ///< counting a jammed robot's)
+  kAgentHalted,   ///< the agent ran away for sim::AgentBrainConfig::max_runaway_cycles cycles
+                  ///< and was halted; its robot stops
+};
+/// "runtime-error", "rule-loop", "skill-failure", "unknown-skill", "lock-hold", "agent-halted".
+const char* to_string(IssueKind kind);
+
+/// A mistake or anomaly of a run that an agent or skill author should see, with its place. Its
+/// fields come as data from the agent host, the skill engine and the game (never parsed from
+/// log text).
 struct RunIssue {
   double time_s = 0.0;  ///< game time since the start of the run
   std::string robot;
-  /// "runtime-error" (a rule's actions failed, incl. a work budget that stopped them),
-  /// "rule-loop" (the firing limit of a cycle was reached), "skill-failure" (a skill string
-  /// ended FAILED: `text` is the skill string and its error), "unknown-skill" (it failed because
-  /// the library has no such skill), "lock-hold" (one robot held one lock longer than
-  /// RunIssue::kLongLockHold_s, not counting a jammed robot's), "agent-halted" (the agent ran
-  /// away for sim::AgentBrainConfig::max_runaway_cycles cycles and was halted; its robot stops).
-  std::string kind;
-  std::string rule;   ///< the CLIPS rule, if known
-  std::string place;  ///< "file:line" of the rule, if known
-  std::string text;
+  IssueKind kind = IssueKind::kRuntimeError;
+  std::string rule;                                 ///< the CLIPS rule, if known
+  std::string file;                                 ///< the rule's file, if known
+  int line = 0;                                     ///< the rule's line in `file`; 0 if unknown
+  std::string skill;                                ///< skill failures: the skill string
+  lua::FailReason reason = lua::FailReason::kNone;  ///< skill failures: why (lua::FailReason)
+  std::string text;  ///< what happened (skill failures: the engine's error)
   static constexpr double kLongLockHold_s = 300.0;
-  /// All kinds but "skill-failure" are mistakes: a strict run (Scenario::strict, `run --strict`)
+  /// "file:line" of the rule; "" if unknown.
+  std::string place() const;
+  /// All kinds but kSkillFailure are mistakes: a strict run (Scenario::strict, `run --strict`)
   /// fails on them.
-  bool is_mistake() const { return kind != "skill-failure"; }
+  bool is_mistake() const { return kind != IssueKind::kSkillFailure; }
 };
 
 /// Everything a run reports.
@@ -80,7 +95,7 @@ struct RunResult {
   int production_points = 0;
   int exploration_reports = 0;  ///< machines reported
   int exploration_correct = 0;
-  int deliveries = 0;  ///< products the gates took
+  int deliveries = 0;  ///< products the delivery gates took (credited to an order or not)
   std::vector<OrderResult> orders;
   int products_p1 = 0, products_p2 = 0, products_p3 = 0;  ///< made (machine completions)
   int recycled = 0;
@@ -102,7 +117,8 @@ struct RunResult {
   double lock_hold_max_s = 0.0;
   /// The thesis' measures (docs/statistics.md): the production time (the refbox's phase clock,
   /// s) at which the first complex product (P1/P2: a T3 or T4 completed) was made, absent if
-  /// none; the team agent's role changes ("production: role change" decisions) and the game time
+  /// none; the agents' role changes (the events (agent-event role-change ...) they declare,
+  /// docs/clips.md) and the game time
   /// (s since the start) of the first, absent if none; the fewest pucks left in the input storage
   /// (its area grown by 0.1 m, so that pucks pushed just past its marks count; sampled every
   /// second; pucks held by a robot not counted) and the game time it first was empty, absent if
@@ -114,7 +130,8 @@ struct RunResult {
   std::optional<double> storage_empty_game_s;
   /// Robot profiles: jams at devices, robots jammed at the end, and the longest run of failures
   /// of one skill by one robot without a success of that skill in between (not counting
-  /// failures of a jammed robot, skills aborted by a newer one, and get_s0's "no puck seen").
+  /// failures of a jammed robot, and failures for the reasons lua::FailReason::kAborted (a
+  /// navigation goal aborted) and kNotFound (get_s0: no puck in the storage)).
   int jams = 0;
   int jammed_at_end = 0;
   int skill_failure_streak_max = 0;
@@ -206,7 +223,12 @@ struct RunHooks {
 /// first tick for bad agent or skill files.
 RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks& hooks = {});
 
-/// The summary as one JSON object (fixed key order).
+/// The summary as one JSON object (fixed key order; the metrics as the metric table says,
+/// metrics.h).
 std::string to_json(const RunResult& r);
+
+/// Products the delivery gates of `refbox` took so far: RunResult::deliveries and the test case
+/// deliveries_at_least (docs/statistics.md, "Deliveries").
+int delivered_products(const refbox::Refbox& refbox);
 
 }  // namespace llsf::study

@@ -14,6 +14,7 @@
 #include "llsf/core/sim_time.h"
 #include "llsf/lua/skill_engine.h"
 #include "llsf/sim/game_config.h"
+#include "llsf/study/metrics.h"
 
 namespace llsf::study {
 
@@ -30,22 +31,16 @@ struct RobotSpec {
   std::vector<std::string> proto_dirs;  ///< its own .proto directories (also in game.agent_protos)
 };
 
-/// A pass/fail condition on a finished game.
+/// A pass/fail condition on a finished game: a metric against a limit (the metric table's test
+/// cases, metrics.h: points_at_least, deliveries_at_least, collisions_at_most, ...), or no
+/// agent error (no_agent_errors: no runtime error and no halted agent).
 struct TestCase {
-  enum class Kind : std::uint8_t {
-    kPointsAtLeast,             ///< total points >= value (at `by_s` if set)
-    kExplorationPointsAtLeast,  ///< exploration points >= value
-    kProductionPointsAtLeast,   ///< production points >= value
-    kDeliveriesAtLeast,         ///< products delivered >= value (at `by_s` if set)
-    kCollisionsAtMost,          ///< robot-robot + robot-wall + robot-device contacts <= value
-    kNoAgentErrors,             ///< no CLIPS runtime error in any agent
-    kSkillFailureStreakAtMost,  ///< RunResult::skill_failure_streak_max <= value
-    kLockHoldAtMost,            ///< RunResult::lock_hold_max_s <= value
-  };
   std::string name;
-  Kind kind = Kind::kPointsAtLeast;
-  double value = 0.0;
+  /// The metric judged, with its test_key and bound; nullptr: no_agent_errors.
+  const Metric* metric = nullptr;
+  double value = 0.0;          ///< the limit
   std::optional<double> by_s;  ///< game time (s since the start) at which it must hold
+  bool no_agent_errors() const { return metric == nullptr; }
 };
 
 /// How the game starts: the controller's first commands at time 0.
