@@ -30,6 +30,9 @@ one markdown table row per variant, with means per game of:
   stuck for good            robots that had a navigation goal at the end of the game and moved
                             less than STUCK_M in its last STUCK_S seconds; a second table lists
                             each with its seed, position and since when it stood there
+  recycling fail            failures of the recycling steps: get_consumed, recycle and
+                            finish_puck_at at R1/R2; a third table lists them by cause (the
+                            skill's error with numbers and device names generalised), per game
 
 Standard library only; no llsfsim code. The numbers are what the recordings hold, nothing is
 modelled here.
@@ -39,6 +42,7 @@ import gzip
 import json
 import math
 import os
+import re
 import sys
 
 CLOSE_M = 0.6
@@ -58,6 +62,16 @@ def recordings(paths):
             yield p
 
 
+RECYCLING = re.compile(r'^(get_consumed|recycle)\{|^finish_puck_at\{place="R[12]"')
+
+
+def cause(error):
+    """A skill error with its numbers and device names generalised: the cause."""
+    error = re.sub(r"\b(M10|M[1-9]|R[12]|D[123]|TST)\b", "<device>", error)
+    error = re.sub(r"-?\d+(\.\d+)?", "N", error)
+    return error.strip()
+
+
 def open_text(path):
     return gzip.open(path, "rt") if path.endswith(".gz") else open(path, "rt")
 
@@ -73,6 +87,7 @@ def analyse(path):
     encounters = []
     nav_state = {}  # robot -> (move_base state, since)
     trail = collections.defaultdict(list)  # robot index -> [(t, x, y)]
+    recycling = collections.Counter()  # cause -> failures
     with open_text(path) as f:
         header = json.loads(f.readline())
         if header.get("format") != "llsfsim-recording":
@@ -157,6 +172,9 @@ def analyse(path):
                         m["blocked_by_robot"] += 1
                 if "no puck seen" in err:
                     m["no_s0_seen"] += 1
+                if RECYCLING.match(o.get("string", "")):
+                    m["recycling_fail"] += 1
+                    recycling[cause(err)] += 1
     m["jammed_at_end"] = len(jammed)
     end = prev_t if prev_t is not None else 0.0
     for (i, j), start in encounter_start.items():
@@ -183,7 +201,7 @@ def analyse(path):
         if busy and since <= end - STUCK_S:
             stuck.append((name, last[0], last[1], since))
     m["stuck_for_good"] = len(stuck)
-    return header.get("variant", ""), header.get("seed", ""), m, encounters, stuck
+    return header.get("variant", ""), header.get("seed", ""), m, encounters, stuck, recycling
 
 
 COLUMNS = [
@@ -193,7 +211,7 @@ COLUMNS = [
     ("blocked by robot", "blocked_by_robot"), ("jams", "jams"),
     ("jammed at end", "jammed_at_end"), ("no S0 seen", "no_s0_seen"),
     ("encounters", "encounters"), ("recovery s", "recovery_s"), ("aborted s", "aborted_s"),
-    ("stuck for good", "stuck_for_good"),
+    ("stuck for good", "stuck_for_good"), ("recycling fail", "recycling_fail"),
 ]
 
 
@@ -204,15 +222,17 @@ def main(argv):
     by_variant = collections.defaultdict(list)
     encounters = collections.defaultdict(list)
     stuck_rows = []
+    causes = collections.defaultdict(collections.Counter)
     for path in recordings(argv[1:]):
         try:
-            variant, seed, m, enc, stuck = analyse(path)
+            variant, seed, m, enc, stuck, recycling = analyse(path)
         except (OSError, ValueError, KeyError, EOFError) as err:
             print(f"recording_evidence: {path}: {err}", file=sys.stderr)
             return 2
         by_variant[variant].append(m)
         encounters[variant].extend(enc)
         stuck_rows.extend((variant, seed, *row) for row in stuck)
+        causes[variant].update(recycling)
     if not by_variant:
         print("recording_evidence: no recordings found", file=sys.stderr)
         return 2
@@ -233,6 +253,14 @@ def main(argv):
         print("|---|---:|---|---:|---:|---:|")
         for variant, seed, name, x, y, since in sorted(stuck_rows, key=str):
             print(f"| {variant} | {seed} | {name} | {x:.2f} | {y:.2f} | {since:.1f} |")
+    if any(causes.values()):
+        print()
+        print("| variant | recycling failure cause | failures | per game |")
+        print("|---|---|---:|---:|")
+        for variant in sorted(causes):
+            games = len(by_variant[variant])
+            for c, k in sorted(causes[variant].items(), key=lambda kv: (-kv[1], kv[0])):
+                print(f"| {variant} | {c} | {k} | {k / games:.2f} |")
     return 0
 
 
