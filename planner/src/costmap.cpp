@@ -192,7 +192,16 @@ void Costmap::mark_and_clear(const Vec2& origin, std::span<const Vec2> hits) {
   int i0 = 0, j0 = 0;
   const bool origin_in = to_cell(origin, i0, j0);
   const int max_cells = static_cast<int>(raytrace_range_ / res_);
-  // 1. Clear free space along every beam (not its end cell), up to the raytrace range.
+  // 1. Clear free space along every beam (not its end cell), up to the raytrace range. A beam
+  // whose end cell an earlier beam of this scan had clears the same cells: traced once.
+  if (traced_.size() != obstacle_.size()) {
+    traced_.assign(obstacle_.size(), 0);
+    traced_gen_ = 0;
+  }
+  if (++traced_gen_ == 0) {
+    std::fill(traced_.begin(), traced_.end(), 0);
+    traced_gen_ = 1;
+  }
   if (origin_in) {
     for (const Vec2& h : hits) {
       // The end point, clipped to the grid along the beam.
@@ -208,6 +217,9 @@ void Costmap::mark_and_clear(const Vec2& origin, std::span<const Vec2> hits) {
       e = origin + d * t;
       int i1 = 0, j1 = 0;
       if (!to_cell(e, i1, j1)) continue;
+      std::uint32_t& traced = traced_[idx(i1, j1)];
+      if (traced == traced_gen_) continue;
+      traced = traced_gen_;
       // Bresenham from (i0, j0) towards (i1, j1), the end cell excluded.
       int x = i0, y = j0;
       const int dx = std::abs(i1 - i0), dy = std::abs(j1 - j0);

@@ -286,7 +286,8 @@ TEST_CASE("the laser reads a known wall distance within its noise") {
   CHECK(scan.ranges[0] == doctest::Approx(2.70 - 1.12).epsilon(0.05));
 }
 
-TEST_CASE("other robots' lasers see the laser-height cylinder (robot.laser_radius_m, laser_offset_m)") {
+TEST_CASE(
+    "other robots' lasers see the laser-height cylinder (robot.laser_radius_m, laser_offset_m)") {
   // Robot 0 at (1.0, 0.6) looks along +x at robot 1 at (2.0, 0.6), which faces away (+x) or
   // towards it (-x): beam 180 (angle 0) hits robot 1's body at 1.0 - 0.185 m, or, with the Gazebo
   // Robotino's cylinder (radius 0.12 m, centre 0.05 m behind), at 1.0 - 0.05 - 0.12 m when robot

@@ -188,6 +188,9 @@ class Costmap {
   std::vector<std::uint8_t> obstacle_;       // 1 = laser obstacle
   std::vector<std::uint8_t> cost_;           // combined, inflated
   std::vector<std::uint8_t> scratch_;        // recenter()'s moved obstacles (kept to reuse)
+  // mark_and_clear(): the end cells already traced from this update's origin (== traced_gen_).
+  std::vector<std::uint32_t> traced_;
+  std::uint32_t traced_gen_ = 0;
   struct KernelRow {  // the inflation kernel by rows: costs of cells di0, di0 + 1, ... of row dj
     int dj;
     int di0;
