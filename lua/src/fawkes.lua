@@ -575,13 +575,17 @@ def("NavigatorInterface", {
                      (status == "ABORTED" and 1) or 0
     end
   end,
+  -- "Pathplan" drives forward only: the team's move_base (TrajectoryPlannerROS, min_vel_x 0.1
+  -- in cfg/move_base_robotino) never drove backwards, so a puck in the holder stays there;
+  -- "Navigator" (the relative navigator) may back up.
   handle = function(d, name, m, id, level)
     local N = llsf.NavigatorInterface
     local rel = id == "Navigator"
+    local forward = not rel
     local function go(x, y, ori)
       if rel then x, y, ori = transform2d(x, y, ori, "/base_link", "/map") end
       d.dest_x, d.dest_y, d.dest_ori = x, y, ori
-      N.goto_pose(N, x, y, ori, false)
+      N.goto_pose(N, x, y, ori, forward)
     end
     if name == "StopMessage" then
       N.stop(N)
@@ -593,7 +597,8 @@ def("NavigatorInterface", {
         go(dist * cos(phi), dist * sin(phi), m.orientation or 0.0)
       else
         local x, y, a = robot_pose()
-        N.goto_pose(N, x + dist * cos(a + phi), y + dist * sin(a + phi), m.orientation or 0, false)
+        N.goto_pose(N, x + dist * cos(a + phi), y + dist * sin(a + phi), m.orientation or 0,
+                    forward)
       end
     elseif name == "PlaceGotoMessage" then
       local place = m.place
@@ -603,13 +608,13 @@ def("NavigatorInterface", {
         local ori = node.props.orientation and tonumber(node.props.orientation)
         if not ori then local _, _, a = robot_pose(); ori = a end
         d.dest_x, d.dest_y, d.dest_ori = node.x_, node.y_, ori
-        N.goto_pose(N, node.x_, node.y_, ori, false)
+        N.goto_pose(N, node.x_, node.y_, ori, forward)
       else
-        N.goto_place(N, place, false)
+        N.goto_place(N, place, forward)
       end
     elseif name == "TurnMessage" then
       local x, y, a = robot_pose()
-      N.goto_pose(N, x, y, a + (m.angle or 0.0), false)
+      N.goto_pose(N, x, y, a + (m.angle or 0.0), forward)
     end
     return N.msgid(N)
   end,

@@ -67,6 +67,10 @@ void read_levels(const core::ConfigNode& n, sim::RobotLevelsConfig& l) {
               {{"ground_truth", sim::DetectionLevel::kGroundTruth},
                {"vision", sim::DetectionLevel::kVision}},
               "detection level");
+  n.read_enum("light_view", l.light.view,
+              {{"front", sim::LightView::kFront},
+               {"laser_cluster", sim::LightView::kLaserCluster}},
+              "light view");
   n.read_enum("puck", l.puck.level,
               {{"ground_truth", sim::DetectionLevel::kGroundTruth},
                {"vision", sim::DetectionLevel::kVision}},
@@ -269,6 +273,9 @@ void read_robots(const core::ConfigNode& n, const std::string& dir, Scenario& s)
       merge_config(spec.config, clips::config_from_node(c, "/clips-agent"));
     }
     if (const core::ConfigNode a = r["agent"]; a.defined()) read_agent_spec(a, dir, spec);
+    if (const core::ConfigNode a = r["agent_start_s"]; a.defined()) {
+      spec.agent_start = core::SimTime::from_seconds(a.as_double(core::in_range(0.0, 3600.0)));
+    }
     kinematic::RobotStart& start = s.game.world.robots[static_cast<std::size_t>(i)];
     r.read("name", start.name);
     r.read("jersey", start.jersey);
