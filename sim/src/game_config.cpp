@@ -64,6 +64,9 @@ void GameConfig::validate() const {
     fail("levels.symbolic.cruise_speed_mps", "must be > 0");
   }
   if (!(levels.symbolic.turn_rate_rps > 0.0)) fail("levels.symbolic.turn_rate_rps", "must be > 0");
+  if (referee_remove_delay < SimTime() || referee_remove_delay > SimTime::from_sec(60)) {
+    fail("referee_remove_delay", "must be in [0, 60] s");
+  }
   // Light detection.
   const LightDetectionConfig& li = levels.light;
   require_game("levels.light.range_m", li.range_m, core::positive());

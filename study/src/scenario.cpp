@@ -390,6 +390,7 @@ constexpr GameFieldKeys kGameFieldKeys[] = {
     {"game.skill_rate_hz", {"rates.skill_hz", "rates.physics_hz", "world.physics.step_ms"}},
     {"game.agent_rate_hz", {"rates.agent_hz", "rates.physics_hz", "world.physics.step_ms"}},
     {"game.beacon_period", {"rates.beacon_period_s"}},
+    {"game.referee_remove_delay", {"referee.remove_delay_s"}},
     {"game.handling.", {"profile"}},
     {"game.hackathon", {"hackathon"}},
     {"physics.", {"rates.physics_hz", "world.physics", "world"}},
@@ -527,6 +528,13 @@ Scenario read_scenario(const core::ConfigNode& root, const std::string& file) {
   read_rates(root["rates"], s.game);
   root.read("team", s.game.team);
   root.read("strict", s.strict);
+  if (const core::ConfigNode n = root["referee"]; n.defined()) {
+    n.require_map();
+    if (const core::ConfigNode d = n["remove_delay_s"]; d.defined()) {
+      s.game.referee_remove_delay = core::SimTime::from_seconds(d.as_double(core::in_range(0.0, 60.0)));
+    }
+    n.no_other_keys();
+  }
   if (const core::ConfigNode n = root["hackathon"]; n.defined()) {
     s.game.hackathon = sim::load_hackathon_config(n, s.game.world);
     s.start = StartMode::kNone;

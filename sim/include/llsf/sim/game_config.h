@@ -198,6 +198,10 @@ struct GameConfig {
   SimTime beacon_period = SimTime::from_sec(1);
   /// Team name in the robots' beacons (empty: the refbox's team).
   std::string team;
+  /// How long after the refbox asks for it the referee takes a puck off the field (a delivered
+  /// product, a puck out of the game): 0 at once. A delivery gate shows its three lamps until
+  /// then (shared/specs/llsf2013-rules.md §2.4: the referee is told to remove the puck).
+  SimTime referee_remove_delay;
   /// The hackathon variant (docs/hackathon.md): when set, the Game adds its obstacles, replaces
   /// the pucks by a coloured layout drawn from the seed, adds the safe place to the planner and
   /// gives every robot the colour camera and the rescue interface.
