@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <map>
+#include <stdexcept>
 
 #include "feature.h"
 
@@ -112,6 +113,7 @@ class BlackboardFeature final : public Feature {
       if (it == s_.blackboard.end() || it->second.serial == o.read_serial) continue;
       o.read_serial = it->second.serial;
       const HostState::InterfaceData& d = it->second;
+      if (assert_direct(env, o, d)) continue;
       std::string fact = "(" + o.type + " (id \"" + o.id + "\") (time " +
                          std::to_string(d.time.ns() / 1'000'000'000) + " " +
                          std::to_string((d.time.ns() % 1'000'000'000) / 1000) + ")";
@@ -130,6 +132,37 @@ class BlackboardFeature final : public Feature {
     }
   }
 
+  // The fact built from values, without printing and parsing it (the agent reads its
+  // interfaces at every cycle); false if a field is not a slot of the type's template (the
+  // text path then reports it).
+  bool assert_direct(Environment& env, const Opened& o, const HostState::InterfaceData& d) {
+    auto found = templates_.find(o.type);
+    if (found == templates_.end()) {
+      Template looked_up;
+      try {
+        looked_up = env.find_template(o.type);
+      } catch (const std::logic_error&) {
+        return false;
+      }
+      found = templates_.emplace(o.type, std::move(looked_up)).first;
+    }
+    const Template& t = found->second;
+    values_.assign(t.slots.size(), Value{});
+    const std::int64_t ns = d.time.ns();
+    values_[static_cast<std::size_t>(t.slot_index("id"))] = Value::string(o.id);
+    values_[static_cast<std::size_t>(t.slot_index("time"))] =
+        Value::multifield({Value::integer_value(ns / 1'000'000'000),
+                           Value::integer_value((ns % 1'000'000'000) / 1000)});
+    for (const auto& [name, v] : d.fields) {
+      const auto slot = std::find(t.slots.begin(), t.slots.end(), name);
+      if (slot == t.slots.end()) return false;
+      values_[static_cast<std::size_t>(slot - t.slots.begin())] = v;
+    }
+    FactHandle h = env.assert_fact(t, values_);
+    env.release(h);
+    return true;
+  }
+
   static std::string types_text() {
     std::string out;
     for (const InterfaceDef& d : interface_defs())
@@ -139,6 +172,8 @@ class BlackboardFeature final : public Feature {
 
   HostState& s_;
   std::map<std::pair<std::string, std::string>, Opened> opened_;
+  std::vector<Value> values_;                  // assert_direct's slot values
+  std::map<std::string, Template> templates_;  // by type, looked up once
 };
 
 }  // namespace

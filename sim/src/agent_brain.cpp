@@ -190,7 +190,7 @@ clips::Value field_value(const lua::InterfaceField& f) {
 }  // namespace
 
 void AgentBrain::on_agent_cycle(lua::RobotApi& robot, RobotRadio& radio) {
-  if (halt_) return;  // halted: no cycle (the game clears the inbox)
+  if (halt_) return;                 // halted: no cycle (the game clears the inbox)
   if (robot.now() < start_) return;  // not switched on yet
   const lua::PoseEstimate pose = robot.pose();
   if (pose.valid) agent_->set_pose(pose.pose);

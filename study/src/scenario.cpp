@@ -68,8 +68,7 @@ void read_levels(const core::ConfigNode& n, sim::RobotLevelsConfig& l) {
                {"vision", sim::DetectionLevel::kVision}},
               "detection level");
   n.read_enum("light_view", l.light.view,
-              {{"front", sim::LightView::kFront},
-               {"laser_cluster", sim::LightView::kLaserCluster}},
+              {{"front", sim::LightView::kFront}, {"laser_cluster", sim::LightView::kLaserCluster}},
               "light view");
   n.read_enum("puck", l.puck.level,
               {{"ground_truth", sim::DetectionLevel::kGroundTruth},
@@ -531,7 +530,8 @@ Scenario read_scenario(const core::ConfigNode& root, const std::string& file) {
   if (const core::ConfigNode n = root["referee"]; n.defined()) {
     n.require_map();
     if (const core::ConfigNode d = n["remove_delay_s"]; d.defined()) {
-      s.game.referee_remove_delay = core::SimTime::from_seconds(d.as_double(core::in_range(0.0, 60.0)));
+      s.game.referee_remove_delay =
+          core::SimTime::from_seconds(d.as_double(core::in_range(0.0, 60.0)));
     }
     n.no_other_keys();
   }

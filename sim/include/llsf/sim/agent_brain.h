@@ -139,7 +139,7 @@ class AgentBrain final : public RobotBrain, private clips::SkillRunner {
   int errors_before_reload_ = 0;
   int max_runaway_cycles_ = 10;
   core::SimTime start_;  // AgentBrainConfig::start
-  int rule_loops_ = 0;  // runaway cycles of the current agent
+  int rule_loops_ = 0;   // runaway cycles of the current agent
   int budget_stops_ = 0;
   std::optional<Halt> halt_;
   // A Fawkes-style agent's RobotinoLightInterface "Light_State": since when no device is seen.
