@@ -377,35 +377,39 @@ def("Position3DInterface", {
   -- Pose: the localization; OmniPuck<n>: the n-th nearest puck the puck detection sees;
   -- "Euclidean Laser Cluster": the signal of the device in front (its RFID zone), as the
   -- laser-cluster plugin found it, while the light detection sees that device.
+  -- (the second function: whether the data are visible now, all that F.poll needs of them)
   writer = function(id)
     if id == "Pose" then
+      local P = llsf.Position3DInterface
       return function(d, now)
-        local P = llsf.Position3DInterface
         local x, y, a = P.get(P)
         pose_fields(d, x, y, a, "/map", P.is_valid(P), now)
-      end
+      end, function() return P.is_valid(P) end
     end
     local n = id:match("^OmniPuck(%d+)$")
     if n then
       n = tonumber(n)
+      local V = llsf.PuckVisionInterface
       return function(d, now)
         local list = pucks_by_distance(now)
         local p = list[n]
         pose_fields(d, p and p[1] or 0.0, p and p[2] or 0.0, 0.0, "/base_link", p ~= nil, now)
-      end
+      end, function() return V.count(V) >= n end
     end
     if id == "Euclidean Laser Cluster" then
-      return function(d, now)
-        local L = llsf.RobotinoLightInterface
+      local L, N = llsf.RobotinoLightInterface, llsf.NavigatorInterface
+      local function target()  -- the RFID zone of the device the light detection sees
         local device = L.visible(L) and L.device(L) or nil
-        local x, y
-        if device then
-          local N = llsf.NavigatorInterface
-          local _, _, _, tx, ty = N.place(N, device)
-          if tx then x, y = transform2d(tx, ty, 0, "/map", "/base_link") end
-        end
-        pose_fields(d, x or 0.0, y or 0.0, 0.0, "/base_link", x ~= nil, now)
+        if not device then return nil end
+        local _, _, _, tx, ty = N.place(N, device)
+        return tx, ty
       end
+      return function(d, now)
+        local tx, ty = target()
+        local x, y
+        if tx then x, y = transform2d(tx, ty, 0, "/map", "/base_link") end
+        pose_fields(d, x or 0.0, y or 0.0, 0.0, "/base_link", x ~= nil, now)
+      end, function() return target() ~= nil end
     end
     return nil
   end,
@@ -423,8 +427,9 @@ def("RobotinoLightInterface", {
   -- Other ids (the team's "Light determined") are written by skills (writing=true).
   writer = function(id)
     if id ~= "Light_State" then return nil end
+    local LI = llsf.RobotinoLightInterface
     return function(d, now)
-      local L = llsf.RobotinoLightInterface
+      local L = LI
       local visible = L.visible(L)
       d.red = visible and L.red(L) or "UNKNOWN"
       d.yellow = visible and L.yellow(L) or "UNKNOWN"
@@ -433,7 +438,7 @@ def("RobotinoLightInterface", {
       -- (frames since the reading last changed, as the agent's "Light_State" counts them)
       local h = history(d, visible, now)
       d.visibility_history = visible and (floor(L.stable_for(L) * 1e9) // cycle_ns + 1) or h
-    end
+    end, function() return LI.visible(LI) end
   end,
   llsf = llsf.RobotinoLightInterface,
 })
@@ -732,10 +737,10 @@ common.msgq_enqueue = common.msgq_enqueue_copy
 local function make_object(type_name, id, t)
   local d = {}
   for f, spec in pairs(t.fields) do d[f] = default_value(spec[1], spec[2]) end
-  local w = t.writer(id)
+  local w, visible = t.writer(id)
   local obj = {}
   meta_of[obj] = {type = type_name, id = id, t = t, write = w ~= "store" and w or nil,
-                  store = w == "store", msgid = 0}
+                  visible = visible, store = w == "store", msgid = 0}
   if w == "store" then meta_of[obj].written = true end
   data_of[obj] = d
   -- llsfsim's own methods answer at every id of its types; before the fields of the same name
@@ -863,8 +868,22 @@ end
 
 -- Fawkes' skiller read every interface at the start of each loop: the visibility histories of
 -- the interfaces files written for Fawkes bound follow the robot from cycle to cycle, read or not.
+-- Only the visibility is followed here (a writer's second function; the fields are read when
+-- asked for): it is all that a history counts.
 function F.poll()
-  for i = 1, #polled do pcall(refresh, polled[i]) end  -- (a failing read fails at the skill's)
+  local now
+  for i = 1, #polled do
+    local obj = polled[i]
+    local visible = meta_of[obj].visible
+    if visible then
+      now = now or now_ns()
+      local ok, v = pcall(visible)  -- (a failing read fails at the skill's)
+      local d = data_of[obj]
+      if ok and d.vis_state ~= v then d.vis_state, d.vis_since = v, now end
+    else
+      pcall(refresh, obj)
+    end
+  end
 end
 function F.type_names()
   local names = {}
