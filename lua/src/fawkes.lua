@@ -657,13 +657,22 @@ local function default_value(kind, len)
   return t
 end
 
--- The fields, read again from the robot at every read (a command sent through llsfsim's own
--- methods in the same cycle shows at once, e.g. the navigator's goal id).
+-- The fields, read again from the robot when the time or what the skills did changed since
+-- the object's last read: a command sent in the same cycle (a message, a field set, llsfsim's
+-- own methods) shows at once, e.g. the navigator's goal id. `epoch` counts those commands.
+local epoch = 0
 local function refresh(obj)
   local m = meta_of[obj]
-  if m.write then m.write(data_of[obj], now_ns()) end
+  if m.write then
+    local now = now_ns()
+    if m.read_ns ~= now or m.read_epoch ~= epoch then
+      m.write(data_of[obj], now)
+      m.read_ns, m.read_epoch = now, epoch
+    end
+  end
   return data_of[obj]
 end
+
 
 local function message_class(type_name, name, fields)
   local by_type = message_classes[type_name]
@@ -728,6 +737,7 @@ function common.msgq_enqueue_copy(obj, msg)
          common.uid(obj), m.type, m.var or "iface")
   end
   m.msgid = m.msgid + 1
+  epoch = epoch + 1
   local handle = m.t.handle
   local id = handle and handle(data_of[obj], class.name, msg, m.id, 3) or nil
   return id or m.msgid
@@ -751,13 +761,23 @@ local function make_object(type_name, id, t)
   local mt = {__metatable = false}
   local lookup
   -- What a key means is fixed per object: looked up once (no closure made per call).
-  local cache = {}
+  -- llsfsim's own methods may command the robot: looking one up counts as a command (epoch).
+  local cache, commands = {}, {}
   mt.__index = function(o, k)
     local v = cache[k]
+    if v ~= nil then return v end
+    v = commands[k]
     if v == nil then
-      v = lookup(o, k)
-      if v ~= nil then cache[k] = v end
+      local command
+      v, command = lookup(o, k)
+      if v == nil then return nil end
+      if not command then
+        cache[k] = v
+        return v
+      end
+      commands[k] = v
     end
+    epoch = epoch + 1
     return v
   end
   lookup = function(_, k)
@@ -765,6 +785,7 @@ local function make_object(type_name, id, t)
     if c then return c end
     if llsf_first then
       local v = llsf_obj[k]
+      if type(v) == "function" then return v, true end
       if v ~= nil then return v end
     end
     if k == "type" then return type_of end
@@ -797,6 +818,7 @@ local function make_object(type_name, id, t)
       return function(self, a, b)
         local dd = data_of[self]
         if t.fields[set][2] then dd[set][floor(a) + 1] = b else dd[set] = a end
+        epoch = epoch + 1
         mark_written(self)  -- (Fawkes' skiller wrote its writing interfaces after every loop)
       end
     end
@@ -806,7 +828,11 @@ local function make_object(type_name, id, t)
     end
     if t.constants and t.constants[k] ~= nil then return t.constants[k] end
     if t.messages[k] then return message_class(type_name, k, t.messages[k]) end
-    if llsf_obj then return llsf_obj[k] end
+    if llsf_obj then
+      local v = llsf_obj[k]
+      if type(v) == "function" then return v, true end
+      return v
+    end
     return nil
   end
   mt.__newindex = function() fail(2, "interfaces are read-only") end
