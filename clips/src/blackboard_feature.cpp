@@ -2,10 +2,12 @@
 // Blackboard feature (Fawkes-style agents, docs/fawkes.md): Fawkes' clips blackboard feature
 // for the interfaces a 2013 agent reads. (blackboard-open "Type" "Id") defines a deftemplate per
 // interface type (slot id, multislot time, one slot per field, as Fawkes built it from the
-// interface's fields) and a clean-up rule; (blackboard-enable-time-read) adds the rule that
-// calls (blackboard-read) whenever a (time) fact exists; (blackboard-read) asserts one fact per
-// opened interface whose data changed since it was last read. The data are written by the host
-// (AgentHost::write_interface; the pose as Position3DInterface "Pose").
+// interface's fields) whose facts go at the end of every run (Fawkes: a clean-up rule at salience
+// -10000); (blackboard-enable-time-read) makes every cycle start with (blackboard-read) (Fawkes:
+// a rule at salience 1000 on the (time) fact); (blackboard-read) asserts one fact per opened
+// interface whose data changed since it was last read. Both happen without a rule firing, as the
+// time fact's retraction: at every cycle, they were most of the 2013 agent's firings. The data are
+// written by the host (AgentHost::write_interface; the pose as Position3DInterface "Pose").
 #include <algorithm>
 #include <array>
 #include <map>
@@ -56,9 +58,8 @@ class BlackboardFeature final : public Feature {
   explicit BlackboardFeature(HostState& s) : s_(s) {}
 
   void define(Environment& env) override {
-    env.define_function("blackboard-enable-time-read", "00", [&env](Args&) {
-      env.load(
-          "(defrule blackboard-read (declare (salience 1000)) (time $?) => (blackboard-read))");
+    env.define_function("blackboard-enable-time-read", "00", [this](Args&) {
+      time_read_ = true;
       return Value{};
     });
     env.define_function("blackboard-open", "22k", [this, &env](Args& a) {
@@ -77,6 +78,16 @@ class BlackboardFeature final : public Feature {
   void after_reset(Environment&) override {
     for (auto& [key, o] : opened_) o.read_serial = 0;  // the reset took the facts
   }
+
+  // The cycle's time fact is there (TimeFeature, before this feature): the facts of the
+  // interfaces that changed come first, as the salience-1000 rule brought them.
+  void before_run(Environment& env) override {
+    cleanup(env);  // (a run cut short left them)
+    if (time_read_) read(env);
+  }
+
+  // As the clean-up rules at salience -10000: every fact of an opened type goes.
+  void after_run(Environment& env) override { cleanup(env); }
 
  private:
   struct Opened {
@@ -101,8 +112,7 @@ class BlackboardFeature final : public Feature {
         t += std::string(f.length > 1 ? " (multislot " : " (slot ") + f.name + " " + f.slot + ")";
       t += ")";
       env.load(t);
-      env.load("(defrule " + type + "-cleanup (declare (salience -10000)) ?f <- (" + type +
-               ") => (retract ?f))");
+      cleanup_.push_back(env.find_template(type));
     }
     opened_[{type, id}] = Opened{type, id, 0};
   }
@@ -163,6 +173,10 @@ class BlackboardFeature final : public Feature {
     return true;
   }
 
+  void cleanup(Environment& env) {
+    for (const Template& t : cleanup_) env.retract_all(t);
+  }
+
   static std::string types_text() {
     std::string out;
     for (const InterfaceDef& d : interface_defs())
@@ -174,6 +188,8 @@ class BlackboardFeature final : public Feature {
   std::map<std::pair<std::string, std::string>, Opened> opened_;
   std::vector<Value> values_;                  // assert_direct's slot values
   std::map<std::string, Template> templates_;  // by type, looked up once
+  std::vector<Template> cleanup_;              // the opened types
+  bool time_read_ = false;                     // blackboard-enable-time-read
 };
 
 }  // namespace
