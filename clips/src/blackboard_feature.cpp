@@ -2,13 +2,16 @@
 // Blackboard feature (Fawkes-style agents, docs/fawkes.md): Fawkes' clips blackboard feature
 // for the interfaces a 2013 agent reads. (blackboard-open "Type" "Id") defines a deftemplate per
 // interface type (slot id, multislot time, one slot per field, as Fawkes built it from the
-// interface's fields) and a clean-up rule; (blackboard-enable-time-read) adds the rule that
-// calls (blackboard-read) whenever a (time) fact exists; (blackboard-read) asserts one fact per
-// opened interface whose data changed since it was last read. The data are written by the host
-// (AgentHost::write_interface; the pose as Position3DInterface "Pose").
+// interface's fields) whose facts go at the end of every run (Fawkes: a clean-up rule at salience
+// -10000); (blackboard-enable-time-read) makes every cycle start with (blackboard-read) (Fawkes:
+// a rule at salience 1000 on the (time) fact); (blackboard-read) asserts one fact per opened
+// interface whose data changed since it was last read. Both happen without a rule firing, as the
+// time fact's retraction: at every cycle, they were most of the 2013 agent's firings. The data are
+// written by the host (AgentHost::write_interface; the pose as Position3DInterface "Pose").
 #include <algorithm>
 #include <array>
 #include <map>
+#include <stdexcept>
 
 #include "feature.h"
 
@@ -55,9 +58,8 @@ class BlackboardFeature final : public Feature {
   explicit BlackboardFeature(HostState& s) : s_(s) {}
 
   void define(Environment& env) override {
-    env.define_function("blackboard-enable-time-read", "00", [&env](Args&) {
-      env.load(
-          "(defrule blackboard-read (declare (salience 1000)) (time $?) => (blackboard-read))");
+    env.define_function("blackboard-enable-time-read", "00", [this](Args&) {
+      time_read_ = true;
       return Value{};
     });
     env.define_function("blackboard-open", "22k", [this, &env](Args& a) {
@@ -76,6 +78,16 @@ class BlackboardFeature final : public Feature {
   void after_reset(Environment&) override {
     for (auto& [key, o] : opened_) o.read_serial = 0;  // the reset took the facts
   }
+
+  // The cycle's time fact is there (TimeFeature, before this feature): the facts of the
+  // interfaces that changed come first, as the salience-1000 rule brought them.
+  void before_run(Environment& env) override {
+    cleanup(env);  // (a run cut short left them)
+    if (time_read_) read(env);
+  }
+
+  // As the clean-up rules at salience -10000: every fact of an opened type goes.
+  void after_run(Environment& env) override { cleanup(env); }
 
  private:
   struct Opened {
@@ -100,8 +112,7 @@ class BlackboardFeature final : public Feature {
         t += std::string(f.length > 1 ? " (multislot " : " (slot ") + f.name + " " + f.slot + ")";
       t += ")";
       env.load(t);
-      env.load("(defrule " + type + "-cleanup (declare (salience -10000)) ?f <- (" + type +
-               ") => (retract ?f))");
+      cleanup_.push_back(env.find_template(type));
     }
     opened_[{type, id}] = Opened{type, id, 0};
   }
@@ -112,6 +123,7 @@ class BlackboardFeature final : public Feature {
       if (it == s_.blackboard.end() || it->second.serial == o.read_serial) continue;
       o.read_serial = it->second.serial;
       const HostState::InterfaceData& d = it->second;
+      if (assert_direct(env, o, d)) continue;
       std::string fact = "(" + o.type + " (id \"" + o.id + "\") (time " +
                          std::to_string(d.time.ns() / 1'000'000'000) + " " +
                          std::to_string((d.time.ns() % 1'000'000'000) / 1000) + ")";
@@ -130,6 +142,41 @@ class BlackboardFeature final : public Feature {
     }
   }
 
+  // The fact built from values, without printing and parsing it (the agent reads its
+  // interfaces at every cycle); false if a field is not a slot of the type's template (the
+  // text path then reports it).
+  bool assert_direct(Environment& env, const Opened& o, const HostState::InterfaceData& d) {
+    auto found = templates_.find(o.type);
+    if (found == templates_.end()) {
+      Template looked_up;
+      try {
+        looked_up = env.find_template(o.type);
+      } catch (const std::logic_error&) {
+        return false;
+      }
+      found = templates_.emplace(o.type, std::move(looked_up)).first;
+    }
+    const Template& t = found->second;
+    values_.assign(t.slots.size(), Value{});
+    const std::int64_t ns = d.time.ns();
+    values_[static_cast<std::size_t>(t.slot_index("id"))] = Value::string(o.id);
+    values_[static_cast<std::size_t>(t.slot_index("time"))] =
+        Value::multifield({Value::integer_value(ns / 1'000'000'000),
+                           Value::integer_value((ns % 1'000'000'000) / 1000)});
+    for (const auto& [name, v] : d.fields) {
+      const auto slot = std::find(t.slots.begin(), t.slots.end(), name);
+      if (slot == t.slots.end()) return false;
+      values_[static_cast<std::size_t>(slot - t.slots.begin())] = v;
+    }
+    FactHandle h = env.assert_fact(t, values_);
+    env.release(h);
+    return true;
+  }
+
+  void cleanup(Environment& env) {
+    for (const Template& t : cleanup_) env.retract_all(t);
+  }
+
   static std::string types_text() {
     std::string out;
     for (const InterfaceDef& d : interface_defs())
@@ -139,6 +186,10 @@ class BlackboardFeature final : public Feature {
 
   HostState& s_;
   std::map<std::pair<std::string, std::string>, Opened> opened_;
+  std::vector<Value> values_;                  // assert_direct's slot values
+  std::map<std::string, Template> templates_;  // by type, looked up once
+  std::vector<Template> cleanup_;              // the opened types
+  bool time_read_ = false;                     // blackboard-enable-time-read
 };
 
 }  // namespace

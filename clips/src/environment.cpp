@@ -1350,6 +1350,16 @@ void Environment::retract(FactHandle& h) {
   release(h);
 }
 
+int Environment::retract_all(const Template& t) {
+  std::vector<void*> facts;
+  for (void* f = EnvGetNextFactInTemplate(env_, t.ptr, nullptr); f != nullptr;
+       f = EnvGetNextFactInTemplate(env_, t.ptr, f)) {
+    facts.push_back(f);
+  }
+  for (void* f : facts) EnvRetract(env_, f);
+  return static_cast<int>(facts.size());
+}
+
 void Environment::release(FactHandle& h) {
   if (h.fact_ == nullptr) return;
   EnvDecrementFactCount(env_, h.fact_);

@@ -193,6 +193,8 @@ class Environment {
   bool exists(const FactHandle& h) const;
   /// Retracts the fact if it still exists and releases the handle.
   void retract(FactHandle& h);
+  /// Retracts every fact of template `t`; returns how many.
+  int retract_all(const Template& t);
   /// Releases the handle without retracting.
   void release(FactHandle& h);
   /// Asserts a fact from text (tests and tools; slow path). Returns false on a parse error.

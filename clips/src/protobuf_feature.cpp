@@ -288,12 +288,14 @@ class ProtobufFeature final : public Feature {
   void after_run(Environment& env) override {
     for (auto& h : facts_) env.retract(h);
     facts_.clear();
-    for (auto it = entries_.begin(); it != entries_.end();) {
-      if (it->second.kind == Kind::kCreated)
-        ++it;
-      else
-        it = entries_.erase(it);
+    // Received messages (unless pb-ref kept them) and views end with the run. Only those are
+    // looked at: an agent that never destroys what it creates (the 2013 agent's reports) would
+    // otherwise make every run cost as much as all its messages.
+    for (const void* key : transient_) {
+      auto it = entries_.find(key);
+      if (it != entries_.end() && it->second.kind != Kind::kCreated) entries_.erase(it);
     }
+    transient_.clear();
     s_.live_messages = static_cast<int>(entries_.size());
   }
 
@@ -353,15 +355,17 @@ class ProtobufFeature final : public Feature {
   void add(std::unique_ptr<Message> m, Kind kind, Message* raw) {
     Entry e{kind, raw, raw, std::move(m)};
     entries_.emplace(raw, std::move(e));
+    if (kind != Kind::kCreated) transient_.push_back(raw);
     s_.live_messages = static_cast<int>(entries_.size());
   }
 
   void destroy(const Message* root) {
-    for (auto it = entries_.begin(); it != entries_.end();) {
-      if (it->second.root == root && it->second.kind == Kind::kView)
-        it = entries_.erase(it);
-      else
-        ++it;
+    // (views are transient: only those of this run can be left)
+    for (const void* key : transient_) {
+      auto it = entries_.find(key);
+      if (it != entries_.end() && it->second.root == root && it->second.kind == Kind::kView) {
+        entries_.erase(it);
+      }
     }
     entries_.erase(root);
     s_.live_messages = static_cast<int>(entries_.size());
@@ -571,11 +575,13 @@ class ProtobufFeature final : public Feature {
           if (set) copy->CopyFrom(from);
           Message* raw = copy.get();
           entries_.emplace(raw, Entry{Kind::kView, raw, root, std::move(copy)});
+          transient_.push_back(raw);
           s_.live_messages = static_cast<int>(entries_.size());
           return Value::external(raw);
         }
         Message* sub = rep ? r->MutableRepeatedMessage(&m, f, index) : r->MutableMessage(&m, f);
         auto [it, inserted] = entries_.try_emplace(sub, Entry{Kind::kView, sub, root, {}});
+        if (inserted) transient_.push_back(sub);
         if (!inserted && it->second.kind == Kind::kView) it->second.root = root;
         s_.live_messages = static_cast<int>(entries_.size());
         return Value::external(sub);
@@ -723,6 +729,7 @@ class ProtobufFeature final : public Feature {
   std::vector<std::pair<const Descriptor*, bool>> wanted_;  // wanted()'s answers so far
   std::uint64_t code_version_ = 0;
   std::unordered_map<const void*, Entry> entries_;
+  std::vector<const void*> transient_;  // keys of the kReceived and kView entries of this run
   std::unordered_map<std::string, const Message*> by_name_;
   struct FieldCacheEntry {
     const Descriptor* descriptor = nullptr;

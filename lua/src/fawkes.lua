@@ -377,35 +377,39 @@ def("Position3DInterface", {
   -- Pose: the localization; OmniPuck<n>: the n-th nearest puck the puck detection sees;
   -- "Euclidean Laser Cluster": the signal of the device in front (its RFID zone), as the
   -- laser-cluster plugin found it, while the light detection sees that device.
+  -- (the second function: whether the data are visible now, all that F.poll needs of them)
   writer = function(id)
     if id == "Pose" then
+      local P = llsf.Position3DInterface
       return function(d, now)
-        local P = llsf.Position3DInterface
         local x, y, a = P.get(P)
         pose_fields(d, x, y, a, "/map", P.is_valid(P), now)
-      end
+      end, function() return P.is_valid(P) end
     end
     local n = id:match("^OmniPuck(%d+)$")
     if n then
       n = tonumber(n)
+      local V = llsf.PuckVisionInterface
       return function(d, now)
         local list = pucks_by_distance(now)
         local p = list[n]
         pose_fields(d, p and p[1] or 0.0, p and p[2] or 0.0, 0.0, "/base_link", p ~= nil, now)
-      end
+      end, function() return V.count(V) >= n end
     end
     if id == "Euclidean Laser Cluster" then
-      return function(d, now)
-        local L = llsf.RobotinoLightInterface
+      local L, N = llsf.RobotinoLightInterface, llsf.NavigatorInterface
+      local function target()  -- the RFID zone of the device the light detection sees
         local device = L.visible(L) and L.device(L) or nil
-        local x, y
-        if device then
-          local N = llsf.NavigatorInterface
-          local _, _, _, tx, ty = N.place(N, device)
-          if tx then x, y = transform2d(tx, ty, 0, "/map", "/base_link") end
-        end
-        pose_fields(d, x or 0.0, y or 0.0, 0.0, "/base_link", x ~= nil, now)
+        if not device then return nil end
+        local _, _, _, tx, ty = N.place(N, device)
+        return tx, ty
       end
+      return function(d, now)
+        local tx, ty = target()
+        local x, y
+        if tx then x, y = transform2d(tx, ty, 0, "/map", "/base_link") end
+        pose_fields(d, x or 0.0, y or 0.0, 0.0, "/base_link", x ~= nil, now)
+      end, function() return target() ~= nil end
     end
     return nil
   end,
@@ -423,8 +427,9 @@ def("RobotinoLightInterface", {
   -- Other ids (the team's "Light determined") are written by skills (writing=true).
   writer = function(id)
     if id ~= "Light_State" then return nil end
+    local LI = llsf.RobotinoLightInterface
     return function(d, now)
-      local L = llsf.RobotinoLightInterface
+      local L = LI
       local visible = L.visible(L)
       d.red = visible and L.red(L) or "UNKNOWN"
       d.yellow = visible and L.yellow(L) or "UNKNOWN"
@@ -433,7 +438,7 @@ def("RobotinoLightInterface", {
       -- (frames since the reading last changed, as the agent's "Light_State" counts them)
       local h = history(d, visible, now)
       d.visibility_history = visible and (floor(L.stable_for(L) * 1e9) // cycle_ns + 1) or h
-    end
+    end, function() return LI.visible(LI) end
   end,
   llsf = llsf.RobotinoLightInterface,
 })
@@ -575,13 +580,17 @@ def("NavigatorInterface", {
                      (status == "ABORTED" and 1) or 0
     end
   end,
+  -- "Pathplan" drives forward only: the team's move_base (TrajectoryPlannerROS, min_vel_x 0.1
+  -- in cfg/move_base_robotino) never drove backwards, so a puck in the holder stays there;
+  -- "Navigator" (the relative navigator) may back up.
   handle = function(d, name, m, id, level)
     local N = llsf.NavigatorInterface
     local rel = id == "Navigator"
+    local forward = not rel
     local function go(x, y, ori)
       if rel then x, y, ori = transform2d(x, y, ori, "/base_link", "/map") end
       d.dest_x, d.dest_y, d.dest_ori = x, y, ori
-      N.goto_pose(N, x, y, ori, false)
+      N.goto_pose(N, x, y, ori, forward)
     end
     if name == "StopMessage" then
       N.stop(N)
@@ -593,7 +602,8 @@ def("NavigatorInterface", {
         go(dist * cos(phi), dist * sin(phi), m.orientation or 0.0)
       else
         local x, y, a = robot_pose()
-        N.goto_pose(N, x + dist * cos(a + phi), y + dist * sin(a + phi), m.orientation or 0, false)
+        N.goto_pose(N, x + dist * cos(a + phi), y + dist * sin(a + phi), m.orientation or 0,
+                    forward)
       end
     elseif name == "PlaceGotoMessage" then
       local place = m.place
@@ -603,13 +613,13 @@ def("NavigatorInterface", {
         local ori = node.props.orientation and tonumber(node.props.orientation)
         if not ori then local _, _, a = robot_pose(); ori = a end
         d.dest_x, d.dest_y, d.dest_ori = node.x_, node.y_, ori
-        N.goto_pose(N, node.x_, node.y_, ori, false)
+        N.goto_pose(N, node.x_, node.y_, ori, forward)
       else
-        N.goto_place(N, place, false)
+        N.goto_place(N, place, forward)
       end
     elseif name == "TurnMessage" then
       local x, y, a = robot_pose()
-      N.goto_pose(N, x, y, a + (m.angle or 0.0), false)
+      N.goto_pose(N, x, y, a + (m.angle or 0.0), forward)
     end
     return N.msgid(N)
   end,
@@ -647,13 +657,22 @@ local function default_value(kind, len)
   return t
 end
 
--- The fields, read again from the robot at every read (a command sent through llsfsim's own
--- methods in the same cycle shows at once, e.g. the navigator's goal id).
+-- The fields, read again from the robot when the time or what the skills did changed since
+-- the object's last read: a command sent in the same cycle (a message, a field set, llsfsim's
+-- own methods) shows at once, e.g. the navigator's goal id. `epoch` counts those commands.
+local epoch = 0
 local function refresh(obj)
   local m = meta_of[obj]
-  if m.write then m.write(data_of[obj], now_ns()) end
+  if m.write then
+    local now = now_ns()
+    if m.read_ns ~= now or m.read_epoch ~= epoch then
+      m.write(data_of[obj], now)
+      m.read_ns, m.read_epoch = now, epoch
+    end
+  end
   return data_of[obj]
 end
+
 
 local function message_class(type_name, name, fields)
   local by_type = message_classes[type_name]
@@ -718,6 +737,7 @@ function common.msgq_enqueue_copy(obj, msg)
          common.uid(obj), m.type, m.var or "iface")
   end
   m.msgid = m.msgid + 1
+  epoch = epoch + 1
   local handle = m.t.handle
   local id = handle and handle(data_of[obj], class.name, msg, m.id, 3) or nil
   return id or m.msgid
@@ -727,10 +747,10 @@ common.msgq_enqueue = common.msgq_enqueue_copy
 local function make_object(type_name, id, t)
   local d = {}
   for f, spec in pairs(t.fields) do d[f] = default_value(spec[1], spec[2]) end
-  local w = t.writer(id)
+  local w, visible = t.writer(id)
   local obj = {}
   meta_of[obj] = {type = type_name, id = id, t = t, write = w ~= "store" and w or nil,
-                  store = w == "store", msgid = 0}
+                  visible = visible, store = w == "store", msgid = 0}
   if w == "store" then meta_of[obj].written = true end
   data_of[obj] = d
   -- llsfsim's own methods answer at every id of its types; before the fields of the same name
@@ -741,13 +761,23 @@ local function make_object(type_name, id, t)
   local mt = {__metatable = false}
   local lookup
   -- What a key means is fixed per object: looked up once (no closure made per call).
-  local cache = {}
+  -- llsfsim's own methods may command the robot: looking one up counts as a command (epoch).
+  local cache, commands = {}, {}
   mt.__index = function(o, k)
     local v = cache[k]
+    if v ~= nil then return v end
+    v = commands[k]
     if v == nil then
-      v = lookup(o, k)
-      if v ~= nil then cache[k] = v end
+      local command
+      v, command = lookup(o, k)
+      if v == nil then return nil end
+      if not command then
+        cache[k] = v
+        return v
+      end
+      commands[k] = v
     end
+    epoch = epoch + 1
     return v
   end
   lookup = function(_, k)
@@ -755,6 +785,7 @@ local function make_object(type_name, id, t)
     if c then return c end
     if llsf_first then
       local v = llsf_obj[k]
+      if type(v) == "function" then return v, true end
       if v ~= nil then return v end
     end
     if k == "type" then return type_of end
@@ -787,6 +818,7 @@ local function make_object(type_name, id, t)
       return function(self, a, b)
         local dd = data_of[self]
         if t.fields[set][2] then dd[set][floor(a) + 1] = b else dd[set] = a end
+        epoch = epoch + 1
         mark_written(self)  -- (Fawkes' skiller wrote its writing interfaces after every loop)
       end
     end
@@ -796,7 +828,11 @@ local function make_object(type_name, id, t)
     end
     if t.constants and t.constants[k] ~= nil then return t.constants[k] end
     if t.messages[k] then return message_class(type_name, k, t.messages[k]) end
-    if llsf_obj then return llsf_obj[k] end
+    if llsf_obj then
+      local v = llsf_obj[k]
+      if type(v) == "function" then return v, true end
+      return v
+    end
     return nil
   end
   mt.__newindex = function() fail(2, "interfaces are read-only") end
@@ -858,8 +894,22 @@ end
 
 -- Fawkes' skiller read every interface at the start of each loop: the visibility histories of
 -- the interfaces files written for Fawkes bound follow the robot from cycle to cycle, read or not.
+-- Only the visibility is followed here (a writer's second function; the fields are read when
+-- asked for): it is all that a history counts.
 function F.poll()
-  for i = 1, #polled do pcall(refresh, polled[i]) end  -- (a failing read fails at the skill's)
+  local now
+  for i = 1, #polled do
+    local obj = polled[i]
+    local visible = meta_of[obj].visible
+    if visible then
+      now = now or now_ns()
+      local ok, v = pcall(visible)  -- (a failing read fails at the skill's)
+      local d = data_of[obj]
+      if ok and d.vis_state ~= v then d.vis_state, d.vis_since = v, now end
+    else
+      pcall(refresh, obj)
+    end
+  end
 end
 function F.type_names()
   local names = {}

@@ -31,6 +31,7 @@ AgentBrain::AgentBrain(Game& game, int index, AgentBrainConfig config, clips::Lo
   ac.seed = seed.next_u64();
   ac.max_rules_per_cycle = config.max_rules_per_cycle;
   max_runaway_cycles_ = config.max_runaway_cycles;
+  start_ = config.start;
   ac.sandbox = config.sandbox;
   ac.fawkes = config.fawkes;
   ac.agent_dir = config.agent_dir;
@@ -191,7 +192,8 @@ clips::Value field_value(const lua::InterfaceField& f) {
 }  // namespace
 
 void AgentBrain::on_agent_cycle(lua::RobotApi& robot, RobotRadio& radio) {
-  if (halt_) return;  // halted: no cycle (the game clears the inbox)
+  if (halt_) return;                 // halted: no cycle (the game clears the inbox)
+  if (robot.now() < start_) return;  // not switched on yet
   const lua::PoseEstimate pose = robot.pose();
   if (pose.valid) agent_->set_pose(pose.pose);
   if (host_config_.fawkes) {

@@ -387,7 +387,7 @@ void Game::step() {
   in.rfid = rfid_;
   in.insertion_slot_occupied = insertion_slot_occupied();
   const std::span<const refbox::Outgoing> outgoing = protocol_->step(now, in);
-  apply_refbox_output(protocol_->engine_output());
+  apply_refbox_output(protocol_->engine_output(), now);
   for (const refbox::Outgoing& o : outgoing) {
     // Stream clients (controllers) are not part of the game loop; peers get the UDP messages.
     if (o.to.kind == refbox::Destination::Kind::kAllPeers) {
@@ -535,7 +535,13 @@ const char* Game::TickProfile::step_name(int step) {
 
 // --- referee actions -------------------------------------------------------------------------
 
-void Game::apply_refbox_output(const refbox::StepOutput& out) {
+void Game::apply_refbox_output(const refbox::StepOutput& out, SimTime now) {
+  // The referee's removals that are due (in the order asked for).
+  while (!pending_removals_.empty() && pending_removals_.front().first <= now) {
+    const core::PuckId p = pending_removals_.front().second;
+    pending_removals_.erase(pending_removals_.begin());
+    if (world_->has_puck(p)) world_->remove_puck(p);
+  }
   // The refbox's lamps on the world's devices (all of them once, then the changed ones).
   for (int i = 0; i < kinematic::kDeviceCount; ++i) {
     if (lights_applied_ && (out.lights_changed_mask & (1u << i)) == 0) continue;
@@ -545,7 +551,11 @@ void Game::apply_refbox_output(const refbox::StepOutput& out) {
   for (const refbox::RefereeAction& a : out.actions) {
     switch (a.kind) {
       case refbox::RefereeAction::Kind::kRemovePuck:
-        if (world_->has_puck(a.puck)) world_->remove_puck(a.puck);
+        if (config_.referee_remove_delay > SimTime()) {
+          pending_removals_.emplace_back(now + config_.referee_remove_delay, a.puck);
+        } else if (world_->has_puck(a.puck)) {
+          world_->remove_puck(a.puck);
+        }
         break;
       case refbox::RefereeAction::Kind::kPlacePuck:
         if (world_->has_puck(a.puck)) break;

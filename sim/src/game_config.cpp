@@ -64,9 +64,17 @@ void GameConfig::validate() const {
     fail("levels.symbolic.cruise_speed_mps", "must be > 0");
   }
   if (!(levels.symbolic.turn_rate_rps > 0.0)) fail("levels.symbolic.turn_rate_rps", "must be > 0");
+  if (referee_remove_delay < SimTime() || referee_remove_delay > SimTime::from_sec(60)) {
+    fail("referee_remove_delay", "must be in [0, 60] s");
+  }
   // Light detection.
   const LightDetectionConfig& li = levels.light;
   require_game("levels.light.range_m", li.range_m, core::positive());
+  require_game("levels.light.cluster_max_x_m", li.cluster_max_x_m, core::positive());
+  require_game("levels.light.cluster_half_width_m", li.cluster_half_width_m, core::positive());
+  if (li.cluster_min_x_m < 0.0 || li.cluster_min_x_m >= li.cluster_max_x_m) {
+    fail("levels.light.cluster_min_x_m", "must be in [0, cluster_max_x_m)");
+  }
   angle("levels.light.half_angle_rad", li.half_angle_rad);
   angle("levels.light.facing_half_angle_rad", li.facing_half_angle_rad);
   require_game("levels.light.frame_rate_hz", li.frame_rate_hz, core::positive());

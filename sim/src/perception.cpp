@@ -132,6 +132,26 @@ int LightDetection::device_in_front(const core::Pose2D& pose, bool vision) {
   }
   int best = -1;
   double best_d = 0.0;
+  if (c_.view == LightView::kLaserCluster) {
+    // The 2013 team's light detection: the laser cluster nearest to the robot within the
+    // cluster window ahead (a device's RFID zone, where the laser sees its signal tower and
+    // reader), from any side of the device; the camera then reads that device's lamps.
+    const double c = std::cos(pose.theta), s = std::sin(pose.theta);
+    for (int i = 0; i < static_cast<int>(devices_.size()); ++i) {
+      const core::Vec2 v = devices_[static_cast<std::size_t>(i)].front - pose.position();
+      const double x = c * v.x() + s * v.y();  // in the robot frame
+      const double y = -s * v.x() + c * v.y();
+      if (x < c_.cluster_min_x_m || x > c_.cluster_max_x_m) continue;
+      if (std::abs(y) > c_.cluster_half_width_m) continue;
+      const double dist2 = x * x + y * y;
+      if (best < 0 || dist2 < best_d) {
+        best = i;
+        best_d = dist2;
+      }
+    }
+    front_ = {pose, vision, best};
+    return best;
+  }
   const double range2_margin = c_.range_m * c_.range_m * (1.0 + 1e-9) + 1e-12;
   for (int i = 0; i < static_cast<int>(devices_.size()); ++i) {
     const DeviceView& d = devices_[static_cast<std::size_t>(i)];

@@ -418,6 +418,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
     c.sandbox = spec.sandbox;
     c.fawkes = spec.fawkes;
     c.agent_dir = spec.agent_dir;
+    c.start = spec.agent_start;
     const std::string name(game.robot(i).name());
     // The agent's decisions (info and above) go into the recording. Its issues and events
     // come as data (clips::AgentIo::issues, ::events): the role changes it declares are

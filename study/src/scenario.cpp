@@ -67,6 +67,9 @@ void read_levels(const core::ConfigNode& n, sim::RobotLevelsConfig& l) {
               {{"ground_truth", sim::DetectionLevel::kGroundTruth},
                {"vision", sim::DetectionLevel::kVision}},
               "detection level");
+  n.read_enum("light_view", l.light.view,
+              {{"front", sim::LightView::kFront}, {"laser_cluster", sim::LightView::kLaserCluster}},
+              "light view");
   n.read_enum("puck", l.puck.level,
               {{"ground_truth", sim::DetectionLevel::kGroundTruth},
                {"vision", sim::DetectionLevel::kVision}},
@@ -269,6 +272,9 @@ void read_robots(const core::ConfigNode& n, const std::string& dir, Scenario& s)
       merge_config(spec.config, clips::config_from_node(c, "/clips-agent"));
     }
     if (const core::ConfigNode a = r["agent"]; a.defined()) read_agent_spec(a, dir, spec);
+    if (const core::ConfigNode a = r["agent_start_s"]; a.defined()) {
+      spec.agent_start = core::SimTime::from_seconds(a.as_double(core::in_range(0.0, 3600.0)));
+    }
     kinematic::RobotStart& start = s.game.world.robots[static_cast<std::size_t>(i)];
     r.read("name", start.name);
     r.read("jersey", start.jersey);
@@ -382,6 +388,7 @@ constexpr GameFieldKeys kGameFieldKeys[] = {
     {"game.skill_rate_hz", {"rates.skill_hz", "rates.physics_hz", "world.physics.step_ms"}},
     {"game.agent_rate_hz", {"rates.agent_hz", "rates.physics_hz", "world.physics.step_ms"}},
     {"game.beacon_period", {"rates.beacon_period_s"}},
+    {"game.referee_remove_delay", {"referee.remove_delay_s"}},
     {"game.handling.", {"profile"}},
     {"game.hackathon", {"hackathon"}},
     {"physics.", {"rates.physics_hz", "world.physics", "world"}},
@@ -519,6 +526,14 @@ Scenario read_scenario(const core::ConfigNode& root, const std::string& file) {
   read_rates(root["rates"], s.game);
   root.read("team", s.game.team);
   root.read("strict", s.strict);
+  if (const core::ConfigNode n = root["referee"]; n.defined()) {
+    n.require_map();
+    if (const core::ConfigNode d = n["remove_delay_s"]; d.defined()) {
+      s.game.referee_remove_delay =
+          core::SimTime::from_seconds(d.as_double(core::in_range(0.0, 60.0)));
+    }
+    n.no_other_keys();
+  }
   if (const core::ConfigNode n = root["hackathon"]; n.defined()) {
     s.game.hackathon = sim::load_hackathon_config(n, s.game.world);
     s.start = StartMode::kNone;

@@ -33,6 +33,7 @@ class FakeRobot : public lua::RobotApi {
   lua::PoseEstimate pose_estimate{{0.2, 0.4, 0.0}, {}, true};
   lua::NavState nav;
   std::string nav_goal;
+  bool nav_forward = false;  ///< the last goal's forward_only
   int nav_left = 0;
   int stops = 0;
   double vx = 0.0, vy = 0.0, omega = 0.0;
@@ -51,8 +52,9 @@ class FakeRobot : public lua::RobotApi {
     if (throw_on_pose) throw std::runtime_error("localization lost");
     return pose_estimate;
   }
-  void goto_place(std::string_view place, bool) override {
+  void goto_place(std::string_view place, bool forward) override {
     ++nav.goal_id;
+    nav_forward = forward;
     nav_goal = std::string(place);
     nav.error.clear();
     if (places.find(place) == places.end()) {
@@ -63,8 +65,9 @@ class FakeRobot : public lua::RobotApi {
     nav.status = lua::NavStatus::kRunning;
     nav_left = nav_steps;
   }
-  void goto_pose(const core::Pose2D& p, bool) override {
+  void goto_pose(const core::Pose2D& p, bool forward) override {
     ++nav.goal_id;
+    nav_forward = forward;
     nav_goal = "pose";
     pose_estimate.pose = p;
     nav.status = lua::NavStatus::kRunning;

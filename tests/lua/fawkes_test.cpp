@@ -173,10 +173,13 @@ TEST_CASE("ppgoto: poses, places, stop and its failures") {
   CHECK(test::run_until_done(engine, robot) == SkillStatus::kFinal);
   CHECK(robot.pose_estimate.pose.x == doctest::Approx(1.5));
   CHECK(robot.pose_estimate.pose.theta == doctest::Approx(0.5));
+  CHECK(robot.nav_forward);  // "Pathplan" (the team's move_base) never drives backwards
   // An llsfsim place when no navgraph has the node.
+  robot.nav_forward = false;
   REQUIRE(engine.exec("ppgoto{place='M2'}"));
   CHECK(test::run_until_done(engine, robot) == SkillStatus::kFinal);
   CHECK(robot.nav_goal == "M2");
+  CHECK(robot.nav_forward);
   REQUIRE(engine.exec("ppgoto{}"));
   CHECK(test::run_until_done(engine, robot) == SkillStatus::kFailed);
   CHECK(contains(engine.error(), "needs x and y, place or stop"));
@@ -271,6 +274,7 @@ TEST_CASE("the relative navigator, the puck detection by id, fawkes.Time") {
         "skiller=probe{}/2");
   CHECK(robot.pose_estimate.pose.y == doctest::Approx(2.0));
   CHECK(robot.pose_estimate.pose.theta == doctest::Approx(core::kPi / 2));
+  CHECK_FALSE(robot.nav_forward);  // the relative navigator may back up
 }
 
 TEST_CASE("bad Fawkes-style input: navgraph files, messages, config, interface ids") {

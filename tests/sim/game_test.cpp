@@ -190,6 +190,41 @@ TEST_CASE("the refbox's lamps are on the world's devices in every phase") {
   CHECK(mirror.mismatches == 0);
 }
 
+TEST_CASE("referee_remove_delay: a delivered puck lies at the gate, all lamps on, until then") {
+  GameConfig config = test::small_game(1, 5);
+  config.referee_remove_delay = SimTime::from_sec(4);
+  Game g(config);
+  test::start_phase(g, refbox::GamePhase::kProduction);
+  g.step();
+  const auto& params = *g.refbox().params();
+  int t5 = -1;
+  for (int i = 0; i < refbox::kProductionMachineCount; ++i) {
+    if (params.machine_types[static_cast<std::size_t>(i)] == refbox::MachineType::kT5) t5 = i;
+  }
+  REQUIRE(t5 >= 0);
+  const core::PuckId puck(16);
+  g.world().teleport_puck(puck, config.world.devices[static_cast<std::size_t>(t5)].rfid_center());
+  REQUIRE(
+      run_until(g, 200.0, [&] { return g.refbox().puck_state(puck) == refbox::PuckState::kP3; }));
+  const std::optional<core::DeviceId> gate = g.refbox().active_gate();
+  REQUIRE(gate.has_value());
+  g.world().teleport_puck(
+      puck, config.world.devices[static_cast<std::size_t>(gate->value())].rfid_center());
+  REQUIRE(run_until(g, 10.0,
+                    [&] { return g.refbox().puck_state(puck) == refbox::PuckState::kFinished; }));
+  const SimTime finished = g.time();
+  // Still there, the gate's three lamps on, until the referee comes.
+  REQUIRE(run_until(g, 3.5, [&] { return false; }) == false);
+  CHECK(g.world().has_puck(puck));
+  const kinematic::SignalLights l = g.world().lights(*gate);
+  CHECK(l.red == kinematic::LampState::kOn);
+  CHECK(l.yellow == kinematic::LampState::kOn);
+  CHECK(l.green == kinematic::LampState::kOn);
+  REQUIRE(run_until(g, 1.0, [&] { return !g.world().has_puck(puck); }));
+  CHECK(g.time() - finished >= SimTime::from_sec(4));
+  CHECK(g.time() - finished <= SimTime::from_ms(4020));
+}
+
 TEST_CASE("referee actions: a delivered puck leaves the world, late-order pucks arrive") {
   GameConfig config = test::small_game(1, 5);
   Game g(config);

@@ -208,6 +208,44 @@ TEST_CASE("light vision: must face the device, and the front of it") {
   CHECK(rig.stack.light().device == "M6");
 }
 
+TEST_CASE("light laser_cluster view: the nearest RFID zone in the cluster window, from any side") {
+  RobotLevelsConfig levels;
+  levels.light.view = LightView::kLaserCluster;
+  Rig rig(levels);
+  rig.lights[4] = {kOn, kOff, kOn};  // M5
+  const kinematic::DeviceConfig& m5 = rig.config.world.devices[4];
+  const core::Vec2 zone = m5.rfid_center();
+  // Beside the device, a little behind the plane of its front, looking at its zone: the front
+  // view (and its vision level) needs the robot on the front's side; the cluster does not.
+  const core::Vec2 side =
+      zone - 0.1 * core::unit(m5.pose.theta) + 0.5 * core::unit(m5.pose.theta + core::kPi / 2);
+  const core::Vec2 to_zone = zone - side;
+  const double at_zone = std::atan2(to_zone.y(), to_zone.x());
+  rig.pose = {side.x(), side.y(), at_zone};
+  rig.tick();
+  CHECK(rig.stack.light().device == "M5");
+  CHECK(shows(rig.stack.light(), lua::Lamp::kOn, lua::Lamp::kOff, lua::Lamp::kOn));
+  // Behind the device, looking at it (the zone 0.64 m ahead): still M5.
+  const core::Vec2 behind = m5.pose.position() - 0.5 * core::unit(m5.pose.theta);
+  rig.pose = {behind.x(), behind.y(), m5.pose.theta};
+  rig.tick();
+  CHECK(rig.stack.light().device == "M5");
+  // The zone beyond the window's 0.8 m, or behind the robot: nothing.
+  const core::Vec2 far = zone - 0.9 * core::unit(m5.pose.theta + core::kPi / 2);
+  rig.pose = {far.x(), far.y(), core::normalize_angle(m5.pose.theta + core::kPi / 2)};
+  rig.tick();
+  CHECK_FALSE(rig.stack.light().visible);
+  rig.pose = {side.x(), side.y(), core::normalize_angle(at_zone + core::kPi)};  // behind
+  rig.tick();
+  CHECK(rig.stack.light().device != "M5");
+  // The front view from beside M5 (the same pose as first): nothing.
+  Rig front({});
+  front.lights[4] = {kOn, kOff, kOn};
+  front.pose = {side.x(), side.y(), at_zone};
+  front.tick();
+  CHECK_FALSE(front.stack.light().visible);
+}
+
 TEST_CASE("light vision: misreads at about the configured rate") {
   for (const double rate : {0.05, 0.25}) {
     RobotLevelsConfig levels;

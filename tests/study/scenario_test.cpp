@@ -225,3 +225,38 @@ TEST_CASE("scenario: refbox.known_teams fills GameInfo's known teams; bad lists 
   p = scenario_file("t5.yaml", "name: t\nrefbox: {known_teams: [\"\"]}\n");
   CHECK(error_of(p).find("a team name has 1 to 64 characters") != std::string::npos);
 }
+
+TEST_CASE("scenario: each[i].agent_start_s, referee.remove_delay_s, levels.light_view") {
+  const ScenarioFile f = load_scenario(
+      scenario_file("start.yaml",
+                    "name: s\nstart: production\nduration_s: 3\nreferee: {remove_delay_s: 5}\n"
+                    "levels: {light_view: laser_cluster}\nrobots:\n  count: 2\n" +
+                        kAgent + "  each:\n    - {}\n    - {agent_start_s: 1.5}\n"));
+  const Scenario& s = f.variants[0];
+  CHECK(s.game.referee_remove_delay == SimTime::from_sec(5));
+  CHECK(s.game.levels.light.view == LightView::kLaserCluster);
+  CHECK(s.robots[0].agent_start == SimTime());
+  CHECK(s.robots[1].agent_start == SimTime::from_ms(1500));
+  // The late robot's agent neither cycles nor fires a rule before its start.
+  Game game(s.game);
+  AgentBrainConfig c;
+  c.agent_files = s.robots[1].agent;
+  c.start = s.robots[1].agent_start;
+  AgentBrain brain(game, 1, c);
+  game.set_brain(1, &brain);
+  brain.agent().start(SimTime{});
+  const std::int64_t fired = brain.agent().rules_fired();
+  game.run_until(SimTime::from_ms(1400));
+  CHECK(brain.agent().rules_fired() == fired);
+  game.run_until(SimTime::from_ms(1700));
+  CHECK(brain.agent().rules_fired() > fired);
+  game.set_brain(1, nullptr);
+  // Bad values name the key.
+  std::string e = error_of(scenario_file(
+      "start2.yaml", "name: s\nrobots:\n  count: 1\n  each:\n    - {agent_start_s: -1}\n"));
+  CHECK(e.find("agent_start_s") != std::string::npos);
+  e = error_of(scenario_file("start3.yaml", "name: s\nreferee: {remove_delay_s: 61}\n"));
+  CHECK(e.find("remove_delay_s") != std::string::npos);
+  e = error_of(scenario_file("start4.yaml", "name: s\nlevels: {light_view: sideways}\n"));
+  CHECK(e.find("light_view") != std::string::npos);
+}

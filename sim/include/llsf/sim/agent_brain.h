@@ -47,6 +47,10 @@ struct AgentBrainConfig {
   /// entry file, inside `agent_dir` (Fawkes' clips-dirs), which path-load reads from.
   bool fawkes = false;
   std::string agent_dir;
+  /// Game time of the agent's first cycle (before it, the agent neither cycles nor hears the
+  /// radio): robots whose software was switched on one after the other, as the 2013 team's
+  /// were, so that their agents' lock-master elections do not start in the same tick.
+  core::SimTime start;
   /// Robots that take part in the lock protocol (the majority is counted of these); 0: every
   /// robot of the game.
   int lock_team_size = 0;
@@ -142,7 +146,8 @@ class AgentBrain final : public RobotBrain, private clips::SkillRunner {
   std::vector<FileStamp> loaded_;  // the files as last loaded
   int errors_before_reload_ = 0;
   int max_runaway_cycles_ = 10;
-  int rule_loops_ = 0;  // runaway cycles of the current agent
+  core::SimTime start_;  // AgentBrainConfig::start
+  int rule_loops_ = 0;   // runaway cycles of the current agent
   int budget_stops_ = 0;
   std::optional<Halt> halt_;
   // A Fawkes-style agent's RobotinoLightInterface "Light_State": since when no device is seen.

@@ -184,7 +184,7 @@ class Game {
   const TickProfile& profile() const { return profile_; }
 
  private:
-  void apply_refbox_output(const refbox::StepOutput& out);
+  void apply_refbox_output(const refbox::StepOutput& out, SimTime now);
   /// Carries out robot `robot`'s symbolic skill requests (tick step 2).
   void apply_symbolic(int robot);
   /// Distance from a robot's centre to the centre of a puck in its pocket.
@@ -222,6 +222,8 @@ class Game {
   kinematic::WorldEvents no_events_;
   std::int64_t ticks_ = 0;
   bool lights_applied_ = false;
+  /// Pucks the referee takes off the field later (GameConfig::referee_remove_delay): when, which.
+  std::vector<std::pair<SimTime, core::PuckId>> pending_removals_;
   SimTime next_skill_;
   bool skills_cycled_ = false;
   SimTime next_agent_;

@@ -62,6 +62,17 @@ struct LocalizationConfig {
   double heading_noise_rad = 0.01;  ///< std of the correction's heading error
 };
 
+/// Which device the light detection reads.
+enum class LightView : std::uint8_t {
+  /// The device whose front is ahead and faces the robot (LightDetectionConfig): llsfsim's
+  /// reader of the light the device shows towards the field.
+  kFront,
+  /// The 2013 Carologistics light detection (thesis §5.1.3, Gazsim-Light-Front): the laser
+  /// cluster plugin finds the device nearest to the robot within its window ahead, from any side
+  /// (a device's signal tower is seen all around), and the camera reads that device's lamps.
+  kLaserCluster,
+};
+
 /// Light-signal detection of the device in front. A device is "in front" when its front (the
 /// RFID zone centre) lies within `range_m` of the robot and within `half_angle_rad` of its
 /// heading, and the robot is on the front's side; the nearest such device is read. `vision`
@@ -69,9 +80,17 @@ struct LocalizationConfig {
 /// at the front of the light, not from the side), samples at `frame_rate_hz`,
 /// reports a reading only after a full blink period of frames of one device (blink = lit and
 /// unlit frames within that period), `delay` late, and with probability `error_rate` per
-/// reading one lamp is reported wrong.
+/// reading one lamp is reported wrong. With `view` kLaserCluster the device is chosen as the
+/// 2013 team's light detection chose it instead (see LightView).
 struct LightDetectionConfig {
   DetectionLevel level = DetectionLevel::kGroundTruth;
+  LightView view = LightView::kFront;
+  /// kLaserCluster: the laser-cluster window in the robot frame (x forward, y left), metres: the
+  /// 2013 team's cfg/conf.d/laser-cluster.yaml (cluster_min_x 0.02, cluster_max_x 0.8,
+  /// cluster_min_y -0.7, cluster_max_y 0.7).
+  double cluster_min_x_m = 0.02;
+  double cluster_max_x_m = 0.8;
+  double cluster_half_width_m = 0.7;
   double range_m = 1.0;
   double half_angle_rad = 0.35;
   double facing_half_angle_rad = 1.0;    ///< vision only
@@ -179,6 +198,10 @@ struct GameConfig {
   SimTime beacon_period = SimTime::from_sec(1);
   /// Team name in the robots' beacons (empty: the refbox's team).
   std::string team;
+  /// How long after the refbox asks for it the referee takes a puck off the field (a delivered
+  /// product, a puck out of the game): 0 at once. A delivery gate shows its three lamps until
+  /// then (shared/specs/llsf2013-rules.md §2.4: the referee is told to remove the puck).
+  SimTime referee_remove_delay;
   /// The hackathon variant (docs/hackathon.md): when set, the Game adds its obstacles, replaces
   /// the pucks by a coloured layout drawn from the seed, adds the safe place to the planner and
   /// gives every robot the colour camera and the rescue interface.

@@ -29,6 +29,9 @@ struct RobotSpec {
   bool fawkes = false;
   std::string agent_dir;
   std::vector<std::string> proto_dirs;  ///< its own .proto directories (also in game.agent_protos)
+  /// Game time at which the robot's agent starts cycling (robots.each[i].agent_start_s): robots
+  /// whose software was switched on one after the other.
+  core::SimTime agent_start;
 };
 
 /// A pass/fail condition on a finished game: a metric against a limit (the metric table's test
