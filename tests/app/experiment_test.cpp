@@ -310,7 +310,7 @@ TEST_CASE("llsfsim experiment --until plays in rounds until the findings are dec
   CHECK(has(r.out, "finding    F1 decided after 10 seeds (check 1 holds)\n"));
   // The report covers what was played; the non-comparison check is evaluated on it.
   CHECK(has(r.out, "mean 20.0, 95 % CI [20.0, 20.0]; n 10 (10 of 20 runs)"));
-  CHECK(has(r.out, "reproduced"));
+  CHECK(has(r.out, "  F1  Longer games last longer\n    all: reproduced\n"));
   CHECK(has(slurp(dir.file("f1.md")),
             "Reproduce: `llsfsim experiment " + exp + " --until F1 --max-runs 20 --looks 2`"));
   CHECK(llsf::study::StatsStore(db).count_rows("runs") == 40);  // 2 batches x 2 variants x 10
@@ -356,6 +356,60 @@ TEST_CASE("llsfsim experiment --until plays in rounds until the findings are dec
   bad({"--until", "--max-runs", "20", "--runs", "3"}, "excludes");
   CHECK(!fs::exists(bad_db));
   bad({"--until", "--max-runs", "20", "--report-only"}, "excludes");
-  bad({"--max-runs", "20"}, "requires --until");
+  bad({"--max-runs", "20"}, "--max-runs requires --until");
   CHECK(!fs::exists(bad_db));
+  const Run help = llsfsim({"experiment", "--help"});
+  CHECK(has(help.out, "--until [ID,...]"));
+  CHECK(has(help.out, "--max-runs"));
+}
+
+TEST_CASE("llsfsim experiment --until: Ctrl-C keeps the stored runs, the next call resumes") {
+  const TempDir dir;
+  write_until_experiment(dir);
+  const std::string db = dir.file("int.db");
+  const std::vector<std::string> args{"experiment",
+                                      dir.file("until.yaml"),
+                                      "--db",
+                                      db,
+                                      "--jobs",
+                                      "1",
+                                      "--no-record",
+                                      "--until",
+                                      "F1",
+                                      "--max-runs",
+                                      "20",
+                                      "--looks",
+                                      "2"};
+  const auto old = std::signal(SIGINT, ignore_sigint);
+  std::atomic<bool> done{false};
+  std::thread ctrl_c([&] {
+    while (!done) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      if (!fs::exists(db)) continue;
+      try {
+        if (llsf::study::StatsStore(db).count_rows("runs") < 1) continue;
+      } catch (const std::exception&) {
+        continue;
+      }
+      std::raise(SIGINT);
+      return;
+    }
+  });
+  Run r = llsfsim(args);
+  done = true;
+  ctrl_c.join();
+  std::signal(SIGINT, old);
+  INFO(r.out, r.err);
+  CHECK(r.code == llsf::app::kExitInterrupted);
+  CHECK(has(r.out, "result     interrupted"));
+  CHECK(!has(r.out, "finding    F1"));
+  const std::int64_t stored = llsf::study::StatsStore(db).count_rows("runs");
+  CHECK(stored >= 1);
+  CHECK(stored < 40);
+  // The same command plays the rest of the first round and comes to the answer.
+  r = llsfsim(args);
+  INFO(r.out, r.err);
+  CHECK(r.code == llsf::app::kExitOk);
+  CHECK(has(r.out, "finding    F1 decided after 10 seeds (check 1 holds)\n"));
+  CHECK(llsf::study::StatsStore(db).count_rows("runs") == 40);
 }
