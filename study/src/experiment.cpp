@@ -627,10 +627,17 @@ BatchData load_batch_data(const ExperimentBatch& b, const StatsStore& store,
   d.batch = &b;
   d.runs.resize(b.scenario.variants.size());
   std::map<std::string, std::size_t> index;
+  // Per variant, the seeds evaluated: all, or the first N (a look of `experiment --until`).
+  std::vector<std::set<std::uint64_t>> first(b.scenario.variants.size());
   for (std::size_t v = 0; v < b.scenario.variants.size(); ++v) {
     const Scenario& s = b.scenario.variants[v];
     index[s.variant] = v;
-    d.expected.push_back(static_cast<int>(batch_seeds(s, o.runs).size()));
+    const std::vector<std::uint64_t> seeds = batch_seeds(s, o.runs);
+    d.expected.push_back(static_cast<int>(seeds.size()));
+    if (o.first_seeds) {
+      const auto n = static_cast<std::size_t>(std::clamp(*o.first_seeds, 0, d.expected.back()));
+      first[v].insert(seeds.begin(), seeds.begin() + static_cast<std::ptrdiff_t>(n));
+    }
   }
   state.name = b.name;
   state.file_as_given = b.file_as_given;
@@ -655,6 +662,7 @@ BatchData load_batch_data(const ExperimentBatch& b, const StatsStore& store,
   for (const StoredRun& run : runs) {
     const auto it = index.find(run.variant);
     if (it == index.end()) continue;
+    if (o.first_seeds && first[it->second].count(run.seed) == 0) continue;
     std::map<std::string, double> values;
     for (const auto& [name, value] : store.statistics(run.id)) {
       values[name] = value;
@@ -1134,6 +1142,103 @@ ExperimentResult evaluate(const Experiment& e, const StatsStore& store, const Ev
     }
   }
   return r;
+}
+
+bool is_sequential(Check::Kind k) { return k == Check::Kind::kGreater || has_margin(k); }
+
+std::string to_string(CheckLook::Decision d) {
+  switch (d) {
+    case CheckLook::Decision::kOpen:
+      return "open";
+    case CheckLook::Decision::kHolds:
+      return "holds";
+    case CheckLook::Decision::kFails:
+      return "fails";
+  }
+  return "?";
+}
+
+std::vector<CheckLook> look_at_findings(const Experiment& e, const StatsStore& store,
+                                        const EvaluateOptions& options,
+                                        const std::vector<int>& findings,
+                                        const SequentialPlan& plan, int look) {
+  LLSF_DEMAND(plan.problem().empty());
+  LLSF_DEMAND(look >= 1 && look <= plan.looks);
+  EvaluateOptions o = options;
+  o.first_seeds = plan.look_sizes()[static_cast<std::size_t>(look - 1)];
+  // Only the batches the findings' checks use are read.
+  std::vector<BatchData> data(e.batches.size());
+  for (const int f : findings) {
+    for (const Check& c : e.findings[static_cast<std::size_t>(f)].checks) {
+      const auto i = static_cast<std::size_t>(c.sel.batch);
+      if (data[i].batch != nullptr) continue;
+      BatchState state;
+      data[i] = load_batch_data(e.batches[i], store, o, state);
+    }
+  }
+  std::vector<CheckLook> out;
+  for (const int fi : findings) {
+    const Finding& f = e.findings[static_cast<std::size_t>(fi)];
+    std::vector<int> batches;
+    for (const Check& c : f.checks) batches.push_back(c.sel.batch);
+    for (const std::string& g : groups_of(e, batches, f.groups)) {
+      for (std::size_t i = 0; i < f.checks.size(); ++i) {
+        const Check& c = f.checks[i];
+        if (!is_sequential(c.kind)) continue;
+        CheckLook l;
+        l.finding = fi;
+        l.check = static_cast<int>(i) + 1;
+        l.group = g;
+        l.description = describe(c);
+        const BatchData& d = data[static_cast<std::size_t>(c.sel.batch)];
+        const ExperimentBatch& b = *d.batch;
+        require_stored(d.statistics, c.sel.statistic, c.where, b.name);
+        const AxisFilter fa = with_group(e, b, c.a, g);
+        const AxisFilter fb = with_group(e, b, c.b, g);
+        const std::vector<std::size_t> key_axes = pooled_axes(b, fa, fb);
+        SampleCounts na, nb;
+        const std::vector<KeyedValue> ak = collect_keyed(d, c.sel, fa, key_axes, na);
+        const std::vector<KeyedValue> bk = collect_keyed(d, c.sel, fb, key_axes, nb);
+        if (ak.empty() || bk.empty()) {
+          out.push_back(std::move(l));
+          continue;
+        }
+        // Each check, group and look its own stream: adding a check changes no other decision.
+        core::RandomStream rng = stream(o, "until/finding/" + f.id + "/" + std::to_string(l.check) +
+                                               "/" + g + "/" + std::to_string(look));
+        const Comparison cmp =
+            compare_means(ak, bk, rng, o.min_games, kBootstrapResamples, plan.look_alpha());
+        l.comparison = cmp;
+        // A check is decided when its test is conclusive either way at the look's level; the
+        // margin checks on the 1 - 2 alpha interval (two one-sided tests), greater on 1 - alpha.
+        using D = CheckLook::Decision;
+        const Interval t = cmp.ci_tost;
+        const double m = c.margin;
+        D dec = D::kOpen;
+        switch (c.kind) {
+          case Check::Kind::kGreater:
+            dec = cmp.ci.low > 0.0 ? D::kHolds : cmp.ci.high < 0.0 ? D::kFails : D::kOpen;
+            break;
+          case Check::Kind::kNotGreater:
+            dec = t.high < m ? D::kHolds : t.low >= m ? D::kFails : D::kOpen;
+            break;
+          case Check::Kind::kNotLess:
+            dec = t.low > -m ? D::kHolds : t.high <= -m ? D::kFails : D::kOpen;
+            break;
+          case Check::Kind::kEquivalent:
+            dec = -m < t.low && t.high < m     ? D::kHolds
+                  : t.low >= m || t.high <= -m ? D::kFails
+                                               : D::kOpen;
+            break;
+          default:
+            break;
+        }
+        l.decision = cmp.enough ? dec : D::kOpen;
+        out.push_back(std::move(l));
+      }
+    }
+  }
+  return out;
 }
 
 namespace {

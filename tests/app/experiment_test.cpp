@@ -13,6 +13,7 @@
 #include <iterator>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "app/cli_fixture.h"
 #include "batch_progress.h"
@@ -240,4 +241,175 @@ TEST_CASE("llsfsim experiment: Ctrl-C keeps the stored runs and exits 130") {
   const std::int64_t stored = llsf::study::StatsStore(db).count_rows("runs");
   CHECK(stored >= 1);
   CHECK(stored < 60);
+}
+
+namespace {
+
+/// until.yaml: tiny.yaml (P3 and P1P2 play equally long: a `greater` between them is never
+/// separated) and len.yaml (30 s against 20 s games: separated at the first look with enough
+/// seeds), both at 30 s or less so that 80 games stay quick.
+void write_until_experiment(const TempDir& dir) {
+  write_scenario(dir);
+  std::string tiny = slurp(dir.file("tiny.yaml"));
+  tiny.replace(tiny.find("duration_s: 60"), 14, "duration_s: 30");
+  dir.write("tiny.yaml", tiny);
+  std::string len = tiny;
+  len.replace(len.find("matrix:"), std::string::npos,
+              "matrix:\n"
+              "  length:\n"
+              "    long: {}\n"
+              "    short: {duration_s: 20}\n");
+  dir.write("len.yaml", len);
+  dir.write("until.yaml",
+            "name: until-exp\n"
+            "description: Two small batches played until the answer is known.\n"
+            "batches:\n"
+            "  tiny: tiny.yaml\n"
+            "  len: len.yaml\n"
+            "findings:\n"
+            "  - id: F1\n"
+            "    claim: Longer games last longer\n"
+            "    checks:\n"
+            "      - greater: {batch: len, statistic: game_time_s, a: {length: long},\n"
+            "                  b: {length: short}}\n"
+            "      - mean_in: {batch: len, statistic: game_time_s, where: {length: short},\n"
+            "                  range: [19.5, 20.5]}\n"
+            "  - id: F2\n"
+            "    claim: P3 plays longer than P1P2\n"
+            "    checks:\n"
+            "      - greater: {batch: tiny, statistic: game_time_s, a: {config: P3},\n"
+            "                  b: {config: P1P2}}\n"
+            "  - id: F3\n"
+            "    claim: Games last 30 s\n"
+            "    checks:\n"
+            "      - mean_in: {batch: tiny, statistic: game_time_s, range: [29.5, 30.5]}\n");
+}
+
+}  // namespace
+
+TEST_CASE("llsfsim experiment --until plays in rounds until the findings are decided") {
+  const TempDir dir;
+  write_until_experiment(dir);
+  const std::string exp = dir.file("until.yaml");
+  const std::string db = dir.file("until.db");
+
+  // F1 separates at the first look (10 of at most 20 seeds): the batches stop there.
+  Run r = llsfsim({"experiment", exp, "--db", db, "--no-record", "--jobs", "2", "--until", "F1",
+                   "--max-runs", "20", "--looks", "2", "--out", dir.file("f1.md")});
+  INFO(r.out, r.err);
+  CHECK(r.code == llsf::app::kExitOk);
+  CHECK(has(r.out,
+            "until      F1: at most 20 seeds a variant, looks after 10, 20 seeds; each "
+            "comparison check at 2.5 % a look (5 % in all per check: Bonferroni over the 2 "
+            "looks; not corrected over the checks)"));
+  CHECK(has(r.out,
+            "look 1/2   10 seeds, 1 comparison checks, 0 open:\n"
+            "  F1 check 1 (all): +10.00 [+10.00, +10.00] (97.5 % interval, paired by seed): "
+            "holds\n"));
+  CHECK(!has(r.out, "look 2/2"));
+  CHECK(has(r.out, "finding    F1 decided after 10 seeds (check 1 holds)\n"));
+  // The report covers what was played; the non-comparison check is evaluated on it.
+  CHECK(has(r.out, "mean 20.0, 95 % CI [20.0, 20.0]; n 10 (10 of 20 runs)"));
+  CHECK(has(r.out, "  F1  Longer games last longer\n    all: reproduced\n"));
+  CHECK(has(slurp(dir.file("f1.md")),
+            "Reproduce: `llsfsim experiment " + exp + " --until F1 --max-runs 20 --looks 2`"));
+  CHECK(llsf::study::StatsStore(db).count_rows("runs") == 40);  // 2 batches x 2 variants x 10
+
+  // Every finding: F1 is decided again at the first look, F2's equal game times never separate
+  // (the 10 seeds stored are not played again), F3 has no comparison to look at.
+  r = llsfsim({"experiment", exp, "--db", db, "--no-record", "--jobs", "2", "--until", "--max-runs",
+               "20", "--looks", "2"});
+  INFO(r.out, r.err);
+  CHECK(r.code == llsf::app::kExitOk);
+  CHECK(has(r.out, "until      F1, F2: at most 20 seeds"));
+  CHECK(has(r.out, "0 played, 20 stored before"));
+  CHECK(has(r.out,
+            "look 1/2   10 seeds, 2 comparison checks, 1 open:\n"
+            "  F1 check 1 (all): +10.00 [+10.00, +10.00] (97.5 % interval, paired by seed): "
+            "holds\n"
+            "  F2 check 1 (all): +0.00 [+0.00, +0.00] (97.5 % interval, paired by seed): open\n"));
+  CHECK(has(r.out,
+            "look 2/2   20 seeds, 2 comparison checks, 1 open:\n"
+            "  F1 check 1 (all): holds since 10 seeds\n"
+            "  F2 check 1 (all): +0.00 [+0.00, +0.00] (97.5 % interval, paired by seed): open\n"));
+  CHECK(has(r.out, "finding    F1 decided after 10 seeds (check 1 holds)\n"));
+  CHECK(has(r.out, "finding    F2 undecided after 20 seeds (check 1 open)\n"));
+  CHECK(has(r.out, "n 20 vs 20"));
+  CHECK(llsf::study::StatsStore(db).count_rows("runs") == 80);
+
+  // Bad input: named, exit 2, nothing played.
+  const std::string bad_db = dir.file("bad.db");
+  auto bad = [&](std::vector<std::string> extra, const std::string& what) {
+    std::vector<std::string> a{"experiment", exp, "--db", bad_db, "--no-record"};
+    a.insert(a.end(), extra.begin(), extra.end());
+    const Run b = llsfsim(a);
+    INFO(b.out, b.err);
+    CHECK(b.code == llsf::app::kExitBadInput);
+    CHECK(has(b.err, what));
+  };
+  bad({"--until"}, "--until needs --max-runs N");
+  bad({"--until", "F9", "--max-runs", "20"},
+      "--until: the experiment has no finding 'F9' (findings: F1, F2, F3)");
+  bad({"--until", "F1,F3", "--max-runs", "20"},
+      "--until: finding F3 has no greater, not_greater, not_less or equivalent check");
+  bad({"--until", "--max-runs", "5"}, "--max-runs must be at least 10");
+  bad({"--until", "--max-runs", "20", "--runs", "3"}, "excludes");
+  CHECK(!fs::exists(bad_db));
+  bad({"--until", "--max-runs", "20", "--report-only"}, "excludes");
+  bad({"--max-runs", "20"}, "--max-runs requires --until");
+  CHECK(!fs::exists(bad_db));
+  const Run help = llsfsim({"experiment", "--help"});
+  CHECK(has(help.out, "--until [ID,...]"));
+  CHECK(has(help.out, "--max-runs"));
+}
+
+TEST_CASE("llsfsim experiment --until: Ctrl-C keeps the stored runs, the next call resumes") {
+  const TempDir dir;
+  write_until_experiment(dir);
+  const std::string db = dir.file("int.db");
+  const std::vector<std::string> args{"experiment",
+                                      dir.file("until.yaml"),
+                                      "--db",
+                                      db,
+                                      "--jobs",
+                                      "1",
+                                      "--no-record",
+                                      "--until",
+                                      "F1",
+                                      "--max-runs",
+                                      "20",
+                                      "--looks",
+                                      "2"};
+  const auto old = std::signal(SIGINT, ignore_sigint);
+  std::atomic<bool> done{false};
+  std::thread ctrl_c([&] {
+    while (!done) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      if (!fs::exists(db)) continue;
+      try {
+        if (llsf::study::StatsStore(db).count_rows("runs") < 1) continue;
+      } catch (const std::exception&) {
+        continue;
+      }
+      std::raise(SIGINT);
+      return;
+    }
+  });
+  Run r = llsfsim(args);
+  done = true;
+  ctrl_c.join();
+  std::signal(SIGINT, old);
+  INFO(r.out, r.err);
+  CHECK(r.code == llsf::app::kExitInterrupted);
+  CHECK(has(r.out, "result     interrupted"));
+  CHECK(!has(r.out, "finding    F1"));
+  const std::int64_t stored = llsf::study::StatsStore(db).count_rows("runs");
+  CHECK(stored >= 1);
+  CHECK(stored < 40);
+  // The same command plays the rest of the first round and comes to the answer.
+  r = llsfsim(args);
+  INFO(r.out, r.err);
+  CHECK(r.code == llsf::app::kExitOk);
+  CHECK(has(r.out, "finding    F1 decided after 10 seeds (check 1 holds)\n"));
+  CHECK(llsf::study::StatsStore(db).count_rows("runs") == 40);
 }

@@ -826,3 +826,68 @@ TEST_CASE("experiment sweeps: Holm's correction over the rows, named with the co
   CHECK(s.rows[1].separated);
   CHECK(has(to_text(r), "top two paired by seed, Holm's correction over 3 comparisons"));
 }
+
+TEST_CASE("experiment --until: each comparison check is decided either way, or left open") {
+  const StudyFixture f;
+  Experiment e = load_experiment(f.experiment(
+      "findings:\n"
+      "  - id: U\n"
+      "    claim: mixed\n"
+      "    checks:\n"
+      "      - greater: {batch: conf, statistic: points, a: {config: A}, b: {config: B}}\n"
+      "      - greater: {batch: conf, statistic: points, a: {config: B}, b: {config: A}}\n"
+      "      - not_greater: {batch: conf, statistic: points, a: {config: A}, b: {config: B},\n"
+      "                      margin: 10, margin_reason: one delivery}\n"
+      "      - not_less: {batch: conf, statistic: points, a: {config: A}, b: {config: B},\n"
+      "                   margin: 10, margin_reason: one delivery}\n"
+      "      - equivalent: {batch: conf, statistic: points, a: {config: A}, b: {config: B},\n"
+      "                     margin: 1, margin_reason: strict}\n"
+      "      - mean_in: {batch: conf, statistic: points, range: [0, 1000]}\n"
+      "  - id: V\n"
+      "    claim: only a mean\n"
+      "    checks:\n"
+      "      - mean_in: {batch: conf, statistic: points, range: [0, 1000]}\n"));
+  const StatsStore store(f.db);
+  SequentialPlan plan;
+  plan.max_runs = 10;  // the fixture holds 4 seeds: the look takes what there is
+  plan.looks = 1;
+  const std::vector<CheckLook> looks =
+      look_at_findings(e, store, StudyFixture::few_games(), {0, 1}, plan, 1);
+  // Per group (ideal, real) the five comparison checks; the mean_in and finding V have none.
+  REQUIRE(looks.size() == 10);
+  using D = CheckLook::Decision;
+  auto decision = [&](const std::string& g, int check) {
+    for (const CheckLook& l : looks) {
+      if (l.group == g && l.check == check) return l.decision;
+    }
+    FAIL("no look at check " << check << " in " << g);
+    return D::kOpen;
+  };
+  // ideal: A - B = +50 on every seed.
+  CHECK(decision("ideal", 1) == D::kHolds);
+  CHECK(decision("ideal", 2) == D::kFails);
+  CHECK(decision("ideal", 3) == D::kFails);  // better by far more than 10
+  CHECK(decision("ideal", 4) == D::kHolds);
+  CHECK(decision("ideal", 5) == D::kFails);  // wholly beyond +1
+  // real: A - B = -3, -1, +1, +3: neither greater, within 10 both ways, not provably within 1.
+  CHECK(decision("real", 1) == D::kOpen);
+  CHECK(decision("real", 2) == D::kOpen);
+  CHECK(decision("real", 3) == D::kHolds);
+  CHECK(decision("real", 4) == D::kHolds);
+  CHECK(decision("real", 5) == D::kOpen);
+  for (const CheckLook& l : looks) {
+    REQUIRE(l.comparison);
+    CHECK(l.comparison->alpha == doctest::Approx(0.05));
+    CHECK(l.comparison->pairs == 4);
+  }
+  // With 5 looks the level is 1 %: the same data give the same decisions here, each at 1 %.
+  plan.looks = 5;
+  const std::vector<CheckLook> first =
+      look_at_findings(e, store, StudyFixture::few_games(), {0}, plan, 1);  // 2 seeds of 10
+  REQUIRE(first.size() == 10);
+  CHECK(first.front().comparison->alpha == doctest::Approx(0.01));
+  CHECK(first.front().comparison->pairs == 2);
+  CHECK(to_string(D::kOpen) == "open");
+  CHECK(is_sequential(Check::Kind::kEquivalent));
+  CHECK(!is_sequential(Check::Kind::kDifferenceIn));
+}

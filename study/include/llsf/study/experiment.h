@@ -151,6 +151,9 @@ struct EvaluateOptions {
   std::uint64_t seed = 1;
   /// Fewest games a side (pairs, if paired) for a verdict; fewer give "too few games".
   int min_games = kMinGamesForVerdict;
+  /// If set, only the first N seeds of each variant's list are evaluated (a look of `llsfsim
+  /// experiment --until`, and its report); the counts still compare with a complete batch.
+  std::optional<int> first_seeds;
 };
 
 /// What the store holds of one batch.
@@ -275,6 +278,39 @@ struct ExperimentResult {
 /// statistic no stored run of its batch has, StatsError if the store cannot be read.
 ExperimentResult evaluate(const Experiment& e, const StatsStore& store,
                           const EvaluateOptions& options = {});
+
+/// Whether `experiment --until` looks at a check of this kind after every round: the comparisons
+/// with a test (greater, not_greater, not_less, equivalent). The others (difference_in, mean_in,
+/// median_in, share_*) are evaluated once, on what was played.
+bool is_sequential(Check::Kind k);
+
+/// One comparison check of a finding in one group at one look of `experiment --until`.
+struct CheckLook {
+  /// kOpen: neither way yet. kHolds / kFails: the look's test decided the check (greater:
+  /// the interval lies above / below 0; a margin check: inside / beyond the margin).
+  enum class Decision : std::uint8_t { kOpen, kHolds, kFails };
+  int finding = 0;  ///< index into Experiment::findings
+  int check = 0;    ///< 1-based, in the finding's list
+  std::string group;
+  std::string description;  ///< as the report's
+  /// At the look's level (compare_means with alpha = plan.look_alpha()); unset: a side without
+  /// values.
+  std::optional<Comparison> comparison;
+  Decision decision = Decision::kOpen;
+};
+
+/// "open", "holds", "fails".
+std::string to_string(CheckLook::Decision d);
+
+/// Look number `look` (1-based) of `plan` at every sequential check (is_sequential) of the
+/// findings `findings` (indices into e.findings), in every group, on the first
+/// plan.look_sizes()[look - 1] seeds of each variant (options.first_seeds is replaced by it).
+/// Each check and group draws its bootstrap from its own stream named by the finding, check,
+/// group and look: the same store gives the same decisions. Throws as evaluate().
+std::vector<CheckLook> look_at_findings(const Experiment& e, const StatsStore& store,
+                                        const EvaluateOptions& options,
+                                        const std::vector<int>& findings,
+                                        const SequentialPlan& plan, int look);
 
 /// The report as readable text (the terminal's).
 std::string to_text(const ExperimentResult& r);
