@@ -149,6 +149,27 @@ void produce_s1(std::uint64_t seed) {
   CHECK(g.summary().collisions_robot_wall == 0);
 }
 
+/// The referee's hand: puck 16 under the T5's reader becomes a P3 (20..40 s, plus a down time),
+/// then lies in the active gate's zone. Returns the gate.
+core::DeviceId deliver_p3(Game& g, const GameConfig& config, core::PuckId puck) {
+  test::start_phase(g, refbox::GamePhase::kProduction);
+  g.step();
+  const auto& params = *g.refbox().params();
+  int t5 = -1;
+  for (int i = 0; i < refbox::kProductionMachineCount; ++i) {
+    if (params.machine_types[static_cast<std::size_t>(i)] == refbox::MachineType::kT5) t5 = i;
+  }
+  REQUIRE(t5 >= 0);
+  g.world().teleport_puck(puck, config.world.devices[static_cast<std::size_t>(t5)].rfid_center());
+  REQUIRE(
+      run_until(g, 200.0, [&] { return g.refbox().puck_state(puck) == refbox::PuckState::kP3; }));
+  const std::optional<core::DeviceId> gate = g.refbox().active_gate();
+  REQUIRE(gate.has_value());
+  g.world().teleport_puck(
+      puck, config.world.devices[static_cast<std::size_t>(gate->value())].rfid_center());
+  return *gate;
+}
+
 }  // namespace
 
 TEST_CASE("a robot takes an S0 from the storage to a T1 through its RobotApi; it becomes S1") {
@@ -194,29 +215,15 @@ TEST_CASE("referee_remove_delay: a delivered puck lies at the gate, all lamps on
   GameConfig config = test::small_game(1, 5);
   config.referee_remove_delay = SimTime::from_sec(4);
   Game g(config);
-  test::start_phase(g, refbox::GamePhase::kProduction);
-  g.step();
-  const auto& params = *g.refbox().params();
-  int t5 = -1;
-  for (int i = 0; i < refbox::kProductionMachineCount; ++i) {
-    if (params.machine_types[static_cast<std::size_t>(i)] == refbox::MachineType::kT5) t5 = i;
-  }
-  REQUIRE(t5 >= 0);
   const core::PuckId puck(16);
-  g.world().teleport_puck(puck, config.world.devices[static_cast<std::size_t>(t5)].rfid_center());
-  REQUIRE(
-      run_until(g, 200.0, [&] { return g.refbox().puck_state(puck) == refbox::PuckState::kP3; }));
-  const std::optional<core::DeviceId> gate = g.refbox().active_gate();
-  REQUIRE(gate.has_value());
-  g.world().teleport_puck(
-      puck, config.world.devices[static_cast<std::size_t>(gate->value())].rfid_center());
+  const core::DeviceId gate = deliver_p3(g, config, puck);
   REQUIRE(run_until(g, 10.0,
                     [&] { return g.refbox().puck_state(puck) == refbox::PuckState::kFinished; }));
   const SimTime finished = g.time();
   // Still there, the gate's three lamps on, until the referee comes.
   REQUIRE(run_until(g, 3.5, [&] { return false; }) == false);
   CHECK(g.world().has_puck(puck));
-  const kinematic::SignalLights l = g.world().lights(*gate);
+  const kinematic::SignalLights l = g.world().lights(gate);
   CHECK(l.red == kinematic::LampState::kOn);
   CHECK(l.yellow == kinematic::LampState::kOn);
   CHECK(l.green == kinematic::LampState::kOn);
@@ -228,24 +235,9 @@ TEST_CASE("referee_remove_delay: a delivered puck lies at the gate, all lamps on
 TEST_CASE("referee actions: a delivered puck leaves the world, late-order pucks arrive") {
   GameConfig config = test::small_game(1, 5);
   Game g(config);
-  test::start_phase(g, refbox::GamePhase::kProduction);
-  g.step();
-  const auto& params = *g.refbox().params();
-  int t5 = -1;
-  for (int i = 0; i < refbox::kProductionMachineCount; ++i) {
-    if (params.machine_types[static_cast<std::size_t>(i)] == refbox::MachineType::kT5) t5 = i;
-  }
-  REQUIRE(t5 >= 0);
-  // The referee's hand: puck 16 under T5's reader makes it a P3 (20..40 s, plus a down time).
+  // ... delivered at the active gate, and the refbox has it taken away.
   const core::PuckId puck(16);
-  g.world().teleport_puck(puck, config.world.devices[static_cast<std::size_t>(t5)].rfid_center());
-  REQUIRE(
-      run_until(g, 200.0, [&] { return g.refbox().puck_state(puck) == refbox::PuckState::kP3; }));
-  // ... then into the active gate's zone: delivered, and the refbox has it taken away.
-  const std::optional<core::DeviceId> gate = g.refbox().active_gate();
-  REQUIRE(gate.has_value());
-  g.world().teleport_puck(
-      puck, config.world.devices[static_cast<std::size_t>(gate->value())].rfid_center());
+  deliver_p3(g, config, puck);
   REQUIRE(run_until(g, 10.0, [&] { return !g.world().has_puck(puck); }));
   CHECK(g.refbox().puck_state(puck) == refbox::PuckState::kFinished);
 
