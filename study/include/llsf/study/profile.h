@@ -2,10 +2,10 @@
 // Robot profiles: a named set of the robot capabilities that set the pace and the failures of a
 // game -- drive limits, fine motion, alignment at a goal, light and laser rates, localization,
 // navigation around other robots, jams at devices and whether skills detect being stuck.
-// `ideal` is the game loop's defaults; `robotino-2013` is the 2013 Carologistics Robotino as the
-// thesis' Gazebo games show it; `robotino-2013-move_base` the same robot with the team's own
-// move_base configuration (work in progress). docs/profiles.md gives every figure with its
-// source.
+// `ideal` is the game loop's defaults; `robotino-2013` is the 2013 Carologistics Robotino from the
+// team's own files (move_base-2013 navigation, its skills' motions, the Gazebo models of the
+// thesis' runs); `robotino-2013-omniscient` the earlier model of it (an omniscient navigator, jam
+// dice). docs/profiles.md gives every figure with its source.
 #pragma once
 
 #include <string>
@@ -77,7 +77,7 @@ struct RobotProfile {
   /// "carologistics-2013".
   std::string motions = "llsfsim";
 
-  /// The names named() knows: "ideal", "robotino-2013", "robotino-2013-move_base".
+  /// The names named() knows: "ideal", "robotino-2013", "robotino-2013-omniscient".
   static std::vector<std::string> names();
   /// A named profile; throws std::invalid_argument for an unknown name.
   static RobotProfile named(std::string_view name);
