@@ -4,7 +4,9 @@
 // beams (Bresenham), and the costmap_2d inflation written as a precomputed kernel.
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdlib>
+#include <cstring>
 
 #include "llsf/core/assert.h"
 #include "llsf/planner/move_base.h"
@@ -188,22 +190,55 @@ bool Costmap::erase_within(const Vec2& center, double radius_m) {
   return any;
 }
 
+namespace {
+
+// The octants around a cell: bit 0 x negative, bit 1 y negative, bit 2 |y| > |x|. A direction's
+// octant, and whether an offset lies in an octant with its boundaries.
+int octant_of(int a, int b) {
+  return (a < 0 ? 1 : 0) | (b < 0 ? 2 : 0) | (std::abs(b) > std::abs(a) ? 4 : 0);
+}
+bool in_closed_octant(int o, int a, int b) {
+  return ((o & 1) != 0 ? a <= 0 : a >= 0) && ((o & 2) != 0 ? b <= 0 : b >= 0) &&
+         ((o & 4) != 0 ? std::abs(b) >= std::abs(a) : std::abs(a) >= std::abs(b));
+}
+
+}  // namespace
+
 void Costmap::mark_and_clear(const Vec2& origin, std::span<const Vec2> hits) {
   int i0 = 0, j0 = 0;
   const bool origin_in = to_cell(origin, i0, j0);
   const int max_cells = static_cast<int>(raytrace_range_ / res_);
-  // 1. Clear free space along every beam (not its end cell), up to the raytrace range. A beam
-  // whose end cell an earlier beam of this scan had clears the same cells: traced once.
-  if (traced_.size() != obstacle_.size()) {
-    traced_.assign(obstacle_.size(), 0);
-    traced_gen_ = 0;
-  }
-  if (++traced_gen_ == 0) {
-    std::fill(traced_.begin(), traced_.end(), 0);
-    traced_gen_ = 1;
-  }
+  // 1. Clear free space along every beam (not its end cell), up to the raytrace range: the
+  // cells of a Bresenham line from the origin's cell towards the end's. Only laser obstacle
+  // cells can change, so each beam is tested against them instead of walked: the line's k-th
+  // cell lies k cells along its major axis, and its minor offset has a closed form (below), so
+  // a cell is on the line iff it sits at that offset, fewer than the line's steps away. Each
+  // cell can only be on lines in the closed octants that hold it; the cells are kept by octant.
   if (origin_in) {
-    for (const Vec2& h : hits) {
+    for (auto& list : octant_cells_) list.clear();
+    const int bi0 = std::max(0, i0 - max_cells), bi1 = std::min(nx_ - 1, i0 + max_cells);
+    const int bj0 = std::max(0, j0 - max_cells), bj1 = std::min(ny_ - 1, j0 + max_cells);
+    bool any = false;
+    for (int j = bj0; j <= bj1; ++j) {
+      const std::uint8_t* row = obstacle_.data() + idx(0, j);
+      for (int i = bi0; i <= bi1; ++i) {
+        if (i + 8 <= bi1 + 1) {  // eight free cells at a time
+          std::uint64_t block = 0;
+          std::memcpy(&block, row + i, sizeof block);
+          if (block == 0) {
+            i += 7;
+            continue;
+          }
+        }
+        if (row[i] == 0) continue;
+        const int a = i - i0, b = j - j0;
+        for (int o = 0; o < 8; ++o) {
+          if (in_closed_octant(o, a, b)) octant_cells_[o].push_back({a, b});
+        }
+        any = true;
+      }
+    }
+    for (const Vec2& h : any ? hits : std::span<const Vec2>{}) {
       // The end point, clipped to the grid along the beam.
       Vec2 e = h;
       const Vec2 d = e - origin;
@@ -217,26 +252,29 @@ void Costmap::mark_and_clear(const Vec2& origin, std::span<const Vec2> hits) {
       e = origin + d * t;
       int i1 = 0, j1 = 0;
       if (!to_cell(e, i1, j1)) continue;
-      std::uint32_t& traced = traced_[idx(i1, j1)];
-      if (traced == traced_gen_) continue;
-      traced = traced_gen_;
-      // Bresenham from (i0, j0) towards (i1, j1), the end cell excluded.
-      int x = i0, y = j0;
-      const int dx = std::abs(i1 - i0), dy = std::abs(j1 - j0);
-      const int sx = i1 >= i0 ? 1 : -1, sy = j1 >= j0 ? 1 : -1;
+      const int da = i1 - i0, db = j1 - j0;
+      const int dx = std::abs(da), dy = std::abs(db);
       const int steps = std::min(std::max(dx, dy), max_cells);
-      int err = dx - dy;
-      for (int s = 0; s < steps; ++s) {
-        obstacle_[idx(x, y)] = 0;
-        const int e2 = 2 * err;
-        if (e2 > -dy) {
-          err -= dy;
-          x += sx;
+      if (steps == 0) continue;
+      std::vector<OffsetCell>& cells = octant_cells_[octant_of(da, db)];
+      const int sx = da >= 0 ? 1 : -1, sy = db >= 0 ? 1 : -1;
+      const bool x_major = dx >= dy;
+      const int major = x_major ? dx : dy, minor = x_major ? dy : dx;
+      for (std::size_t c = 0; c < cells.size();) {
+        const int a = cells[c].a * sx, b = cells[c].b * sy;  // both >= 0 in this octant
+        const int k = x_major ? a : b;
+        const int m = x_major ? b : a;
+        // The textbook Bresenham's minor offset at major step k is ceil(num / den) with
+        // num = 2 k minor - major and den = 2 major (checked against the walk for every line
+        // up to 90 cells): m is it iff (m - 1) den < num <= m den.
+        const int num = 2 * k * minor - major, den = 2 * major;
+        if (k < steps && num <= m * den && num > (m - 1) * den) {
+          obstacle_[idx(i0 + cells[c].a, j0 + cells[c].b)] = 0;
+          cells[c] = cells.back();  // cleared: no later beam needs to test it
+          cells.pop_back();
+          continue;
         }
-        if (e2 < dx) {
-          err += dx;
-          y += sy;
-        }
+        ++c;
       }
     }
   }

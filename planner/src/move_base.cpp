@@ -862,11 +862,17 @@ void MoveBaseNavigator::update_grids(const Pose2D& pose) {
     return static_cast<std::size_t>(j) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(i);
   };
   auto bfs = [&](std::vector<int>& dist) {
+    // The queue holds cell indices; a cell's column and row are kept beside it (no division).
     std::size_t head = 0;
+    queue_ij_.resize(queue_.size());
+    for (std::size_t q = 0; q < queue_.size(); ++q) {
+      const std::size_t k = static_cast<std::size_t>(queue_[q]);
+      queue_ij_[q] = {static_cast<int>(k % static_cast<std::size_t>(nx)),
+                      static_cast<int>(k / static_cast<std::size_t>(nx))};
+    }
     while (head < queue_.size()) {
-      const std::size_t k = static_cast<std::size_t>(queue_[head++]);
-      const int i = static_cast<int>(k % static_cast<std::size_t>(nx));
-      const int j = static_cast<int>(k / static_cast<std::size_t>(nx));
+      const std::size_t k = static_cast<std::size_t>(queue_[head]);
+      const auto [i, j] = queue_ij_[head++];
       const int d = dist[k];
       constexpr int kDi[4] = {1, -1, 0, 0};
       constexpr int kDj[4] = {0, 0, 1, -1};
@@ -881,6 +887,7 @@ void MoveBaseNavigator::update_grids(const Pose2D& pose) {
         }
         dist[kk] = d + 1;
         queue_.push_back(static_cast<int>(kk));
+        queue_ij_.push_back({a, b});
       }
     }
   };
@@ -939,6 +946,7 @@ void MoveBaseNavigator::generate(const Pose2D& pose, const VelocityCommand& vel,
   t.cost = -1.0;
   double occ = 0.0;
   int path_d = 0, goal_d = 0;
+  double trig_th = th, cos_th = std::cos(th), sin_th = std::sin(th);
   for (int s = 0; s < steps; ++s) {
     int i = 0, j = 0;
     if (!m.to_cell(Vec2(x, y), i, j)) return;  // off the known map
@@ -959,8 +967,13 @@ void MoveBaseNavigator::generate(const Pose2D& pose, const VelocityCommand& vel,
     vx = ramp(vx_s, vx, c.acc_lim_x, dt);
     vy = ramp(vy_s, vy, c.acc_lim_y, dt);
     vth = ramp(vth_s, vth, c.acc_lim_th, dt);
-    x += (vx * std::cos(th) - vy * std::sin(th)) * dt;
-    y += (vx * std::sin(th) + vy * std::cos(th)) * dt;
+    if (th != trig_th) {  // the same values, computed once per heading
+      cos_th = std::cos(th);
+      sin_th = std::sin(th);
+      trig_th = th;
+    }
+    x += (vx * cos_th - vy * sin_th) * dt;
+    y += (vx * sin_th + vy * cos_th) * dt;
     th += vth * dt;
   }
   t.cost = c.path_distance_bias * path_d + c.goal_distance_bias * goal_d + c.occdist_scale * occ;

@@ -10,10 +10,12 @@
 // its source.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "llsf/core/sim_time.h"
@@ -188,9 +190,13 @@ class Costmap {
   std::vector<std::uint8_t> obstacle_;       // 1 = laser obstacle
   std::vector<std::uint8_t> cost_;           // combined, inflated
   std::vector<std::uint8_t> scratch_;        // recenter()'s moved obstacles (kept to reuse)
-  // mark_and_clear(): the end cells already traced from this update's origin (== traced_gen_).
-  std::vector<std::uint32_t> traced_;
-  std::uint32_t traced_gen_ = 0;
+  // mark_and_clear(): the laser obstacle cells within reach, as offsets from the scan's origin
+  // cell, by the closed octants around it that hold them.
+  struct OffsetCell {
+    int a;
+    int b;
+  };
+  std::array<std::vector<OffsetCell>, 8> octant_cells_;
   struct KernelRow {  // the inflation kernel by rows: costs of cells di0, di0 + 1, ... of row dj
     int dj;
     int di0;
@@ -342,6 +348,7 @@ class MoveBaseNavigator {
   std::vector<int> path_dist_;
   std::vector<int> goal_dist_;
   std::vector<int> queue_;
+  std::vector<std::pair<int, int>> queue_ij_;  // update_grids(): queue_ cells' column and row
   int unreachable_ = 0;
   bool rotating_to_goal_ = false;
   bool stuck_left_ = false, stuck_right_ = false;

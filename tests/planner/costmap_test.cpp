@@ -1,0 +1,144 @@
+// SPDX-License-Identifier: MIT
+// The move_base-2013 costmap's laser update against a plain reference: every beam walked cell
+// by cell with the textbook Bresenham line (costmap_2d's raytraceLine), the hits marked, the
+// robot's circle cleared. Costmap::update tests beams against the obstacle cells instead of
+// walking them (planner/src/costmap.cpp); the cells it leaves must be the same.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "llsf/planner/move_base.h"
+
+using namespace llsf;
+using llsf::core::Vec2;
+using planner::Costmap;
+using planner::MoveBaseConfig;
+
+namespace {
+
+// The reference: obstacle cells as a plain grid, updated as costmap_2d describes it.
+struct Reference {
+  Vec2 origin;
+  int nx, ny;
+  double res;
+  double range;
+  std::vector<std::uint8_t> obstacle;
+
+  bool to_cell(const Vec2& p, int& i, int& j) const {
+    const double fx = (p.x() - origin.x()) / res;
+    const double fy = (p.y() - origin.y()) / res;
+    if (!(fx >= 0.0 && fy >= 0.0)) return false;
+    i = static_cast<int>(fx);
+    j = static_cast<int>(fy);
+    return i < nx && j < ny;
+  }
+  std::uint8_t& at(int i, int j) { return obstacle[static_cast<std::size_t>(j * nx + i)]; }
+
+  void update(const Vec2& from, const std::vector<Vec2>& hits, const Vec2& robot, double r) {
+    int i0 = 0, j0 = 0;
+    const int max_cells = static_cast<int>(range / res);
+    if (to_cell(from, i0, j0)) {
+      for (const Vec2& h : hits) {
+        // The end clipped to the grid along the beam, as the costmap does it.
+        Vec2 e = h;
+        const Vec2 d = e - from;
+        double t = 1.0;
+        const double x_hi = origin.x() + nx * res - 1e-9, y_hi = origin.y() + ny * res - 1e-9;
+        if (e.x() < origin.x()) t = std::min(t, (origin.x() - from.x()) / d.x());
+        if (e.x() > x_hi) t = std::min(t, (x_hi - from.x()) / d.x());
+        if (e.y() < origin.y()) t = std::min(t, (origin.y() - from.y()) / d.y());
+        if (e.y() > y_hi) t = std::min(t, (y_hi - from.y()) / d.y());
+        e = from + d * t;
+        int i1 = 0, j1 = 0;
+        if (!to_cell(e, i1, j1)) continue;
+        int x = i0, y = j0;
+        const int dx = std::abs(i1 - i0), dy = std::abs(j1 - j0);
+        const int sx = i1 >= i0 ? 1 : -1, sy = j1 >= j0 ? 1 : -1;
+        const int steps = std::min(std::max(dx, dy), max_cells);
+        int err = dx - dy;
+        for (int s = 0; s < steps; ++s) {
+          at(x, y) = 0;
+          const int e2 = 2 * err;
+          if (e2 > -dy) {
+            err -= dy;
+            x += sx;
+          }
+          if (e2 < dx) {
+            err += dx;
+            y += sy;
+          }
+        }
+      }
+    }
+    for (const Vec2& h : hits) {
+      if ((h - from).squaredNorm() >= range * range) continue;
+      int i = 0, j = 0;
+      if (to_cell(h, i, j)) at(i, j) = 1;
+    }
+    for (int j = 0; j < ny; ++j) {
+      for (int i = 0; i < nx; ++i) {
+        const Vec2 c(origin.x() + (i + 0.5) * res, origin.y() + (j + 0.5) * res);
+        if ((c - robot).squaredNorm() <= r * r) at(i, j) = 0;
+      }
+    }
+  }
+};
+
+// `scans` random scans of `beams` beams from random origins, some reaching past the grid.
+void compare(double res, int nx, int ny, int scans, int beams, std::uint32_t seed) {
+  const MoveBaseConfig config;
+  const Vec2 origin(0.37, -0.21);
+  Costmap costmap(origin, nx, ny, res, config);
+  Reference ref{origin,
+                nx,
+                ny,
+                res,
+                config.raytrace_range_m,
+                std::vector<std::uint8_t>(static_cast<std::size_t>(nx * ny), 0)};
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double w = nx * res, h = ny * res;
+  int cleared = 0, marked = 0;
+  for (int scan = 0; scan < scans; ++scan) {
+    // Origins mostly inside, now and then outside the grid.
+    const Vec2 from(origin.x() + (u(rng) * 1.2 - 0.1) * w, origin.y() + (u(rng) * 1.2 - 0.1) * h);
+    std::vector<Vec2> hits;
+    const double turn = u(rng) * 6.283;
+    for (int b = 0; b < beams; ++b) {
+      const double a = turn + 6.283185307179586 * b / beams;
+      // Ranges: some short (marks near the robot), some past the raytrace range or the grid.
+      const double range = u(rng) < 0.3 ? 0.2 + u(rng) * 1.0 : 0.5 + u(rng) * 5.0;
+      hits.emplace_back(from.x() + range * std::cos(a), from.y() + range * std::sin(a));
+    }
+    const std::vector<std::uint8_t> before = ref.obstacle;
+    costmap.update(from, hits, from, 0.1);
+    ref.update(from, hits, from, 0.1);
+    for (int j = 0; j < ny; ++j) {
+      for (int i = 0; i < nx; ++i) {
+        const bool want = ref.at(i, j) != 0;
+        if (costmap.obstacle(i, j) != want) {
+          FAIL_CHECK("scan " << scan << " cell " << i << "," << j << ": reference " << want);
+          return;
+        }
+        const bool was = before[static_cast<std::size_t>(j * nx + i)] != 0;
+        cleared += (was && !want) ? 1 : 0;
+        marked += (!was && want) ? 1 : 0;
+      }
+    }
+  }
+  // The comparison saw both kinds of change.
+  CHECK(cleared > 100);
+  CHECK(marked > 100);
+}
+
+}  // namespace
+
+TEST_CASE("costmap: the laser update leaves the cells the textbook beam walk leaves") {
+  SUBCASE("the global costmap's resolution") { compare(0.05, 112, 96, 60, 360, 7); }
+  SUBCASE("the local rolling window's") { compare(0.1, 30, 30, 200, 360, 11); }
+  SUBCASE("few beams, coarse cells") { compare(0.25, 23, 17, 300, 17, 13); }
+}
