@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <queue>
 #include <utility>
@@ -784,14 +786,22 @@ bool MoveBaseNavigator::make_plan(const Pose2D& pose) {
     ++stats_.plan_failures;
     return false;
   }
-  using Item = std::pair<float, std::size_t>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
+  // The open list, smallest potential first and among equal ones the smallest cell index: one
+  // 64-bit key, the potential's bits above the index (a non-negative float's bits order as the
+  // float does).
+  auto key = [](float p, std::size_t k) {
+    return (static_cast<std::uint64_t>(std::bit_cast<std::uint32_t>(p)) << 32) |
+           static_cast<std::uint64_t>(k);
+  };
+  std::priority_queue<std::uint64_t, std::vector<std::uint64_t>, std::greater<>> open;
   potential_[index(gi, gj)] = 0.0f;
-  open.push({0.0f, index(gi, gj)});
+  open.push(key(0.0f, index(gi, gj)));
   const std::size_t start = index(si, sj);
   while (!open.empty()) {
-    const auto [p, k] = open.top();
+    const std::uint64_t top = open.top();
     open.pop();
+    const float p = std::bit_cast<float>(static_cast<std::uint32_t>(top >> 32));
+    const std::size_t k = static_cast<std::size_t>(top & 0xffffffffu);
     if (done_[k] != 0) continue;
     done_[k] = 1;
     if (k == start) break;
@@ -804,7 +814,7 @@ bool MoveBaseNavigator::make_plan(const Pose2D& pose) {
       const float c = p + 50.0f + 0.8f * static_cast<float>(m.cost(a, b));
       if (c < potential_[kk]) {
         potential_[kk] = c;
-        open.push({c, kk});
+        open.push(key(c, kk));
       }
     }
   }
