@@ -15,8 +15,9 @@ function(llsf_target_options target)
 endfunction()
 
 # llsf_module(NAME SOURCES ...): one folder = one library `llsf_NAME` (alias `llsf::NAME`) with
-# public headers in NAME/include and private ones in NAME/src. Installed (cmake --install) with
-# its headers and exported as llsf::NAME in the llsfsim package (cmake/install.cmake).
+# public headers in NAME/include and private ones in NAME/src. Its archive is installed
+# (cmake --install) and exported as llsf::NAME in the llsfsim package, as what llsf::llsfsim
+# links; its headers are not installed (cmake/install.cmake).
 function(llsf_module name)
   cmake_parse_arguments(ARG "" "" "SOURCES" ${ARGN})
   add_library(llsf_${name} STATIC ${ARG_SOURCES})
@@ -26,8 +27,9 @@ function(llsf_module name)
            $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>
     PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src)
   llsf_target_options(llsf_${name})
+  # The archive is installed (the installed interface, llsf::llsfsim, links it); the module's
+  # headers are not: only llsfsim/llsfsim.h is (docs/install.md).
   llsf_install_library(llsf_${name} ${name})
-  install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 endfunction()
 
 # llsf_install_library(TARGET EXPORT_NAME): TARGET installed and exported as llsf::EXPORT_NAME.
@@ -45,9 +47,8 @@ function(llsf_install_protos target export_name)
                              $<BUILD_INTERFACE:${CMAKE_CURRENT_BINARY_DIR}/gen>
                              $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
   llsf_install_library(${target} ${export_name})
-  install(DIRECTORY ${CMAKE_CURRENT_BINARY_DIR}/gen/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
-          FILES_MATCHING PATTERN "*.pb.h")
-  # The .proto files beside them (to import from other messages).
-  install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
+  # The .proto files (the messages' definitions, for tools of one's own that speak them), not the
+  # generated headers: share/llsfsim/proto/<package>/.
+  install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/ DESTINATION ${CMAKE_INSTALL_DATADIR}/llsfsim/proto
           FILES_MATCHING PATTERN "*.proto")
 endfunction()
