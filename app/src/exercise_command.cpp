@@ -8,25 +8,19 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <condition_variable>
 #include <cstdio>
-#include <deque>
-#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
-#include <mutex>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <ostream>
 #include <regex>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "batch_progress.h"
@@ -41,10 +35,11 @@
 #include "llsf/core/data_dir.h"
 #include "llsf/core/error.h"
 #include "llsf/core/version.h"
-#include "llsf/sim/driver.h"
 #include "llsf/sim/game.h"
 #include "llsf/sim/skill_brain.h"
 #include "llsf/study/batch.h"
+#include "llsf/study/player.h"
+#include "llsf/study/pool.h"
 #include "llsf/study/recording.h"
 #include "llsf/study/scenario.h"
 #include "llsf/study/stats_store.h"
@@ -177,10 +172,6 @@ void friendly(const std::string& message, const std::string& tmp, const std::str
   }
 }
 
-/// Plays exercise `ex` with the participant's file `o.skill_file` on `seed`, printing what
-/// happens on `out` (progress, log lines, the verdict) as a single run does, and returns the
-/// outcome. Thread-safe for distinct `out`/`err` streams when `o` asks for no server and no
-/// recording.
 /// Why a reported find position `p` of robot `robot` is not the goal colour's puck, by what lies
 /// there: another colour's puck (the camera's false colour, or the wrong sighting taken), the
 /// puck in the robot's holder or the robot itself, or the goal puck's position in the robot's
@@ -229,23 +220,26 @@ std::string find_why_not(const sim::Game& game, const Exercise& ex, int robot, c
          "the README's hints), and report it when the colour is sure";
 }
 
+/// Plays exercise `ex` with the participant's file `o.skill_file` on `seed` (a study::Player of
+/// the exercise's scenario, the file's skill engine plugged into every robot, an observer that
+/// stops the game when the skills end), printing what happens on `out` (progress, log lines, the
+/// verdict) as a single run does, and returns the outcome. Thread-safe for distinct `out`/`err`
+/// streams when `o` asks for no server and no recording.
 SeedRun play_seed(const Exercise& ex, const ExerciseOptions& o, std::uint64_t seed,
                   std::ostream& out, std::ostream& err) {
   SeedRun run;
   run.seed = seed;
   // The game and one skill engine per robot, each with the library plus the participant's file.
-  sim::GameConfig config = ex.scenario.game;
-  config.seed = seed;
-  sim::GameDriver driver(config);
-  sim::Game& game = driver.game();
+  study::Player player(ex.scenario, seed);
+  sim::Game& game = player.game();
   const SkillDir skill_dir(o.skill_file, ex.skill);
   lua::SkillEngineConfig ec = ex.scenario.skills;
-  if (ec.skill_dirs.empty()) ec.skill_dirs = sim::skill_library_dirs(config.levels.skill);
+  if (ec.skill_dirs.empty()) ec.skill_dirs = sim::skill_library_dirs(ex.scenario.game.levels.skill);
   ec.skill_dirs.push_back(skill_dir.dir());
   ec.hot_reload = false;
   ec.display_paths[skill_dir.path()] = o.skill_file;  // messages name the participant's file
-  std::vector<sim::SkillBrain*> brains;               // owned by the driver
-  for (int i = 0; i < game.robot_count(); ++i) brains.push_back(&driver.plug_skills(i, ec));
+  std::vector<sim::SkillBrain*> brains;               // owned by the player's driver
+  for (int i = 0; i < game.robot_count(); ++i) brains.push_back(&player.plug_skills(i, ec));
   const std::string& user = o.skill_file;
   for (const lua::SkillInfo& s : brains.front()->engine().skills()) {
     if (s.name != ex.skill || s.load_error.empty()) continue;
@@ -378,9 +372,10 @@ SeedRun play_seed(const Exercise& ex, const ExerciseOptions& o, std::uint64_t se
       return run;
     }
   }
+  player.start();   // as the scenario says: the hackathon world's refbox stays in PRE_GAME
   int failed = -1;  // the robot whose skill failed
   bool ended = false;
-  driver.run_until(end, [&](const sim::Game&) {
+  player.observe([&](const sim::Game&) {
     if (recorder) recorder->frame(game);
     pacer.wait(game.time().seconds());
     if (!game.skills_cycled()) return false;  // skill states change only in the skill cycle
@@ -417,6 +412,7 @@ SeedRun play_seed(const Exercise& ex, const ExerciseOptions& o, std::uint64_t se
     }
     return false;
   });
+  player.play_until(end);
 
   // The verdict.
   bool passed = false;
@@ -519,9 +515,10 @@ SeedRun play_seed(const Exercise& ex, const ExerciseOptions& o, std::uint64_t se
 
 // --- Sweeps: several seeds, a table or JSON ---------------------------------------------------
 
-/// Plays `seeds` of `ex` on up to `o.jobs` threads (default: one per core). Games are
-/// independent (each its own driver and skill engines; the wall clock never enters a game), so
-/// each seed's run is the same whatever the number of threads. Returns the runs in the order of
+/// Plays `seeds` of `ex` on study's worker pool (study::play_on_pool, as `batch` plays its
+/// games) with up to `o.jobs` threads (default: one per core). Games are independent (each its
+/// own player and skill engines), so each seed's run is the same whatever the number of
+/// threads. Returns the runs in the order of
 /// `seeds`. Progress on `err` as seeds end: a bar when `err` is std::cerr on a terminal, else one
 /// line per seed; nothing with -q or --json.
 std::vector<SeedRun> play_seeds(const Exercise& ex, const ExerciseOptions& o,
@@ -535,74 +532,39 @@ std::vector<SeedRun> play_seeds(const Exercise& ex, const ExerciseOptions& o,
   quiet.quiet = true;
   std::vector<SeedRun> runs(seeds.size());
   const int total = static_cast<int>(seeds.size());
-  const int hardware = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  const int threads = std::min(o.jobs > 0 ? o.jobs : hardware, total);
 
-  // Workers take seeds in order and queue the index of each run that ended; this thread prints
-  // the progress, so that nothing interleaves.
-  std::mutex mutex;
-  std::condition_variable ended;
-  std::deque<std::size_t> done;
-  std::exception_ptr error;
-  std::atomic<std::size_t> next{0};
-  std::atomic<bool> stop{false};
-  int running = threads;
-  {
-    std::vector<std::jthread> pool;  // joined on every way out
-    for (int w = 0; w < threads; ++w) {
-      pool.emplace_back([&] {
-        for (;;) {
-          const std::size_t i = next++;
-          if (stop || SigintGuard::interrupted() || i >= seeds.size()) break;
-          try {
-            std::ostringstream game_out;
-            std::ostringstream game_err;
-            runs[i] = play_seed(ex, quiet, seeds[i], game_out, game_err);
-            const std::lock_guard lock(mutex);
-            ended_ok[i] = 1;
-            done.push_back(i);
-          } catch (...) {
-            const std::lock_guard lock(mutex);
-            if (!error) error = std::current_exception();
-            stop = true;
-          }
-          ended.notify_one();
+  // The pool's workers take seeds in order; this thread prints the progress as each run ends,
+  // so that nothing interleaves.
+  const bool bar =
+      &err == &std::cerr && isatty(STDERR_FILENO) != 0 && !o.quiet && !o.json && total > 1;
+  const bool lines = !bar && !o.quiet && !o.json;
+  int played = 0;
+  int not_passed = 0;
+  if (bar) err << fmt::format("\r{} 0/{} seeds", progress_bar(0, total), total) << std::flush;
+  study::play_on_pool<SeedRun>(
+      seeds.size(), o.jobs,
+      [&](std::size_t i) {
+        std::ostringstream game_out;
+        std::ostringstream game_err;
+        return play_seed(ex, quiet, seeds[i], game_out, game_err);
+      },
+      [&](std::size_t i, SeedRun& run) {
+        runs[i] = std::move(run);
+        ended_ok[i] = 1;
+        const SeedRun& r = runs[i];
+        ++played;
+        if (r.result != Outcome::kPass) ++not_passed;
+        if (bar) {
+          err << fmt::format("\r{} {}/{} seeds, {} not passed", progress_bar(played, total), played,
+                             total, not_passed)
+              << (played == total ? "\n" : "") << std::flush;
+        } else if (lines) {
+          err << fmt::format("[{}/{}] seed {}: {}, {:.2f} s of game time\n", played, total, r.seed,
+                             outcome_name(r.result), r.game_time_s)
+              << std::flush;
         }
-        {
-          const std::lock_guard lock(mutex);
-          --running;
-        }
-        ended.notify_one();
-      });
-    }
-
-    const bool bar =
-        &err == &std::cerr && isatty(STDERR_FILENO) != 0 && !o.quiet && !o.json && total > 1;
-    const bool lines = !bar && !o.quiet && !o.json;
-    int played = 0;
-    int not_passed = 0;
-    if (bar) err << fmt::format("\r{} 0/{} seeds", progress_bar(0, total), total) << std::flush;
-    for (;;) {
-      std::unique_lock lock(mutex);
-      ended.wait(lock, [&] { return !done.empty() || running == 0; });
-      if (done.empty()) break;
-      const SeedRun& r = runs[done.front()];
-      done.pop_front();
-      lock.unlock();
-      ++played;
-      if (r.result != Outcome::kPass) ++not_passed;
-      if (bar) {
-        err << fmt::format("\r{} {}/{} seeds, {} not passed", progress_bar(played, total), played,
-                           total, not_passed)
-            << (played == total ? "\n" : "") << std::flush;
-      } else if (lines) {
-        err << fmt::format("[{}/{}] seed {}: {}, {:.2f} s of game time\n", played, total, r.seed,
-                           outcome_name(r.result), r.game_time_s)
-            << std::flush;
-      }
-    }
-  }
-  if (error) std::rethrow_exception(error);
+      },
+      [] { return SigintGuard::interrupted().load(); });
   // (a Ctrl-C while the last games ran, with every seed played, leaves a whole sweep)
   interrupted = SigintGuard::interrupted() &&
                 std::count(ended_ok.begin(), ended_ok.end(), 1) < static_cast<long>(seeds.size());

@@ -23,6 +23,7 @@
 #include "llsf/core/config.h"
 #include "llsf/core/data_dir.h"
 #include "llsf/core/error.h"
+#include "llsf/core/text.h"
 #include "llsf/planner/planner.h"
 #include "llsf/sim/game.h"
 #include "llsf/sim/game_config.h"
@@ -125,30 +126,6 @@ int deg(double rad) {
   return d < 0 ? d + 360 : d;
 }
 
-/// Escapes text for SVG/XML.
-std::string xml(const std::string& s) {
-  std::string r;
-  for (const char c : s) {
-    switch (c) {
-      case '<':
-        r += "&lt;";
-        break;
-      case '>':
-        r += "&gt;";
-        break;
-      case '&':
-        r += "&amp;";
-        break;
-      case '"':
-        r += "&quot;";
-        break;
-      default:
-        r += c;
-    }
-  }
-  return r;
-}
-
 class Svg {
  public:
   Svg(double field_w, double field_h) : field_h_(field_h) {
@@ -164,7 +141,7 @@ class Svg {
   void text(double px, double py, const std::string& s, const std::string& cls,
             const std::string& anchor = "middle") {
     out_ << "<text x=\"" << px1(px) << "\" y=\"" << px1(py) << "\" class=\"" << cls
-         << "\" text-anchor=\"" << anchor << "\">" << xml(s) << "</text>\n";
+         << "\" text-anchor=\"" << anchor << "\">" << core::xml_escape(s) << "</text>\n";
   }
   void polygon(const std::array<core::Vec2, 4>& c, const std::string& cls) {
     out_ << "<polygon class=\"" << cls << "\" points=\"";
@@ -324,7 +301,7 @@ std::string draw_svg(const MapSource& src, const planner::Planner& planner) {
     if (!label.empty()) {
       o << "<text class=\"area-label\" text-anchor=\"middle\" transform=\"translate("
         << px1(s.x(a.center().x())) << "," << px1(s.y(a.center().y())) << ") rotate(-90)\">"
-        << xml(label) << "</text>\n";
+        << core::xml_escape(label) << "</text>\n";
     }
   };
   area(map.insertion_area, "area-insertion", "insertion area", "area-insertion");
@@ -373,8 +350,8 @@ std::string draw_svg(const MapSource& src, const planner::Planner& planner) {
     o << "</g>\n";
   }
   for (const planner::NamedBox& b : map.obstacles) {
-    o << "<g id=\"obstacle-" << xml(b.name) << "\" data-x=\"" << m2(b.box.pose.x) << "\" data-y=\""
-      << m2(b.box.pose.y) << "\">\n";
+    o << "<g id=\"obstacle-" << core::xml_escape(b.name) << "\" data-x=\"" << m2(b.box.pose.x)
+      << "\" data-y=\"" << m2(b.box.pose.y) << "\">\n";
     s.polygon(b.box.corners(), "obstacle");
     s.text(s.x(b.box.pose.x), s.y(b.box.pose.y) - b.box.half_extents.y() * kScale - 5, b.name,
            "obstacle-label");
@@ -382,8 +359,8 @@ std::string draw_svg(const MapSource& src, const planner::Planner& planner) {
   }
   for (const planner::Place& p : planner.places()) {
     const bool input = p.kind == planner::PlaceKind::kDeviceInput;
-    o << "<g id=\"place-" << xml(p.name) << "\" data-x=\"" << m2(p.pose.x) << "\" data-y=\""
-      << m2(p.pose.y) << "\" data-ori-deg=\"" << deg(p.pose.theta) << "\">\n";
+    o << "<g id=\"place-" << core::xml_escape(p.name) << "\" data-x=\"" << m2(p.pose.x)
+      << "\" data-y=\"" << m2(p.pose.y) << "\" data-ori-deg=\"" << deg(p.pose.theta) << "\">\n";
     s.pose(p.pose, 9.0, input ? "place-input" : "place");
     // The label behind the pose (away from where it looks), clear of the device.
     const double lx = s.x(p.pose.x) - 10.0 * std::cos(p.pose.theta);
@@ -400,8 +377,8 @@ std::string draw_svg(const MapSource& src, const planner::Planner& planner) {
   }
   // Robots at their start.
   for (const kinematic::RobotStart& rb : c.world.robots) {
-    o << "<g id=\"robot-" << xml(rb.name) << "\" data-x=\"" << m2(rb.pose.x) << "\" data-y=\""
-      << m2(rb.pose.y) << "\" data-ori-deg=\"" << deg(rb.pose.theta) << "\">\n";
+    o << "<g id=\"robot-" << core::xml_escape(rb.name) << "\" data-x=\"" << m2(rb.pose.x)
+      << "\" data-y=\"" << m2(rb.pose.y) << "\" data-ori-deg=\"" << deg(rb.pose.theta) << "\">\n";
     s.circle(rb.pose.x, rb.pose.y, c.world.robot.radius_m * kScale, "robot");
     s.pose(rb.pose, c.world.robot.radius_m * kScale, "robot-heading");
     s.text(s.x(rb.pose.x), s.y(rb.pose.y) - c.world.robot.radius_m * kScale - 3, rb.name,

@@ -35,8 +35,8 @@
 #include "llsf/core/input_file.h"
 #include "llsf/core/text.h"
 #include "llsf/sim/agent_brain.h"
-#include "llsf/sim/driver.h"
 #include "llsf/study/metrics.h"
+#include "llsf/study/player.h"
 #include "llsf/study/recording.h"
 #include "llsf/study/runner.h"
 #include "llsf/study/scenario.h"
@@ -692,19 +692,12 @@ int check(const std::vector<std::string>& files, std::ostream& out, std::ostream
       for (const study::Scenario& s : f.variants) {
         seeds += s.seeds.size();
         // Build the game and every brain: agent files are parsed, skill files loaded.
-        sim::GameDriver driver(s.game);
-        for (int i = 0; i < driver.game().robot_count(); ++i) {
+        study::Player player(s, s.game.seed);
+        for (int i = 0; i < player.game().robot_count(); ++i) {
           const study::RobotSpec& spec = s.robots.at(static_cast<std::size_t>(i));
-          if (spec.agent.empty()) continue;
-          sim::AgentBrainConfig c;
-          c.agent_files = spec.agent;
-          c.config = spec.config;
-          c.skills = s.skills;
-          c.locks = spec.locks;
-          c.sandbox = spec.sandbox;
-          c.fawkes = spec.fawkes;
-          c.agent_dir = spec.agent_dir;
-          const sim::AgentBrain& brain = driver.plug_agent(i, c);
+          const sim::AgentBrain* plugged = player.plug_agent(i);
+          if (plugged == nullptr) continue;
+          const sim::AgentBrain& brain = *plugged;
           for (const std::string& e : brain.skills().engine().load_errors()) {
             throw core::ConfigError("skill file error: " + e);
           }

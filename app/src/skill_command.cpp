@@ -15,9 +15,9 @@
 #include "commands.h"
 #include "llsf/app/cli.h"
 #include "llsf/refbox/protocol.h"
-#include "llsf/sim/driver.h"
 #include "llsf/sim/game.h"
 #include "llsf/sim/skill_brain.h"
+#include "llsf/study/player.h"
 #include "llsf/study/recording.h"
 
 namespace llsf::app {
@@ -101,8 +101,12 @@ int run_skill(const SkillOptions& o, std::ostream& out, std::ostream& err) {
         << " robot(s) on the field (--robots)\n";
     return kExitBadInput;
   }
-  sim::GameDriver driver(config);
-  sim::Game& game = driver.game();
+  // The game as a scenario without robot entries: the skill engine is plugged by hand.
+  study::Scenario scenario;
+  scenario.name = "skill";
+  scenario.game = config;
+  study::Player player(scenario, o.seed);
+  sim::Game& game = player.game();
   const int index = o.robot - 1;
 
   lua::SkillEngineConfig ec;
@@ -119,7 +123,7 @@ int run_skill(const SkillOptions& o, std::ostream& out, std::ostream& err) {
     }
     ec.fawkes_config[kv.substr(0, eq)] = kv.substr(eq + 1);
   }
-  sim::SkillBrain& brain = driver.plug_skills(index, ec);
+  sim::SkillBrain& brain = player.plug_skills(index, ec);
   if (o.list) {
     print_skills(brain, out);
     return kExitOk;
@@ -147,9 +151,6 @@ int run_skill(const SkillOptions& o, std::ostream& out, std::ostream& err) {
     brain.set_state_listener(
         [&recorder](const sim::SkillStateChange& c) { recorder->skill_state(c); });
   }
-  const auto frame = [&recorder, &game] {
-    if (recorder) recorder->frame(game);
-  };
 
   const std::string robot_name(game.robot(index).name());
   brain.engine().set_log_sink([&](lua::LogLevel level, std::string_view text) {
@@ -168,21 +169,41 @@ int run_skill(const SkillOptions& o, std::ostream& out, std::ostream& err) {
     out << "\n";
   });
 
-  // The refbox: the chosen phase, running.
-  if (o.phase != "pre_game") driver.start(phase_of(o.phase));
-  driver.run_until(game.time() + SimTime::from_seconds(o.after_s), [&](const sim::Game&) {
-    frame();
-    return false;
-  });
-  if (!o.quiet) {
-    out << stamp(game.time()) << " game: seed " << o.seed << ", " << o.robots << " robot(s), "
-        << o.phase << ", skills " << o.level << ", robot " << robot_name << "\n";
-  }
-
   // Trace: FSM state changes of every skill of the library.
   std::map<std::string, std::string> states;
   std::vector<std::string> names;
   for (const lua::SkillInfo& s : brain.engine().skills()) names.push_back(s.name);
+
+  // After every tick: the recording's frame; while a skill string runs, the trace, and the end
+  // of the string stops the game.
+  bool in_string = false;
+  player.observe([&recorder](const sim::Game& g) {
+    if (recorder) recorder->frame(g);
+    return false;
+  });
+  player.observe([&](const sim::Game&) {
+    if (!in_string) return false;
+    if (o.trace) {
+      for (const std::string& n : names) {
+        const std::string st = brain.engine().skill_state(n);
+        std::string& last = states[n];
+        if (st == last) continue;
+        if (!st.empty())
+          out << stamp(game.time()) << " " << robot_name << "   " << n << ": " << st << "\n";
+        last = st;
+      }
+    }
+    return brain.engine().status() != lua::SkillStatus::kRunning;
+  });
+
+  // The refbox: the chosen phase, running.
+  player.start(o.phase == "pre_game" ? std::nullopt
+                                     : std::optional<refbox::GamePhase>(phase_of(o.phase)));
+  player.play_until(game.time() + SimTime::from_seconds(o.after_s));
+  if (!o.quiet) {
+    out << stamp(game.time()) << " game: seed " << o.seed << ", " << o.robots << " robot(s), "
+        << o.phase << ", skills " << o.level << ", robot " << robot_name << "\n";
+  }
 
   int code = kExitOk;
   for (const std::string& s : o.skill_strings) {
@@ -193,20 +214,9 @@ int run_skill(const SkillOptions& o, std::ostream& out, std::ostream& err) {
     }
     const SimTime end = game.time() + SimTime::from_seconds(o.timeout_s);
     if (brain.engine().status() == lua::SkillStatus::kRunning) {
-      driver.run_until(end, [&](const sim::Game&) {
-        frame();
-        if (o.trace) {
-          for (const std::string& n : names) {
-            const std::string st = brain.engine().skill_state(n);
-            std::string& last = states[n];
-            if (st == last) continue;
-            if (!st.empty())
-              out << stamp(game.time()) << " " << robot_name << "   " << n << ": " << st << "\n";
-            last = st;
-          }
-        }
-        return brain.engine().status() != lua::SkillStatus::kRunning;
-      });
+      in_string = true;
+      player.play_until(end);
+      in_string = false;
     }
     if (brain.engine().status() == lua::SkillStatus::kRunning) {
       out << stamp(game.time()) << " " << robot_name << " TIMEOUT  " << s << " still running after "

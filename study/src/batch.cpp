@@ -2,19 +2,16 @@
 #include "llsf/study/batch.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
-#include <condition_variable>
-#include <deque>
-#include <exception>
 #include <filesystem>
 #include <map>
-#include <mutex>
 #include <set>
 #include <string_view>
-#include <thread>
 #include <utility>
 
 #include "llsf/core/error.h"
+#include "llsf/study/pool.h"
 #include "llsf/study/recording.h"
 
 namespace llsf::study {
@@ -25,35 +22,6 @@ struct Job {
   const Scenario* scenario;
   std::uint64_t seed;
 };
-
-// Joins the workers on every way out of run_batch, after asking them to stop.
-class WorkerPool {
- public:
-  explicit WorkerPool(std::atomic<bool>& stop) : stop_(stop) {}
-  ~WorkerPool() {
-    stop_ = true;
-    join();
-  }
-  WorkerPool(const WorkerPool&) = delete;
-  WorkerPool& operator=(const WorkerPool&) = delete;
-  template <class F>
-  void spawn(F&& f) {
-    threads_.emplace_back(std::forward<F>(f));
-  }
-  void join() {
-    for (std::thread& t : threads_) {
-      if (t.joinable()) t.join();
-    }
-  }
-
- private:
-  std::atomic<bool>& stop_;
-  std::vector<std::thread> threads_;
-};
-
-}  // namespace
-
-namespace {
 
 std::string seeds_budget() {
   return std::to_string(ScenarioLimits::kMaxSeeds) +
@@ -314,88 +282,44 @@ BatchResult run_batch(const ScenarioFile& file, const std::string& scenario_hash
     record_dir = d.string();
   }
 
-  // Workers take jobs in order and queue their results; this thread stores them.
-  struct Done {
-    RunResult result;
-  };
-  std::mutex mutex;
-  std::condition_variable ready;
-  std::deque<Done> queue;
-  std::exception_ptr error;
+  // The pool's workers play the jobs in order; this thread stores each result as it arrives
+  // (one transaction per run).
   std::atomic<bool> stop_workers{false};
-  std::atomic<std::size_t> next{0};
-  int running = 0;
-  auto stopping = [&] { return stop_workers.load() || (hooks.stop && hooks.stop->load()); };
-
-  const int hardware = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  const int threads =
-      std::min(options.jobs > 0 ? options.jobs : hardware, static_cast<int>(jobs.size()));
   const auto t0 = std::chrono::steady_clock::now();  // progress only, never a game input
   BatchProgress progress;
   progress.to_play = static_cast<int>(jobs.size());
-  {
-    WorkerPool pool(stop_workers);
-    running = threads;
-    for (int w = 0; w < threads; ++w) {
-      pool.spawn([&] {
-        for (;;) {
-          if (stopping()) break;
-          const std::size_t j = next++;
-          if (j >= jobs.size()) break;
-          try {
-            RunHooks run_hooks;
-            run_hooks.record_agents = options.record_agents;
-            if (!record_dir.empty()) {
-              run_hooks.record_path = (std::filesystem::path(record_dir) /
-                                       recording_file_name(jobs[j].scenario->name,
-                                                           jobs[j].scenario->variant, jobs[j].seed))
-                                          .string();
-            }
-            RunResult r = run_game(*jobs[j].scenario, jobs[j].seed, run_hooks);
-            // Stop here, not only when the result is stored: the storing thread may lag
-            // behind a worker that plays short games, which would then play them all.
-            if (options.fail_fast && r.agent_error()) stop_workers = true;
-            const std::lock_guard lock(mutex);
-            queue.push_back({std::move(r)});
-          } catch (...) {
-            const std::lock_guard lock(mutex);
-            if (!error) error = std::current_exception();
-            stop_workers = true;
-          }
-          ready.notify_one();
+  play_on_pool<RunResult>(
+      jobs.size(), options.jobs,
+      [&](std::size_t j) {
+        RunHooks run_hooks;
+        run_hooks.record_agents = options.record_agents;
+        if (!record_dir.empty()) {
+          run_hooks.record_path =
+              (std::filesystem::path(record_dir) /
+               recording_file_name(jobs[j].scenario->name, jobs[j].scenario->variant, jobs[j].seed))
+                  .string();
         }
-        {
-          const std::lock_guard lock(mutex);
-          --running;
+        RunResult r = run_game(*jobs[j].scenario, jobs[j].seed, run_hooks);
+        // Stop here, not only when the result is stored: the storing thread may lag behind a
+        // worker that plays short games, which would then play them all.
+        if (options.fail_fast && r.agent_error()) stop_workers = true;
+        return r;
+      },
+      [&](std::size_t, RunResult& r) {
+        store.add_run(result.batch_id, r);  // throws: the pool stops and joins
+        ++result.played;
+        ++progress.done;
+        progress.failed += r.passed() ? 0 : 1;
+        if (options.fail_fast && !result.agent_error && r.agent_error()) {
+          result.agent_error =
+              (r.variant.empty() ? "" : r.variant + " ") + "seed " + std::to_string(r.seed);
+          stop_workers = true;  // no new game; the running ones finish and are stored
         }
-        ready.notify_one();
-      });
-    }
-
-    // Store each result as it arrives: one transaction per run.
-    for (;;) {
-      std::unique_lock lock(mutex);
-      ready.wait(lock, [&] { return !queue.empty() || running == 0; });
-      if (queue.empty()) break;
-      Done d = std::move(queue.front());
-      queue.pop_front();
-      lock.unlock();
-      store.add_run(result.batch_id, d.result);  // throws: the pool stops and joins
-      ++result.played;
-      ++progress.done;
-      progress.failed += d.result.passed() ? 0 : 1;
-      if (options.fail_fast && !result.agent_error && d.result.agent_error()) {
-        result.agent_error = (d.result.variant.empty() ? "" : d.result.variant + " ") + "seed " +
-                             std::to_string(d.result.seed);
-        stop_workers = true;  // no new game; the running ones finish and are stored
-      }
-      progress.elapsed_s =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      if (hooks.stored) hooks.stored(d.result, progress);
-    }
-    pool.join();
-  }
-  if (error) std::rethrow_exception(error);
+        progress.elapsed_s =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        if (hooks.stored) hooks.stored(r, progress);
+      },
+      [&] { return stop_workers.load() || (hooks.stop && hooks.stop->load()); });
 
   result.interrupted = !result.complete();
   if (result.complete() && !sliced && options.stored_elsewhere.empty()) {

@@ -261,17 +261,34 @@ void read_bound(Check& c, const core::ConfigNode& n) {
   }
 }
 
+/// The head of a named entry (a calibration target, a sweep, a table): a map with a `name` that
+/// no other entry of its kind (`names`, `what`: "target") has, and an optional `source`.
+template <class Entry>
+void read_name(const core::ConfigNode& n, std::set<std::string>& names, const char* what,
+               Entry& entry) {
+  n.require_map();
+  core::ConfigNode name;
+  entry.name = required_string(n, "name", &name);
+  if (!names.insert(entry.name).second) {
+    name.fail(std::string("a second ") + what + " of this name");
+  }
+  entry.source = optional_string(n, "source");
+}
+
+/// The head of every entry that reads runs (a check, target, sweep or table): where it is (for
+/// reports) and the batch it reads (into sel.batch).
+const ExperimentBatch& read_batch_head(const Experiment& e, const core::ConfigNode& n,
+                                       std::string& where, Selection& sel) {
+  where = where_of(n);
+  return batch_of(e, n, &sel.batch);
+}
+
 CalibrationTarget read_target(const Experiment& e, const core::ConfigNode& n,
                               std::set<std::string>& names) {
-  n.require_map();
   CalibrationTarget t;
-  core::ConfigNode name;
-  t.name = required_string(n, "name", &name);
-  if (!names.insert(t.name).second) name.fail("a second target of this name");
-  t.source = optional_string(n, "source");
+  read_name(n, names, "target", t);
   Check& c = t.check;
-  c.where = where_of(n);
-  const ExperimentBatch& b = batch_of(e, n, &c.sel.batch);
+  const ExperimentBatch& b = read_batch_head(e, n, c.where, c.sel);
   c.a = read_filter(e, b, n["where"]);
   c.sel.statistic = read_statistic(n);
   int kinds = 0;
@@ -310,8 +327,7 @@ Check read_check(const Experiment& e, const core::ConfigNode& entry) {
   if (n.is_null()) n.fail("expected {batch: ..., statistic: ..., ...}");
   Check c;
   c.kind = *kind;
-  c.where = where_of(n);
-  const ExperimentBatch& b = batch_of(e, n, &c.sel.batch);
+  const ExperimentBatch& b = read_batch_head(e, n, c.where, c.sel);
   c.sel.statistic = read_statistic(n);
   read_selection_options(n, is_share(c.kind), c.sel);
   // Each kind asks for its own keys -- a comparison `a` and `b` (and a difference `range`), the
@@ -389,14 +405,9 @@ Finding read_finding(const Experiment& e, const core::ConfigNode& n, std::set<st
 }
 
 Sweep read_sweep(const Experiment& e, const core::ConfigNode& n, std::set<std::string>& names) {
-  n.require_map();
   Sweep s;
-  core::ConfigNode name;
-  s.name = required_string(n, "name", &name);
-  if (!names.insert(s.name).second) name.fail("a second sweep of this name");
-  s.source = optional_string(n, "source");
-  s.where = where_of(n);
-  const ExperimentBatch& b = batch_of(e, n, &s.sel.batch);
+  read_name(n, names, "sweep", s);
+  const ExperimentBatch& b = read_batch_head(e, n, s.where, s.sel);
   s.sel.statistic = read_statistic(n);
   read_selection_options(n, false, s.sel);
   core::ConfigNode axis_node;
@@ -430,14 +441,9 @@ Sweep read_sweep(const Experiment& e, const core::ConfigNode& n, std::set<std::s
 }
 
 Table read_table(const Experiment& e, const core::ConfigNode& n, std::set<std::string>& names) {
-  n.require_map();
   Table t;
-  core::ConfigNode name;
-  t.name = required_string(n, "name", &name);
-  if (!names.insert(t.name).second) name.fail("a second table of this name");
-  t.source = optional_string(n, "source");
-  t.where = where_of(n);
-  const ExperimentBatch& b = batch_of(e, n, &t.sel.batch);
+  read_name(n, names, "table", t);
+  const ExperimentBatch& b = read_batch_head(e, n, t.where, t.sel);
   read_selection_options(n, false, t.sel);
   core::ConfigNode rows;
   t.rows = required_string(n, "rows", &rows);

@@ -16,6 +16,7 @@
 #include "llsf/core/assert.h"
 #include "llsf/core/data_dir.h"
 #include "llsf/core/rng.h"
+#include "llsf/core/text.h"
 
 namespace llsf::study {
 
@@ -287,30 +288,6 @@ std::string hex16(std::uint64_t v) {
   return buf;
 }
 
-std::string html_escape(const std::string& text) {
-  std::string out;
-  out.reserve(text.size());
-  for (const char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
-
 /// `</script` (any case) would end the inline script early; `<\/script` means the same to
 /// JavaScript inside strings and regular expressions, the only places a bundle can hold it.
 std::string escape_script_end(const std::string& js) {
@@ -459,10 +436,10 @@ std::string to_html(const BatchReport& r, const std::string& json, const std::st
     }
   }
   std::string page = kPageHead;
-  page += html_escape("llsfsim report: " + r.batch.scenario_name + " (batch " +
-                      std::to_string(r.batch.id) + ")");
+  page += core::xml_escape("llsfsim report: " + r.batch.scenario_name + " (batch " +
+                           std::to_string(r.batch.id) + ")");
   page += kPageStyle;
-  page += html_escape(to_text(r));
+  page += core::xml_escape(to_text(r));
   page += "</pre></noscript></main>\n<script id=\"llsf-report-data\" type=\"application/json\">\n";
   page += data;
   page += "</script>\n<script>\n";

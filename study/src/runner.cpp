@@ -20,6 +20,7 @@
 #include "llsf/sim/agent_brain.h"
 #include "llsf/sim/driver.h"
 #include "llsf/study/metrics.h"
+#include "llsf/study/player.h"
 #include "llsf/study/recording.h"
 
 namespace llsf::study {
@@ -56,21 +57,6 @@ double cpu_seconds() {
   // a batch plays several games at once in one process.
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
-/// The phase a scenario's `start` starts the game in; nullopt: no command (PRE_GAME).
-std::optional<refbox::GamePhase> start_phase(StartMode start) {
-  switch (start) {
-    case StartMode::kNone:
-      return std::nullopt;
-    case StartMode::kExploration:
-      return refbox::GamePhase::kExploration;
-    case StartMode::kProduction:
-      return refbox::GamePhase::kProduction;
-    case StartMode::kGame:
-      break;
-  }
-  return refbox::GamePhase::kPreGame;
 }
 
 // Lock waits of the team. A wait opens with a request and closes with the grant. A refusal ends
@@ -375,9 +361,8 @@ bool RunResult::passed() const {
 }
 
 RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks& hooks) {
-  sim::GameConfig config = scenario.game;
-  config.seed = seed;
-  // What the brains call, declared before the driver that owns them (destroyed after them).
+  // What the brains call, declared before the player whose driver owns them (destroyed after
+  // them).
   LockWaits lock_waits;
   LockHolds lock_holds;
   FailureStreaks streaks;
@@ -389,8 +374,9 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
   int mistakes = 0;  // every one, kept or not
   check_trace_requests(scenario, hooks.trace);
   std::unique_ptr<Recorder> recorder;
-  sim::GameDriver driver(config);
-  sim::Game& game = driver.game();
+  Player player(scenario, seed);
+  sim::GameDriver& driver = player.driver();
+  sim::Game& game = player.game();
   if (!hooks.record_path.empty() || hooks.record_sink) {
     recorder = std::make_unique<Recorder>(
         hooks.record_path, game,
@@ -408,17 +394,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
     }
   };
   for (int i = 0; i < game.robot_count(); ++i) {
-    const RobotSpec& spec = scenario.robots.at(static_cast<std::size_t>(i));
-    if (spec.agent.empty()) continue;
-    sim::AgentBrainConfig c;
-    c.agent_files = spec.agent;
-    c.config = spec.config;
-    c.skills = scenario.skills;
-    c.locks = spec.locks;
-    c.sandbox = spec.sandbox;
-    c.fawkes = spec.fawkes;
-    c.agent_dir = spec.agent_dir;
-    c.start = spec.agent_start;
+    if (scenario.robots.at(static_cast<std::size_t>(i)).agent.empty()) continue;
     const std::string name(game.robot(i).name());
     // The agent's decisions (info and above) go into the recording. Its issues and events
     // come as data (clips::AgentIo::issues, ::events): the role changes it declares are
@@ -441,7 +417,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
       if (recorder) recorder->lock(name, e);
     };
     sim::AgentBrain& brain =
-        driver.plug_agent(i, c, std::move(log), std::move(locks), std::move(reports));
+        *player.plug_agent(i, std::move(log), std::move(locks), std::move(reports));
     // The agent's trace: --trace lines and the agent's facts and firings in the recording.
     const std::optional<TraceRequest> trace =
         hooks.trace_sink ? trace_for(hooks.trace, name) : std::nullopt;
@@ -535,7 +511,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
 
   game.enable_profile(hooks.profile);
   if (hooks.attach) hooks.attach(game);
-  driver.start(start_phase(scenario.start));
+  player.start();
   const core::SimTime end = scenario.duration;
   core::SimTime next_progress = hooks.progress_every;
   const double t0 = cpu_seconds();
@@ -581,7 +557,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
       if (hooks.note) hooks.note(h->time, robot, h->text);
     }
   };
-  driver.run_until(end, [&](const sim::Game&) {
+  player.observe([&](const sim::Game&) {
     check_agents();
     if (hooks.stop_at_agent_error && first_agent_error) return true;
     if (hooks.reload_agents && game.time() >= next_reload_check) {
@@ -631,6 +607,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
     }
     return false;
   });
+  player.play_until(end);
   const double cpu = cpu_seconds() - t0;
 
   RunResult r;

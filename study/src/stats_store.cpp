@@ -21,6 +21,125 @@
 
 namespace llsf::study {
 
+namespace {
+
+/// `text` with every `$NAME` of the dialect replaced.
+std::string in_dialect(std::string text, const SqlDialect& d) {
+  const std::pair<std::string_view, std::string_view> words[] = {{"$ID", d.id},
+                                                                 {"$BIGINT", d.bigint},
+                                                                 {"$REAL", d.real},
+                                                                 {"$NOW", d.now},
+                                                                 {"$KEYED", d.keyed}};
+  for (const auto& [from, to] : words) {
+    for (std::size_t at = text.find(from); at != std::string::npos;
+         at = text.find(from, at + to.size())) {
+      text.replace(at, from.size(), to);
+    }
+  }
+  return text;
+}
+
+// Version 1: the tables. `$NAME`s are the dialect's words (SqlDialect).
+constexpr const char* kTablesSql = R"sql(
+CREATE TABLE batches (
+  id               $ID,
+  kind             TEXT    NOT NULL CHECK (kind IN ('batch', 'run')),
+  created          TEXT    NOT NULL DEFAULT $NOW,
+  finished         TEXT,
+  scenario_file    TEXT    NOT NULL,
+  scenario_name    TEXT    NOT NULL,
+  scenario_hash    TEXT    NOT NULL,
+  runs_per_variant INTEGER NOT NULL CHECK (runs_per_variant >= 0),
+  variants         INTEGER NOT NULL CHECK (variants >= 1),
+  seeds            TEXT    NOT NULL,
+  llsfsim_version  TEXT    NOT NULL,
+  UNIQUE (kind, scenario_hash, runs_per_variant)
+);
+CREATE TABLE runs (
+  id               $ID,
+  batch_id         $BIGINT NOT NULL REFERENCES batches (id) ON DELETE CASCADE,
+  scenario         TEXT    NOT NULL,
+  variant          TEXT    NOT NULL,
+  seed             $BIGINT NOT NULL,
+  llsfsim_version  TEXT    NOT NULL,
+  result_hash      TEXT    NOT NULL,
+  passed           INTEGER NOT NULL CHECK (passed IN (0, 1)),
+  points           INTEGER NOT NULL,
+  game_time_s      $REAL NOT NULL,
+  cpu_s            $REAL NOT NULL,
+  real_time_factor $REAL NOT NULL,
+  created          TEXT    NOT NULL DEFAULT $NOW,
+  UNIQUE (batch_id, variant, seed)
+);
+CREATE TABLE statistics (
+  run_id $BIGINT NOT NULL REFERENCES runs (id) ON DELETE CASCADE,
+  name   TEXT    NOT NULL,
+  value  $REAL NOT NULL,
+  PRIMARY KEY (run_id, name)
+)$KEYED;
+CREATE INDEX statistics_by_name ON statistics (name);
+CREATE TABLE orders (
+  run_id         $BIGINT NOT NULL REFERENCES runs (id) ON DELETE CASCADE,
+  order_id       INTEGER NOT NULL,
+  product        TEXT    NOT NULL,
+  requested      INTEGER NOT NULL,
+  delivered      INTEGER NOT NULL,
+  window_begin_s INTEGER NOT NULL,
+  window_end_s   INTEGER NOT NULL,
+  PRIMARY KEY (run_id, order_id)
+)$KEYED;
+CREATE TABLE tests (
+  run_id $BIGINT NOT NULL REFERENCES runs (id) ON DELETE CASCADE,
+  idx    INTEGER NOT NULL,
+  name   TEXT    NOT NULL,
+  passed INTEGER NOT NULL CHECK (passed IN (0, 1)),
+  detail TEXT    NOT NULL,
+  at_s   $REAL NOT NULL,
+  PRIMARY KEY (run_id, idx)
+)$KEYED;
+CREATE TABLE awards (
+  run_id      $BIGINT NOT NULL REFERENCES runs (id) ON DELETE CASCADE,
+  idx         INTEGER NOT NULL,
+  time_s      $REAL NOT NULL,
+  game_time_s $REAL NOT NULL,
+  phase       TEXT    NOT NULL,
+  points      INTEGER NOT NULL,
+  reason      TEXT    NOT NULL,
+  device      TEXT,
+  order_id    INTEGER,
+  puck        INTEGER,
+  PRIMARY KEY (run_id, idx)
+)$KEYED;
+CREATE TABLE events (
+  run_id $BIGINT NOT NULL REFERENCES runs (id) ON DELETE CASCADE,
+  idx    INTEGER NOT NULL,
+  time_s $REAL NOT NULL,
+  kind   TEXT    NOT NULL,
+  name   TEXT    NOT NULL,
+  value  $REAL,
+  detail TEXT    NOT NULL,
+  PRIMARY KEY (run_id, idx)
+)$KEYED;
+CREATE INDEX runs_by_variant ON runs (batch_id, variant);
+)sql";
+
+}  // namespace
+
+std::array<std::string, kSchemaVersion> schema_sql(const SqlDialect& dialect) {
+  return {
+      in_dialect(kTablesSql, dialect),
+      "ALTER TABLE runs ADD COLUMN recording TEXT;",
+      R"sql(
+CREATE TABLE schema_migrations (
+  version     INTEGER PRIMARY KEY,
+  description TEXT    NOT NULL,
+  applied     TEXT
+);
+)sql",
+      kMissingIsMissingSql,
+  };
+}
+
 std::string_view llsfsim_version() { return core::kVersion; }
 
 // ---- Shared by the backends --------------------------------------------------------------------

@@ -16,103 +16,13 @@ namespace llsf::study {
 
 namespace {
 
-// The migrations in SQLite's dialect: kSql[v - 1] takes a store from version v - 1 to v
-// (docs/statistics.md explains every column). Version 2 and earlier kept the version in
-// `PRAGMA user_version` only; it is still written, so that an older llsfsim refuses a newer file
-// rather than misreading it.
-constexpr std::array<const char*, kSchemaVersion> kSql = {
-    R"sql(
-CREATE TABLE batches (
-  id               INTEGER PRIMARY KEY,
-  kind             TEXT    NOT NULL CHECK (kind IN ('batch', 'run')),
-  created          TEXT    NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%SZ', 'now')),
-  finished         TEXT,
-  scenario_file    TEXT    NOT NULL,
-  scenario_name    TEXT    NOT NULL,
-  scenario_hash    TEXT    NOT NULL,
-  runs_per_variant INTEGER NOT NULL CHECK (runs_per_variant >= 0),
-  variants         INTEGER NOT NULL CHECK (variants >= 1),
-  seeds            TEXT    NOT NULL,
-  llsfsim_version  TEXT    NOT NULL,
-  UNIQUE (kind, scenario_hash, runs_per_variant)
-);
-CREATE TABLE runs (
-  id               INTEGER PRIMARY KEY,
-  batch_id         INTEGER NOT NULL REFERENCES batches (id) ON DELETE CASCADE,
-  scenario         TEXT    NOT NULL,
-  variant          TEXT    NOT NULL,
-  seed             INTEGER NOT NULL,
-  llsfsim_version  TEXT    NOT NULL,
-  result_hash      TEXT    NOT NULL,
-  passed           INTEGER NOT NULL CHECK (passed IN (0, 1)),
-  points           INTEGER NOT NULL,
-  game_time_s      REAL    NOT NULL,
-  cpu_s            REAL    NOT NULL,
-  real_time_factor REAL    NOT NULL,
-  created          TEXT    NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%SZ', 'now')),
-  UNIQUE (batch_id, variant, seed)
-);
-CREATE TABLE statistics (
-  run_id INTEGER NOT NULL REFERENCES runs (id) ON DELETE CASCADE,
-  name   TEXT    NOT NULL,
-  value  REAL    NOT NULL,
-  PRIMARY KEY (run_id, name)
-) WITHOUT ROWID;
-CREATE INDEX statistics_by_name ON statistics (name);
-CREATE TABLE orders (
-  run_id         INTEGER NOT NULL REFERENCES runs (id) ON DELETE CASCADE,
-  order_id       INTEGER NOT NULL,
-  product        TEXT    NOT NULL,
-  requested      INTEGER NOT NULL,
-  delivered      INTEGER NOT NULL,
-  window_begin_s INTEGER NOT NULL,
-  window_end_s   INTEGER NOT NULL,
-  PRIMARY KEY (run_id, order_id)
-) WITHOUT ROWID;
-CREATE TABLE tests (
-  run_id INTEGER NOT NULL REFERENCES runs (id) ON DELETE CASCADE,
-  idx    INTEGER NOT NULL,
-  name   TEXT    NOT NULL,
-  passed INTEGER NOT NULL CHECK (passed IN (0, 1)),
-  detail TEXT    NOT NULL,
-  at_s   REAL    NOT NULL,
-  PRIMARY KEY (run_id, idx)
-) WITHOUT ROWID;
-CREATE TABLE awards (
-  run_id      INTEGER NOT NULL REFERENCES runs (id) ON DELETE CASCADE,
-  idx         INTEGER NOT NULL,
-  time_s      REAL    NOT NULL,
-  game_time_s REAL    NOT NULL,
-  phase       TEXT    NOT NULL,
-  points      INTEGER NOT NULL,
-  reason      TEXT    NOT NULL,
-  device      TEXT,
-  order_id    INTEGER,
-  puck        INTEGER,
-  PRIMARY KEY (run_id, idx)
-) WITHOUT ROWID;
-CREATE TABLE events (
-  run_id INTEGER NOT NULL REFERENCES runs (id) ON DELETE CASCADE,
-  idx    INTEGER NOT NULL,
-  time_s REAL    NOT NULL,
-  kind   TEXT    NOT NULL,
-  name   TEXT    NOT NULL,
-  value  REAL,
-  detail TEXT    NOT NULL,
-  PRIMARY KEY (run_id, idx)
-) WITHOUT ROWID;
-CREATE INDEX runs_by_variant ON runs (batch_id, variant);
-)sql",
-    "ALTER TABLE runs ADD COLUMN recording TEXT;",
-    R"sql(
-CREATE TABLE schema_migrations (
-  version     INTEGER PRIMARY KEY,
-  description TEXT    NOT NULL,
-  applied     TEXT
-);
-)sql",
-    kMissingIsMissingSql,
-};
+// The migrations in SQLite's dialect (schema_sql, stats_store.cpp). Version 2 and earlier kept
+// the version in `PRAGMA user_version` only; it is still written, so that an older llsfsim
+// refuses a newer file rather than misreading it.
+const std::array<std::string, kSchemaVersion>& sqlite_migrations() {
+  static const std::array<std::string, kSchemaVersion> sql = schema_sql(kSqliteDialect);
+  return sql;
+}
 
 // ---- RAII wrappers of the SQLite C API -------------------------------------------------------
 
@@ -421,7 +331,7 @@ class SqliteBackend final : public StatsBackend {
       throw StatsError(path_ + ": not an llsfsim statistics store (it has other tables)");
     }
     for (int v = version + 1; v <= kSchemaVersion; ++v) {
-      exec(db_.get(), path_, kSql[static_cast<std::size_t>(v - 1)]);
+      exec(db_.get(), path_, sqlite_migrations()[static_cast<std::size_t>(v - 1)].c_str());
     }
     // Every version in the table: the ones applied now with the time, older ones without.
     Statement rec(db_.get(), path_,

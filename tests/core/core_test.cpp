@@ -12,6 +12,7 @@
 #include "llsf/core/ids.h"
 #include "llsf/core/rng.h"
 #include "llsf/core/sim_time.h"
+#include "llsf/core/text.h"
 
 using namespace llsf::core;
 
@@ -316,4 +317,13 @@ TEST_CASE("validated reads and require() share one wording; loaders add file:lin
                        "p.yaml:2:3: puck.mass_kg: must be > 0", ConfigError);
   CHECK_THROWS_WITH_AS(root.fail_at("robot", "overlaps puck.beams"),
                        "p.yaml:4:10: robot: overlaps puck.beams", ConfigError);
+}
+
+TEST_CASE("xml_escape: the four characters of markup, everything else as it is") {
+  using llsf::core::xml_escape;
+  CHECK(xml_escape("") == "");
+  CHECK(xml_escape("M1 & M2 < 3 > 2 \"P3\" 'x'") == "M1 &amp; M2 &lt; 3 &gt; 2 &quot;P3&quot; 'x'");
+  CHECK(xml_escape("&amp;") == "&amp;amp;");  // escaped once more: no entity is kept
+  CHECK(xml_escape("</script>") == "&lt;/script&gt;");
+  CHECK(xml_escape("gr\xc3\xbcn\n") == "gr\xc3\xbcn\n");  // UTF-8 and newlines pass through
 }

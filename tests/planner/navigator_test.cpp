@@ -174,7 +174,7 @@ TEST_CASE("pushing against an obstacle the map does not know: stuck") {
   kinematic::WorldConfig w = test_world({{2.8, 2.1, core::kPi / 2}});
   core::Rng rng(1);
   kinematic::World world(w, rng);
-  FieldMap f = test::field_from_world(w);
+  FieldMap f = sim::field_map_from_world(w);
   f.devices.erase(f.devices.begin() + 4);  // M5
   PlannerConfig pc;
   pc.places.look_distance_m = 0.6;

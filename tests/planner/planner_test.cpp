@@ -13,7 +13,7 @@
 
 using namespace llsf;
 using namespace llsf::planner;
-using llsf::test::field_from_world;
+using llsf::sim::field_map_from_world;
 
 namespace {
 
@@ -23,7 +23,7 @@ const kinematic::WorldConfig& world2013() {
 }
 
 Planner& shared_planner() {
-  static Planner p(field_from_world(world2013()), PlannerConfig{});
+  static Planner p(field_map_from_world(world2013()), PlannerConfig{});
   return p;
 }
 
@@ -66,8 +66,23 @@ std::vector<Vec2> free_grid(const Planner& p, double step) {
 
 }  // namespace
 
+TEST_CASE("the game's map carries the world's obstacles: no free point inside a box") {
+  // The planner tests build their map with the game's own function (sim::field_map_from_world),
+  // so a scenario's obstacles reach the planner as they do in a game.
+  const core::Vec2 spot(4.9, 1.7);          // between M1 and the delivery gates, no place near
+  REQUIRE(shared_planner().is_free(spot));  // free without the box
+  kinematic::WorldConfig w = world2013();
+  w.obstacles.push_back({"box1", {spot.x(), spot.y(), 0.0}, 0.4, 0.4});
+  const FieldMap f = field_map_from_world(w);
+  REQUIRE(f.obstacles.size() == 1);
+  CHECK(f.obstacles.front().name == "box1");
+  const Planner p(f, PlannerConfig{});
+  CHECK_FALSE(p.is_free(spot));
+  CHECK_FALSE(p.is_free(spot + core::Vec2(0.2 + 0.5 * p.config().inflated_radius_m(), 0.0)));
+}
+
 TEST_CASE("the static map's exact checks agree with FCL and with the world's geometry") {
-  const FieldMap f = field_from_world(world2013());
+  const FieldMap f = field_map_from_world(world2013());
   const detail::StaticMap map(f, 0.26);
   const test::FclOracle fcl(map);
   core::RandomStream rng(7);
@@ -129,7 +144,7 @@ TEST_CASE("planned paths: the robot's footprint swept along them, checked with F
   // and radius + clearance from the discs (FCL's GJK distance, to 1 um). Paths graze the limit:
   // asking 1 mm more fails 7 segments.
   Planner& p = shared_planner();
-  const detail::StaticMap map(field_from_world(world2013()), p.config().inflated_radius_m());
+  const detail::StaticMap map(field_map_from_world(world2013()), p.config().inflated_radius_m());
   const test::FclOracle fcl(map);
   const auto pts = free_grid(p, 0.3);
   core::RandomStream rng(11);
@@ -329,7 +344,7 @@ TEST_CASE("same seed, same path; different seeds explore differently") {
   REQUIRE(r1.status == PlanStatus::kFound);
   CHECK(r1.path.points == r2.path.points);
   // A second planner (a second game) gives the same path for the same request.
-  Planner q(field_from_world(world2013()), PlannerConfig{});
+  Planner q(field_map_from_world(world2013()), PlannerConfig{});
   CHECK(q.plan({a, b, obs, 0.05, 42}).path.points == r1.path.points);
   int differ = 0;
   for (std::uint64_t s = 1; s <= 10; ++s) {
@@ -341,7 +356,7 @@ TEST_CASE("same seed, same path; different seeds explore differently") {
 TEST_CASE("two games planning in parallel threads do not change each other's paths") {
   // Reference: each game's query sequence alone.
   auto game = [](std::uint64_t seed) {
-    Planner p(field_from_world(world2013()), PlannerConfig{});
+    Planner p(field_map_from_world(world2013()), PlannerConfig{});
     core::RandomStream rng(seed);
     const auto pts = free_grid(p, 0.4);
     std::vector<std::vector<Vec2>> paths;
@@ -384,7 +399,7 @@ TEST_CASE("bad maps and configs are rejected naming the field") {
   // A user place inside a machine.
   PlannerConfig u;
   u.places.extra.push_back({"bad", Pose2D{2.8, 0.56, 0.0}});
-  CHECK_THROWS_WITH_AS(Planner(field_from_world(world2013()), u),
+  CHECK_THROWS_WITH_AS(Planner(field_map_from_world(world2013()), u),
                        doctest::Contains("places.bad: pose (2.800, 0.560) is"), core::ConfigError);
 }
 

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// Test helpers: the kinematic world's field as a planner FieldMap (the conversion sim/ will own),
-// and a scene that drives robots in the kinematic World with navigators.
+// Test helpers: a scene that drives robots in the kinematic World with navigators, on the map the
+// game builds from the world (sim::field_map_from_world: devices, marked areas and obstacles).
 #pragma once
 
 #include <string>
@@ -8,44 +8,9 @@
 
 #include "llsf/kinematic/world.h"
 #include "llsf/planner/navigator.h"
+#include "llsf/sim/game.h"
 
 namespace llsf::test {
-
-/// The conversion sim/ will own: devices with their footprints and RFID zone centres, and the
-/// marked areas, copied one to one.
-inline planner::FieldMap field_from_world(const kinematic::WorldConfig& w) {
-  planner::FieldMap m;
-  m.width_m = w.field.width_m;
-  m.height_m = w.field.height_m;
-  for (int i = 0; i < kinematic::kDeviceCount; ++i) {
-    const core::DeviceId id(i);
-    const kinematic::DeviceConfig& d = w.devices[i];
-    planner::DeviceRole role = planner::DeviceRole::kProduction;
-    switch (kinematic::device_kind(id)) {
-      case kinematic::DeviceKind::kProduction:
-        role = planner::DeviceRole::kProduction;
-        break;
-      case kinematic::DeviceKind::kRecycling:
-        role = planner::DeviceRole::kRecycling;
-        break;
-      case kinematic::DeviceKind::kTest:
-        role = planner::DeviceRole::kTest;
-        break;
-      case kinematic::DeviceKind::kDelivery:
-        role = planner::DeviceRole::kDelivery;
-        break;
-    }
-    m.devices.push_back(
-        {std::string(kinematic::device_name(id)), role, d.pose, d.footprint(), d.rfid_center()});
-  }
-  auto rect = [](const kinematic::Rect& r) { return planner::AreaRect{r.lo, r.hi}; };
-  m.insertion_area = rect(w.field.insertion_area);
-  m.input_storage = rect(w.field.input_storage);
-  m.late_order_area = rect(w.field.late_order_area);
-  m.late_order_slot = w.field.late_order_slot;
-  m.delivery_zone = rect(w.field.delivery_zone);
-  return m;
-}
 
 inline kinematic::MotorCommand to_motor(const planner::VelocityCommand& c) {
   return {c.vx_mps, c.vy_mps, c.omega_rps};
@@ -68,7 +33,9 @@ class NavScene {
  public:
   NavScene(const kinematic::WorldConfig& world_config, std::uint64_t seed,
            planner::PlannerConfig pc = {}, planner::ControllerConfig cc = {})
-      : rng_(seed), world_(world_config, rng_), planner_(field_from_world(world_config), pc) {
+      : rng_(seed),
+        world_(world_config, rng_),
+        planner_(sim::field_map_from_world(world_config), pc) {
     for (int i = 0; i < world_.robot_count(); ++i) {
       navs_.emplace_back(planner_, cc, rng_.stream("planner/robot" + std::to_string(i + 1)));
     }

@@ -13,6 +13,7 @@
 #include "llsf/core/error.h"
 #include "llsf/sim/agent_brain.h"
 #include "llsf/sim/driver.h"
+#include "llsf/study/player.h"
 #include "llsf/study/recording.h"
 #include "llsf/study/runner.h"
 #include "llsf/study/scenario.h"
@@ -84,12 +85,7 @@ TEST_CASE("an agent's facts replay from the recording's snapshots and deltas") {
   sim::Game& game = driver.game();
   const std::string path = (temp_dir() / "agents.jsonl.gz").string();
   Recorder recorder(path, game, RecordingInfo{"agents", "", 1});
-  sim::AgentBrainConfig c;
-  c.agent_files = s.robots.at(0).agent;
-  c.config = s.robots.at(0).config;
-  c.skills = s.skills;
-  c.locks = s.robots.at(0).locks;
-  sim::AgentBrain& brain = driver.plug_agent(0, c);
+  sim::AgentBrain& brain = driver.plug_agent(0, agent_config(s, s.robots.at(0)));
   brain.agent().set_trace({.rules = true, .facts = true, .log = true},
                           [&recorder](const clips::TraceEvent& e) { recorder.agent_trace(0, e); });
   driver.start(refbox::GamePhase::kPreGame);

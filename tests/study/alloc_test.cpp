@@ -17,9 +17,8 @@
 #include <string>
 #include <vector>
 
-#include "llsf/sim/agent_brain.h"
-#include "llsf/sim/driver.h"
 #include "llsf/sim/game.h"
+#include "llsf/study/player.h"
 #include "llsf/study/scenario.h"
 
 // --- the counter -------------------------------------------------------------------------------
@@ -160,81 +159,96 @@ int active_orders(const sim::Game& g) {
   return n;
 }
 
-/// The default scenario (3 robots, the llsf2013 CLIPS agent, Lua skills), seed 1, brains as
-/// run_game builds them (without log sinks and recorder).
-struct DefaultGame {
-  study::Scenario scenario;
-  std::unique_ptr<sim::GameDriver> driver;
-  sim::Game* game = nullptr;
-
-  DefaultGame() {
-    scenario = study::load_scenario(LLSF_SOURCE_DIR "/scenarios/default.yaml").variants.front();
-    sim::GameConfig config = scenario.game;
-    config.seed = 1;
-    driver = std::make_unique<sim::GameDriver>(config);
-    game = &driver->game();
-    for (int i = 0; i < game->robot_count(); ++i) {
-      const study::RobotSpec& spec = scenario.robots.at(static_cast<std::size_t>(i));
-      sim::AgentBrainConfig c;
-      c.agent_files = spec.agent;
-      c.config = spec.config;
-      c.skills = scenario.skills;
-      c.locks = spec.locks;
-      driver->plug_agent(i, c);
-    }
-    REQUIRE(scenario.start == study::StartMode::kGame);
-    driver->start(refbox::GamePhase::kPreGame);
+/// The default scenario (3 robots, the llsf2013 CLIPS agent, Lua skills), seed 1, set up and
+/// played as every game is (study::Player: the agents configured by study::agent_config, sandbox
+/// included, the refbox started as the scenario says), without run_game's sinks and recorder.
+/// An observer of the player measures each tick.
+class DefaultGame {
+ public:
+  DefaultGame()
+      : scenario_(study::load_scenario(LLSF_SOURCE_DIR "/scenarios/default.yaml").variants.front()),
+        player_(scenario_, 1),
+        g_(player_.game()),
+        outcomes_(static_cast<std::size_t>(g_.robot_count())) {
+    REQUIRE(scenario_.start == study::StartMode::kGame);
+    REQUIRE(scenario_.robots.front().sandbox);  // the agent real games play
+    player_.plug_agents();
+    for (int i = 0; i < g_.robot_count(); ++i) REQUIRE(player_.driver().agent(i) != nullptr);
+    player_.start();
+    player_.observe([this](const sim::Game&) {
+      if (window_ != nullptr) count_tick(*window_);
+      return false;
+    });
   }
 
-  /// Steps to `from`, then measures every tick until `to`.
+  /// Plays to `from`, then measures every tick until `to`.
   Window measure(core::SimTime from, core::SimTime to) {
-    sim::Game& g = *game;
-    const int n = g.robot_count();
-    g.run_until(from);
-    g.set_profile_counter(&allocations);
-    g.enable_profile(true);
+    player_.play_until(from);
+    g_.set_profile_counter(&allocations);
+    g_.enable_profile(true);
     Window w;
-    std::vector<planner::NavOutcome> outcomes(static_cast<std::size_t>(n));
-    while (g.time() < to) {
-      const Profile before = g.profile();
-      const std::int64_t plans = g.planner().plan_count();
-      const int orders = active_orders(g);
-      for (int i = 0; i < n; ++i) {
-        outcomes[static_cast<std::size_t>(i)] = g.robot(i).nav().status().outcome;
-      }
-      g.step();
-      std::array<std::int64_t, Profile::kSteps> step{};
-      for (std::size_t s = 0; s < step.size(); ++s) {
-        step[s] = g.profile().counts[s] - before.counts[s];
-      }
-      // Navigation: a plan, or the end of a navigation (its status message), is an event.
-      bool nav_event = g.planner().plan_count() > plans;
-      for (int i = 0; i < n; ++i) {
-        nav_event =
-            nav_event || g.robot(i).nav().status().outcome != outcomes[static_cast<std::size_t>(i)];
-      }
-      w[nav_event ? kNavEvents : kNavigation].add(step[1]);
-      w[kNavEvents].events += g.planner().plan_count() - plans;
-      w[kWorld].add(step[2]);
-      const int new_orders = active_orders(g) - orders;
-      w[new_orders > 0 ? kLateOrders : kRefbox].add(step[3]);
-      w[kLateOrders].events += new_orders;
-      // Radio: what the tick step allocated minus the decoding of the messages it delivered.
-      const std::int64_t refbox_in = decode_allocations(g, g.refbox_peer(), true);
-      std::int64_t agents_in = 0;
-      for (int i = 0; i < n; ++i) agents_in += decode_allocations(g, g.robot_peer(i), false);
-      w[kRadio].add(step[4] - refbox_in - agents_in);
-      w[kDecodeRefbox].add(refbox_in);
-      w[kDecodeAgents].add(agents_in);
-      w[kSensors].add(step[5]);
-      w[kSkills].add(step[6]);
-      w[kAgents].add(step[7]);
-      ++w.ticks;
-    }
-    g.enable_profile(false);
-    g.set_profile_counter(nullptr);
+    before_tick();
+    window_ = &w;
+    player_.play_until(to);
+    window_ = nullptr;
+    g_.enable_profile(false);
+    g_.set_profile_counter(nullptr);
     return w;
   }
+
+ private:
+  /// What the next tick is measured against.
+  void before_tick() {
+    before_ = g_.profile();
+    plans_ = g_.planner().plan_count();
+    orders_ = active_orders(g_);
+    for (int i = 0; i < g_.robot_count(); ++i) {
+      outcomes_[static_cast<std::size_t>(i)] = g_.robot(i).nav().status().outcome;
+    }
+  }
+
+  /// The tick that just ended, against before_tick()'s state.
+  void count_tick(Window& w) {
+    sim::Game& g = g_;
+    const int n = g.robot_count();
+    std::array<std::int64_t, Profile::kSteps> step{};
+    for (std::size_t s = 0; s < step.size(); ++s) {
+      step[s] = g.profile().counts[s] - before_.counts[s];
+    }
+    // Navigation: a plan, or the end of a navigation (its status message), is an event.
+    bool nav_event = g.planner().plan_count() > plans_;
+    for (int i = 0; i < n; ++i) {
+      nav_event =
+          nav_event || g.robot(i).nav().status().outcome != outcomes_[static_cast<std::size_t>(i)];
+    }
+    w[nav_event ? kNavEvents : kNavigation].add(step[1]);
+    w[kNavEvents].events += g.planner().plan_count() - plans_;
+    w[kWorld].add(step[2]);
+    const int new_orders = active_orders(g) - orders_;
+    w[new_orders > 0 ? kLateOrders : kRefbox].add(step[3]);
+    w[kLateOrders].events += new_orders;
+    // Radio: what the tick step allocated minus the decoding of the messages it delivered.
+    const std::int64_t refbox_in = decode_allocations(g, g.refbox_peer(), true);
+    std::int64_t agents_in = 0;
+    for (int i = 0; i < n; ++i) agents_in += decode_allocations(g, g.robot_peer(i), false);
+    w[kRadio].add(step[4] - refbox_in - agents_in);
+    w[kDecodeRefbox].add(refbox_in);
+    w[kDecodeAgents].add(agents_in);
+    w[kSensors].add(step[5]);
+    w[kSkills].add(step[6]);
+    w[kAgents].add(step[7]);
+    ++w.ticks;
+    before_tick();
+  }
+
+  study::Scenario scenario_;
+  study::Player player_;
+  sim::Game& g_;
+  Window* window_ = nullptr;  // measuring into it
+  Profile before_{};
+  std::int64_t plans_ = 0;
+  int orders_ = 0;
+  std::vector<planner::NavOutcome> outcomes_;
 };
 
 void report(const char* name, const Window& w) {

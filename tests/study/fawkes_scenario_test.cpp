@@ -11,6 +11,7 @@
 #include "llsf/core/error.h"
 #include "llsf/sim/agent_brain.h"
 #include "llsf/sim/driver.h"
+#include "llsf/study/player.h"
 #include "llsf/study/runner.h"
 #include "llsf/study/scenario.h"
 #include "support/temp_dir.h"
@@ -153,12 +154,7 @@ TEST_CASE("a Fawkes-style agent's own messages travel between the robots") {
   sim::GameDriver driver(s.game);
   std::vector<sim::AgentBrain*> brains;
   for (int i = 0; i < 2; ++i) {
-    sim::AgentBrainConfig c;
-    c.agent_files = s.robots[static_cast<std::size_t>(i)].agent;
-    c.config = s.robots[static_cast<std::size_t>(i)].config;
-    c.fawkes = true;
-    c.agent_dir = s.robots[static_cast<std::size_t>(i)].agent_dir;
-    brains.push_back(&driver.plug_agent(i, c));
+    brains.push_back(&driver.plug_agent(i, agent_config(s, s.robots[static_cast<std::size_t>(i)])));
   }
   driver.run_until(core::SimTime::from_seconds(5.0));
   for (int i = 0; i < 2; ++i) {
@@ -239,12 +235,7 @@ robots:
   const ScenarioFile f = load_scenario(dir.file("s.yaml"));
   const Scenario& s = f.variants.at(0);
   sim::GameDriver driver(s.game);
-  sim::AgentBrainConfig c;
-  c.agent_files = s.robots.at(0).agent;
-  c.config = s.robots.at(0).config;
-  c.fawkes = true;
-  c.agent_dir = s.robots.at(0).agent_dir;
-  sim::AgentBrain& brain = driver.plug_agent(0, c);
+  sim::AgentBrain& brain = driver.plug_agent(0, agent_config(s, s.robots.at(0)));
   driver.run_until(core::SimTime::from_seconds(2.0));
   const clips::AgentHost& agent = brain.agent();
   CHECK(agent.runtime_errors() == 0);
@@ -311,13 +302,7 @@ skills: {skill_dirs: [skills]}
   const ScenarioFile f = load_scenario(dir.file("s.yaml"));
   const Scenario& s = f.variants.at(0);
   sim::GameDriver driver(s.game);
-  sim::AgentBrainConfig c;
-  c.agent_files = s.robots.at(0).agent;
-  c.config = s.robots.at(0).config;
-  c.fawkes = true;
-  c.agent_dir = s.robots.at(0).agent_dir;
-  c.skills = s.skills;
-  sim::AgentBrain& brain = driver.plug_agent(0, c);
+  sim::AgentBrain& brain = driver.plug_agent(0, agent_config(s, s.robots.at(0)));
   driver.run_until(core::SimTime::from_seconds(2.0));
   const clips::AgentHost& agent = brain.agent();
   CHECK(agent.runtime_errors() == 0);

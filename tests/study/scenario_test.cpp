@@ -11,6 +11,7 @@
 #include "llsf/core/error.h"
 #include "llsf/sim/agent_brain.h"
 #include "llsf/sim/game.h"
+#include "llsf/study/player.h"
 #include "llsf/study/runner.h"
 #include "llsf/study/scenario.h"
 #include "support/temp_dir.h"
@@ -123,9 +124,7 @@ TEST_CASE("jersey numbers: per robot in `each`, in the agent, the beacons and th
   CHECK(s.game.world.robots[0].jersey_or(0) == 7);
   CHECK(s.game.world.robots[1].name == "beta");
   Game game(s.game);
-  AgentBrainConfig c;
-  c.agent_files = s.robots[1].agent;
-  AgentBrain brain(game, 1, c);
+  AgentBrain brain(game, 1, agent_config(s, s.robots[1]));
   game.set_brain(1, &brain);
   brain.agent().start(SimTime{});  // (reset): the identity globals
   CHECK(brain.agent().eval("?*ROBOT-NUMBER*").number() == doctest::Approx(3.0));
@@ -239,10 +238,7 @@ TEST_CASE("scenario: each[i].agent_start_s, referee.remove_delay_s, levels.light
   CHECK(s.robots[1].agent_start == SimTime::from_ms(1500));
   // The late robot's agent neither cycles nor fires a rule before its start.
   Game game(s.game);
-  AgentBrainConfig c;
-  c.agent_files = s.robots[1].agent;
-  c.start = s.robots[1].agent_start;
-  AgentBrain brain(game, 1, c);
+  AgentBrain brain(game, 1, agent_config(s, s.robots[1]));
   game.set_brain(1, &brain);
   brain.agent().start(SimTime{});
   const std::int64_t fired = brain.agent().rules_fired();

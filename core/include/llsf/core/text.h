@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
-// Small text helpers for messages: edit distance and the "did you mean" candidate.
+// Small text helpers: edit distance and the "did you mean" candidate for messages; escaping
+// text for HTML, SVG and XML.
 #pragma once
 
 #include <optional>
@@ -16,5 +17,10 @@ int edit_distance(std::string_view a, std::string_view b);
 /// typo), else nullopt.
 std::optional<std::string> closest_match(std::string_view name,
                                          std::span<const std::string> candidates);
+
+/// `text` with &, <, > and " replaced by their entities (&amp; &lt; &gt; &quot;): safe in HTML,
+/// SVG and XML element text and in double-quoted attribute values. The one escaping of the
+/// report page and `field-map`'s SVG.
+std::string xml_escape(std::string_view text);
 
 }  // namespace llsf::core

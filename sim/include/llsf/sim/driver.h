@@ -2,7 +2,8 @@
 // GameDriver: the one way to play a game. It builds the Game from a GameConfig, owns the robots'
 // brains (agents, skill engines) and plugs them in, starts the refbox as a controller would, and
 // steps the game with a hook after every tick. `llsfsim run` and `batch` (study::run_game),
-// `check`, `skill`, `exercise`, the benchmarks and the tests all play through it.
+// `check`, `skill`, `exercise`, the benchmarks and the tests all play through it (above sim
+// through study::Player, which sets a scenario's game up and puts its observers on the hook).
 #pragma once
 
 #include <functional>

@@ -178,7 +178,7 @@ class Game {
   };
   void enable_profile(bool on) { profiling_ = on; }
   /// A monotonic counter read at every tick step boundary while profiling, its increases summed
-  /// in TickProfile::counts (tests/sim/alloc_test.cpp: a count of heap allocations); nullptr:
+  /// in TickProfile::counts (tests/study/alloc_test.cpp: a count of heap allocations); nullptr:
   /// none. Must not allocate.
   void set_profile_counter(std::int64_t (*counter)()) { profile_counter_ = counter; }
   const TickProfile& profile() const { return profile_; }
