@@ -117,6 +117,7 @@ const study::Scenario* pick_variant(const study::ScenarioFile& f, const std::str
 /// skill and error (docs/llsfsim.md, "Issues").
 void print_issues(const study::RunResult& r, std::ostream& out) {
   int mistakes = 0;
+  int halted_late = 0;  // agent-halted issues shown after the first 10
   std::map<std::string, std::pair<int, double>> failures;  // "robot skill: error" -> (n, first)
   for (const study::RunIssue& i : r.issues) {
     if (!i.is_mistake()) {
@@ -128,7 +129,9 @@ void print_issues(const study::RunResult& r, std::ostream& out) {
       if (f.first++ == 0) f.second = i.time_s;
       continue;
     }
-    if (mistakes++ >= 10) continue;
+    // The first 10, and every agent-halted one (it says why the agent stopped playing).
+    if (mistakes++ >= 10 && i.kind != study::IssueKind::kAgentHalted) continue;
+    if (mistakes > 10) ++halted_late;
     std::string where;
     if (!i.rule.empty()) where = " rule " + i.rule;
     if (!i.file.empty()) where += " (" + i.place() + ")";
@@ -138,11 +141,12 @@ void print_issues(const study::RunResult& r, std::ostream& out) {
                        study::to_string(i.kind), where, text);
   }
   // r.mistakes counts those not kept too (RunResult::kMaxIssues).
-  if (r.mistakes > std::min(mistakes, 10)) {
+  const int shown_mistakes = std::min(mistakes, 10) + halted_late;
+  if (r.mistakes > shown_mistakes) {
     out << fmt::format(
         "issue      ... and {} more mistakes, {} in all (--json lists the first {} "
         "issues)\n",
-        r.mistakes - std::min(mistakes, 10), r.mistakes, study::RunResult::kMaxIssues);
+        r.mistakes - shown_mistakes, r.mistakes, study::RunResult::kMaxIssues);
   }
   int shown = 0;
   for (const auto& [what, f] : failures) {

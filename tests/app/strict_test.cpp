@@ -97,3 +97,18 @@ TEST_CASE("run and batch --fail-fast stop at the first agent error") {
   CHECK(has(list.out, "1 variant(s) x 4 run(s)  unfinished"));  // 3 seeds never played
   CHECK(llsfsim({"batch", dir.file("s.yaml"), "--slurm", "--fail-fast"}).code == 2);
 }
+
+TEST_CASE("the summary shows the agent-halted issue also after the first 10 issue lines") {
+  // (while TRUE) in every cycle: 10 runtime errors (the work budget), then the agent is halted.
+  const TempDir dir;
+  std::filesystem::create_directories(dir.file("agent"));
+  std::ofstream(dir.file("agent/a.clp"))
+      << "(defrule spin (time $?) => (while TRUE do (bind ?x 1)))\n";
+  std::ofstream(dir.file("s.yaml")) << "name: spin\nduration_s: 5\n"
+                                       "robots: {count: 1, agent: [agent]}\n";
+  const auto r = llsfsim({"run", dir.file("s.yaml"), "--no-db", "--no-record"});
+  INFO(r.out, r.err);
+  CHECK(r.code == 1);
+  CHECK(has(r.out, "robot1 agent-halted"));
+  CHECK_FALSE(has(r.out, "more mistakes"));  // 11 in all, every one shown
+}
