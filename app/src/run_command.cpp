@@ -680,10 +680,19 @@ std::vector<AgentWarning> agent_warnings(const study::RobotSpec& spec,
     set_paths.push_back(e.path);
     if (read_by_agent(e.path)) continue;
     // Either side may hold the typo: name the near path the agent reads and where, not a fix.
+    // Compared after the shared "/clips-agent/": on whole paths a long prefix made any two
+    // short keys "near" (speed and roles).
+    const std::string_view kPrefix = "/clips-agent/";
+    auto key_of = [&kPrefix](const std::string& p) {
+      return p.starts_with(kPrefix) ? p.substr(kPrefix.size()) : p;
+    };
+    std::vector<std::string> read_keys;
+    for (const std::string& p : read_paths) read_keys.push_back(key_of(p));
     std::string near;
-    if (const auto hint = core::closest_match(e.path, read_paths)) {
-      const auto i = std::find(read_paths.begin(), read_paths.end(), *hint) - read_paths.begin();
-      near = fmt::format("; it reads {} ({}): one of the two is misspelt", *hint,
+    if (const auto hint = core::closest_match(key_of(e.path), read_keys)) {
+      const auto i = std::find(read_keys.begin(), read_keys.end(), *hint) - read_keys.begin();
+      near = fmt::format("; it reads {} ({}): one of the two is misspelt",
+                         read_paths[static_cast<std::size_t>(i)],
                          read_where[static_cast<std::size_t>(i)]);
     } else if (read_paths.empty()) {
       near = "; its files name no /clips-agent/ path at all";

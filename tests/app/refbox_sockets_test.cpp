@@ -13,6 +13,7 @@
 #include <llsf_msgs/VersionInfo.pb.h>
 
 #include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/write.hpp>
 #include <chrono>
 #include <cstdint>
 #include <ctime>
@@ -440,7 +441,14 @@ TEST_CASE("refbox sockets: a controller's malformed frame is logged and sent as 
   boost::asio::ip::tcp::socket raw(io);
   raw.connect(boost::asio::ip::tcp::endpoint(boost::asio::ip::make_address("127.0.0.1"),
                                              static_cast<unsigned short>(sockets.stream_port())));
-  std::vector<std::uint8_t> bad = registry.encode(llsf_msgs::BeaconSignal());
+  llsf_msgs::BeaconSignal beacon;
+  beacon.mutable_time()->set_sec(0);
+  beacon.mutable_time()->set_nsec(0);
+  beacon.set_seq(1);
+  beacon.set_team_name("Carologistics");
+  beacon.set_peer_name("ext1");
+  beacon.set_number(7);
+  std::vector<std::uint8_t> bad = registry.encode(beacon);
   bad[3] = 77;  // the message type's low byte: no such type
   boost::asio::write(raw, boost::asio::buffer(bad));
   std::vector<std::string> told;
