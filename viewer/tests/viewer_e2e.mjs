@@ -217,7 +217,7 @@ try {
   ok = true;
   console.log(
     `${kName}: ok: run ${run.id} seeks ${a.time.toFixed(1)} s -> ${b.time.toFixed(1)} s, ` +
-      `${boxes} boxes, live ${t0.toFixed(1)} s -> ${t1.toFixed(1)} s; screenshots in ${artifacts}`,
+      `${held.length} held-puck samples with clear labels, ${boxes} boxes, live ${t0.toFixed(1)} s -> ${t1.toFixed(1)} s; screenshots in ${artifacts}`,
   );
 } catch (e) {
   const output = e.stderr ? `\n${e.stderr}` : "";
