@@ -2,9 +2,9 @@
 # SPDX-License-Identifier: MIT
 # scripts/check-docs (the doc_examples test) on small trees with a stand-in llsfsim: a shown
 # command whose output matches passes, a different output fails; a command shown with its output
-# but without the `$ ` prompt fails (it would not be checked), as does a doc-test block without
-# a `$ ` line; commands shown without output pass. Usage: check_docs_test.sh SOURCE_DIR. About a
-# second.
+# but without the `$ ` prompt fails (it would not be checked), as do llsfsim's output shown
+# without its command and a doc-test block without a `$ ` line; commands shown without output
+# pass. Usage: check_docs_test.sh SOURCE_DIR. About a second.
 set -eu
 src="$1"
 work=$(mktemp -d)
@@ -73,4 +73,25 @@ EOT
 check 1
 grep -q "docs/a.md:2: a doc-test block without a \`\$ \` line checks nothing" "$work/out" ||
   fail "doc-test without \$: $(cat "$work/out")"
+# llsfsim's output shown without its command (the command in the prose): not checked either.
+cat >"$page" <<EOT
+\`llsfsim run x --trace robot1\` prints:
+
+$fence
+[   6.22] robot1 ==> f-181 (time 6 216666)
+[   6.22] robot1 msg -> LockMasterAnnounce {agent: "robot2"}
+$fence
+
+A diagram, not output:
+
+$fence
+NONE --request--> REQUESTED
+$fence
+EOT
+check 1
+grep -q "docs/a.md:3: the block shows llsfsim's output without the command" "$work/out" ||
+  fail "output without command: $(cat "$work/out")"
+[ "$(grep -c "docs/a.md:" "$work/out")" = 1 ] || fail "the diagram was taken for output: $(cat "$work/out")"
+sed -i '2a <!-- doc-test skip: an illustration -->' "$page"
+check 0
 echo "check_docs_test: ok"
