@@ -673,6 +673,14 @@ std::vector<AgentWarning> agent_warnings(const study::RobotSpec& spec,
     }
     return false;
   };
+  // Paths are compared after the shared "/clips-agent/": on whole paths the long prefix made any
+  // two short keys "near" (speed and roles).
+  auto key_of = [](const std::string& p) {
+    constexpr std::string_view kPrefix = "/clips-agent/";
+    return p.starts_with(kPrefix) ? p.substr(kPrefix.size()) : p;
+  };
+  std::vector<std::string> read_keys;  // read_paths' keys, same order
+  for (const std::string& p : read_paths) read_keys.push_back(key_of(p));
   std::vector<std::string> set_paths;
   for (const clips::ConfigEntry& e : spec.config) {
     if (e.path == "/clips-agent/use-locks") continue;             // the host's (robots.locks)
@@ -680,14 +688,6 @@ std::vector<AgentWarning> agent_warnings(const study::RobotSpec& spec,
     set_paths.push_back(e.path);
     if (read_by_agent(e.path)) continue;
     // Either side may hold the typo: name the near path the agent reads and where, not a fix.
-    // Compared after the shared "/clips-agent/": on whole paths a long prefix made any two
-    // short keys "near" (speed and roles).
-    const std::string_view kPrefix = "/clips-agent/";
-    auto key_of = [&kPrefix](const std::string& p) {
-      return p.starts_with(kPrefix) ? p.substr(kPrefix.size()) : p;
-    };
-    std::vector<std::string> read_keys;
-    for (const std::string& p : read_paths) read_keys.push_back(key_of(p));
     std::string near;
     if (const auto hint = core::closest_match(key_of(e.path), read_keys)) {
       const auto i = std::find(read_keys.begin(), read_keys.end(), *hint) - read_keys.begin();
