@@ -34,6 +34,7 @@
 #include "llsf/core/config.h"
 #include "llsf/core/data_dir.h"
 #include "llsf/core/error.h"
+#include "llsf/core/input_file.h"
 #include "llsf/core/version.h"
 #include "llsf/sim/game.h"
 #include "llsf/sim/skill_brain.h"
@@ -742,7 +743,8 @@ int run_exercise(const ExerciseOptions& o, std::ostream& out, std::ostream& err)
     return kExitBadInput;
   }
   if (!fs::is_regular_file(o.skill_file)) {
-    err << "llsfsim exercise: no such skill file: " << o.skill_file << "\n";
+    err << "llsfsim exercise: no such skill file: " << o.skill_file
+        << core::near_path_hint(o.skill_file) << "\n";
     return kExitBadInput;
   }
   // Which seeds: --seeds LIST is a sweep; else --seed N or the exercise's first.

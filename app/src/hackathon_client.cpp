@@ -18,6 +18,7 @@
 #include <regex>
 
 #include "llsf/app/cli.h"
+#include "llsf/core/input_file.h"
 #include "llsf/study/submission_store.h"
 
 namespace llsf::app {
@@ -89,7 +90,7 @@ int submit_skill(const SubmitOptions& o, const std::string& exercise, const std:
   }
   std::error_code ec;
   if (!fs::is_regular_file(skill_file, ec)) {
-    err << who << "no such skill file: " << skill_file << "\n";
+    err << who << "no such skill file: " << skill_file << core::near_path_hint(skill_file) << "\n";
     return kExitBadInput;
   }
   std::ifstream f(skill_file, std::ios::binary);

@@ -57,7 +57,10 @@ RefboxSockets::RefboxSockets(comm::SocketConfig config, comm::LockNumbering lock
     comm::StreamServerOptions o;
     o.address = config_.address;
     o.port = config_.stream_port;
-    o.log = std::move(log);
+    o.log = [this, log = std::move(log)](std::string_view line) {
+      if (log) log(line);
+      if (transport_log_.size() < 100) transport_log_.emplace_back(line);
+    };
     try {
       server_ = std::make_unique<comm::StreamServer>(registry_, o);
     } catch (const std::runtime_error& e) {
@@ -207,6 +210,11 @@ void RefboxSockets::receive() {
           break;
       }
     }
+    // Frames dropped as malformed: told to the controllers as the 0.6.1 refbox did.
+    for (std::string& line : transport_log_) {
+      g.refbox_protocol().log_transport(refbox::ProtocolLogLine::Level::kWarn, std::move(line));
+    }
+    transport_log_.clear();
   }
   // UDP peers: every datagram read since the last call goes into the radio.
   io_.restart();

@@ -85,6 +85,9 @@ class RefboxSockets {
   sim::Game* game_ = nullptr;
   refbox::WireClock clock_;
   std::vector<std::uint8_t> frame_;  // encoding scratch
+  /// The stream server's log lines (dropped frames) since the last receive(): they go to the
+  /// controllers as LogMessages too (RefboxProtocol::log_transport).
+  std::vector<std::string> transport_log_;
 };
 
 }  // namespace llsf::app

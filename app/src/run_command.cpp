@@ -117,6 +117,7 @@ const study::Scenario* pick_variant(const study::ScenarioFile& f, const std::str
 /// skill and error (docs/llsfsim.md, "Issues").
 void print_issues(const study::RunResult& r, std::ostream& out) {
   int mistakes = 0;
+  int halted_late = 0;  // agent-halted issues shown after the first 10
   std::map<std::string, std::pair<int, double>> failures;  // "robot skill: error" -> (n, first)
   for (const study::RunIssue& i : r.issues) {
     if (!i.is_mistake()) {
@@ -128,7 +129,9 @@ void print_issues(const study::RunResult& r, std::ostream& out) {
       if (f.first++ == 0) f.second = i.time_s;
       continue;
     }
-    if (mistakes++ >= 10) continue;
+    // The first 10, and every agent-halted one (it says why the agent stopped playing).
+    if (mistakes++ >= 10 && i.kind != study::IssueKind::kAgentHalted) continue;
+    if (mistakes > 10) ++halted_late;
     std::string where;
     if (!i.rule.empty()) where = " rule " + i.rule;
     if (!i.file.empty()) where += " (" + i.place() + ")";
@@ -138,11 +141,12 @@ void print_issues(const study::RunResult& r, std::ostream& out) {
                        study::to_string(i.kind), where, text);
   }
   // r.mistakes counts those not kept too (RunResult::kMaxIssues).
-  if (r.mistakes > std::min(mistakes, 10)) {
+  const int shown_mistakes = std::min(mistakes, 10) + halted_late;
+  if (r.mistakes > shown_mistakes) {
     out << fmt::format(
         "issue      ... and {} more mistakes, {} in all (--json lists the first {} "
         "issues)\n",
-        r.mistakes - std::min(mistakes, 10), r.mistakes, study::RunResult::kMaxIssues);
+        r.mistakes - shown_mistakes, r.mistakes, study::RunResult::kMaxIssues);
   }
   int shown = 0;
   for (const auto& [what, f] : failures) {
@@ -424,27 +428,69 @@ struct AgentSource {
   }
 };
 
+/// One agent file's code with its comments blanked (lines and columns kept); "" when it cannot
+/// be read (the agent's load reports that).
+AgentSource read_agent_source(const std::string& f) {
+  std::string error;  // reported when the agent loads
+  AgentSource src{
+      f, core::try_read_input_file(f, core::kMaxSourceBytes, "CLIPS file", error).value_or("")};
+  bool in_string = false;
+  bool comment = false;
+  for (char& c : src.code) {
+    if (c == '\n') {
+      comment = false;
+    } else if (comment) {
+      c = ' ';
+    } else if (c == '"') {
+      in_string = !in_string;
+    } else if (c == ';' && !in_string) {
+      comment = true;
+      c = ' ';
+    }
+  }
+  return src;
+}
+
 std::vector<AgentSource> read_agent_sources(const std::vector<std::string>& entries) {
   std::vector<AgentSource> out;
-  for (const std::string& f : sim::agent_files(entries)) {
-    std::string error;  // reported when the agent loads
-    AgentSource src{
-        f, core::try_read_input_file(f, core::kMaxSourceBytes, "CLIPS file", error).value_or("")};
-    bool in_string = false;
-    bool comment = false;
-    for (char& c : src.code) {
-      if (c == '\n') {
-        comment = false;
-      } else if (comment) {
-        c = ' ';
-      } else if (c == '"') {
-        in_string = !in_string;
-      } else if (c == ';' && !in_string) {
-        comment = true;
-        c = ' ';
-      }
+  for (const std::string& f : sim::agent_files(entries)) out.push_back(read_agent_source(f));
+  return out;
+}
+
+/// A Fawkes-style agent's files in the order it loads them (docs/fawkes.md): the entry file,
+/// then each file a `(path-load FILE)` with a literal name loads (relative to the agent
+/// directory, inside it), at the place of that call, the files it path-loads after it; then the
+/// other .clp files of the entry file's directory in name order (a name computed at run time
+/// cannot be followed).
+std::vector<AgentSource> read_fawkes_sources(const std::string& agent_dir,
+                                             const std::string& entry) {
+  namespace fs = std::filesystem;
+  static const std::regex kPathLoad(R"re(\(path-load\s+(?:"([^"]*)"|([^\s()"]+)))re");
+  std::error_code ec;
+  const fs::path dir = fs::weakly_canonical(agent_dir, ec);
+  std::vector<AgentSource> out;
+  std::set<std::string> seen;
+  // Depth first, each file once: a file's own path-loads come right after it.
+  auto visit = [&](auto&& self, const fs::path& file) -> void {
+    std::error_code e;
+    const fs::path p = fs::weakly_canonical(file, e);
+    if (e || !fs::is_regular_file(p, e) || !seen.insert(p.string()).second) return;
+    const auto [d_end, p_it] = std::mismatch(dir.begin(), dir.end(), p.begin(), p.end());
+    if (d_end != dir.end()) return;  // outside the agent directory: the load refuses it
+    out.push_back(read_agent_source(file.string()));
+    const std::string code = out.back().code;
+    for (auto it = std::sregex_iterator(code.begin(), code.end(), kPathLoad);
+         it != std::sregex_iterator(); ++it) {
+      const std::string name = (*it)[1].matched ? (*it)[1].str() : (*it)[2].str();
+      const fs::path rel(name);
+      self(self, rel.is_absolute() ? rel : fs::path(agent_dir) / rel);
     }
-    out.push_back(std::move(src));
+  };
+  visit(visit, fs::path(entry));
+  for (const std::string& f : sim::agent_files({fs::path(entry).parent_path().string()})) {
+    std::error_code e;
+    const fs::path p = fs::weakly_canonical(f, e);
+    if (!e && !seen.contains(p.string())) out.push_back(read_agent_source(f));
   }
   return out;
 }
@@ -557,13 +603,11 @@ std::vector<AgentWarning> agent_warnings(const study::RobotSpec& spec,
   auto note = [&warnings](std::string text, bool in_run = false) {
     warnings.push_back({AgentWarning::Kind::kNote, in_run, std::move(text)});
   };
-  // A Fawkes-style agent's files are those it path-loads: the entry file's directory.
+  // A Fawkes-style agent's files in the order its entry file path-loads them (a deffunction
+  // that reads the time counts in the files loaded after its own).
   const std::vector<AgentSource> sources =
-      read_agent_sources(spec.fawkes && !spec.agent.empty()
-                             ? std::vector<std::string>{std::filesystem::path(spec.agent.front())
-                                                            .parent_path()
-                                                            .string()}
-                             : spec.agent);
+      spec.fawkes && !spec.agent.empty() ? read_fawkes_sources(spec.agent_dir, spec.agent.front())
+                                         : read_agent_sources(spec.agent);
   std::vector<std::string> skills;
   std::map<std::string, std::vector<std::string>> params;  // skill -> its @param names
   if (brain != nullptr) {
@@ -629,6 +673,14 @@ std::vector<AgentWarning> agent_warnings(const study::RobotSpec& spec,
     }
     return false;
   };
+  // Paths are compared after the shared "/clips-agent/": on whole paths the long prefix made any
+  // two short keys "near" (speed and roles).
+  auto key_of = [](const std::string& p) {
+    constexpr std::string_view kPrefix = "/clips-agent/";
+    return p.starts_with(kPrefix) ? p.substr(kPrefix.size()) : p;
+  };
+  std::vector<std::string> read_keys;  // read_paths' keys, same order
+  for (const std::string& p : read_paths) read_keys.push_back(key_of(p));
   std::vector<std::string> set_paths;
   for (const clips::ConfigEntry& e : spec.config) {
     if (e.path == "/clips-agent/use-locks") continue;             // the host's (robots.locks)
@@ -637,10 +689,24 @@ std::vector<AgentWarning> agent_warnings(const study::RobotSpec& spec,
     if (read_by_agent(e.path)) continue;
     // Either side may hold the typo: name the near path the agent reads and where, not a fix.
     std::string near;
-    if (const auto hint = core::closest_match(e.path, read_paths)) {
-      const auto i = std::find(read_paths.begin(), read_paths.end(), *hint) - read_paths.begin();
-      near = fmt::format("; it reads {} ({}): one of the two is misspelt", *hint,
+    if (const auto hint = core::closest_match(key_of(e.path), read_keys)) {
+      const auto i = std::find(read_keys.begin(), read_keys.end(), *hint) - read_keys.begin();
+      near = fmt::format("; it reads {} ({}): one of the two is misspelt",
+                         read_paths[static_cast<std::size_t>(i)],
                          read_where[static_cast<std::size_t>(i)]);
+    } else if (read_paths.empty()) {
+      near = "; its files name no /clips-agent/ path at all";
+    } else {
+      // No path near it: name what the agent reads, so the one meant can be found.
+      std::set<std::string> all(read_paths.begin(), read_paths.end());
+      std::string list;
+      int shown = 0;
+      for (const std::string& p : all) {
+        if (shown++ == 8) break;
+        list += (list.empty() ? "" : ", ") + p;
+      }
+      near = fmt::format("; it reads {}{}", list,
+                         all.size() > 8 ? fmt::format(", ... ({} paths)", all.size()) : "");
     }
     warn(fmt::format("robots.config: the agent reads no confval {}{}", e.path, near),
          /*in_run=*/true);

@@ -9,8 +9,11 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
+#include <vector>
 
 #include "llsf/core/error.h"
+#include "llsf/core/text.h"
 
 namespace llsf::core {
 
@@ -38,7 +41,7 @@ std::string read_or_throw(const std::string& path, std::uint64_t max_bytes, std:
   const std::string kind(what);
   const auto cannot_open = [&](int err) {
     return ConfigError(path + ": cannot open file: cannot read the " + kind + " (" +
-                       std::strerror(err) + ")");
+                       std::strerror(err) + ")" + (err == ENOENT ? near_path_hint(path) : ""));
   };
   const auto not_regular = [&](mode_t mode) {
     return ConfigError(path + ": not a regular file (" + kind_of(mode) + "); the " + kind +
@@ -84,6 +87,31 @@ std::string read_or_throw(const std::string& path, std::uint64_t max_bytes, std:
 }
 
 }  // namespace
+
+std::optional<std::string> near_path(const std::string& path) {
+  namespace fs = std::filesystem;
+  const fs::path p(path);
+  const std::string name = p.filename().string();
+  if (name.empty()) return std::nullopt;
+  const fs::path dir = p.parent_path();
+  std::error_code ec;
+  std::vector<std::string> names;
+  for (fs::directory_iterator it(dir.empty() ? fs::path(".") : dir, ec), end; !ec && it != end;
+       it.increment(ec)) {
+    if (names.size() == 10000) break;
+    names.push_back(it->path().filename().string());
+  }
+  if (ec) return std::nullopt;
+  std::sort(names.begin(), names.end());  // ties go to the first in name order
+  const std::optional<std::string> m = closest_match(name, names);
+  if (!m) return std::nullopt;
+  return (dir / *m).string();
+}
+
+std::string near_path_hint(const std::string& path) {
+  const std::optional<std::string> m = near_path(path);
+  return m ? " (did you mean '" + *m + "'?)" : "";
+}
 
 std::string read_input_file(const std::string& path, std::uint64_t max_bytes,
                             std::string_view what) {

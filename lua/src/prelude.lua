@@ -926,8 +926,9 @@ local function watch_spin(fsm, now, path, trs, progress)
              tr.from or "*", tr.to.name, tr.cond == true and "cond=true" or tr.label))
 end
 
--- The keys of vars the conditions of `st` read but nothing set, each with a set key near
--- enough to be what was meant: {{"arived", "arrived", tr}, ...} in name order.
+-- The keys of vars the conditions of `st` read and nothing has set, each with the set key near
+-- enough to be what was meant (nil if none is): {{"arived", "arrived", tr}, ...} in name order;
+-- and the keys that are set, in name order.
 local function missed_keys(fsm, st)
   local out = {}
   local set = {}
@@ -935,24 +936,28 @@ local function missed_keys(fsm, st)
     if type(k) == "string" then set[#set + 1] = k end
   end
   for k, tr in pairs(fsm.misses or {}) do
-    if tr.from == nil or tr.from == st.name then
-      local near = nearest(k, set)
-      if near then out[#out + 1] = {k, near, tr} end
+    if (tr.from == nil or tr.from == st.name) and rawget(fsm.vars, k) == nil then
+      out[#out + 1] = {k, nearest(k, set), tr}
     end
   end
   table.sort(out, function(a, b) return a[1] < b[1] end)
-  return out
+  table.sort(set)
+  return out, set
 end
 
 -- A state that has waited kWaitNs on a condition that reads a key of vars nothing set, while a
--- key near it is set: a typo, so the condition never holds. One warning per key and entry.
+-- key near it is set: a typo, so the condition never holds. One warning per key and entry. (A
+-- key with no set key near it may still be set later, by a loop that finds something: only the
+-- report of a skill still running at the end names it.)
 local kWaitNs = 5 * 1000000000
 watch_misses = function(fsm, st, now)
   for _, m in ipairs(missed_keys(fsm, st)) do
     local k, near, tr = m[1], m[2], m[3]
-    log(2, fmt("%s: %s: state '%s' has waited %.0f s on %s, which reads vars.%s: nothing set " ..
-               "it (did you mean vars.%s?), so the condition never holds", tr.where, fsm.name,
-               st.name, (now - st.entered_ns) / 1e9, tr.shown, k, near))
+    if near then
+      log(2, fmt("%s: %s: state '%s' has waited %.0f s on %s, which reads vars.%s: nothing " ..
+                 "set it (did you mean vars.%s?), so the condition never holds", tr.where,
+                 fsm.name, st.name, (now - st.entered_ns) / 1e9, tr.shown, k, near))
+    end
   end
 end
 
@@ -1373,8 +1378,18 @@ function E.skill_wait(name)
   for _, tr in ipairs(st.transitions) do waits[#waits + 1] = fmt("%s (%s)", tr.shown, tr.where) end
   for _, tr in ipairs(fsm.defaults) do waits[#waits + 1] = fmt("%s (%s)", tr.shown, tr.where) end
   out = out .. ", waiting for " .. (#waits > 0 and concat(waits, " or ") or "nothing: no way out")
-  for _, m in ipairs(missed_keys(fsm, st)) do
-    out = out .. fmt("; vars.%s is never set (did you mean vars.%s?)", m[1], m[2])
+  local missed, set = missed_keys(fsm, st)
+  for _, m in ipairs(missed) do
+    if m[2] then
+      out = out .. fmt("; vars.%s is never set (did you mean vars.%s?)", m[1], m[2])
+    else
+      -- No set key is near it: name what is set, so a misspelling or a missing assignment shows.
+      local shown = {}
+      for i = 1, math.min(#set, 8) do shown[i] = "vars." .. set[i] end
+      out = out .. fmt("; vars.%s is never set (%s)", m[1], #set == 0 and
+                         "the skill has set no key of vars" or
+                         "what is set: " .. concat(shown, ", ") .. (#set > 8 and ", ..." or ""))
+    end
   end
   return out
 end

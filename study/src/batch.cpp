@@ -64,6 +64,10 @@ std::vector<std::uint64_t> parse_seed_list(std::string_view text) {
     const std::string_view item =
         text.substr(pos, comma == std::string_view::npos ? std::string_view::npos : comma - pos);
     const std::size_t dash = item.find('-');
+    if (dash == 0) {  // not a range with its first seed missing: a negative seed
+      throw core::ConfigError("--seeds " + std::string(text) + ": '" + std::string(item) +
+                              "' is negative: a seed is a whole number from 0 (a range is A-B)");
+    }
     std::uint64_t first = 0;
     std::uint64_t last = 0;
     if (dash == std::string_view::npos) {

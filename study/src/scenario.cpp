@@ -154,6 +154,15 @@ bool has_clp_file(const std::string& dir) {
   return false;
 }
 
+// " (did you mean 'NEAR'?)" for a missing path `rel` (as the scenario wrote it; `looked` is where
+// it was looked for): the near name of that folder, written as the scenario would write it.
+std::string near_hint(const std::string& rel, const std::string& looked) {
+  const std::optional<std::string> m = core::near_path(looked);
+  if (!m) return "";
+  const fs::path meant = fs::path(rel).parent_path() / fs::path(*m).filename();
+  return " (did you mean '" + meant.string() + "'?)";
+}
+
 std::vector<std::string> read_agent(const core::ConfigNode& n, const std::string& dir) {
   std::vector<std::string> out;
   const std::vector<std::string> entries = string_list(n);
@@ -162,7 +171,8 @@ std::vector<std::string> read_agent(const core::ConfigNode& n, const std::string
     std::error_code ec;
     const core::ConfigNode at = n.is_sequence() ? n.at(static_cast<int>(i)) : n;
     if (!fs::exists(p, ec)) {
-      at.fail("agent file or directory '" + entries[i] + "' not found (looked at " + p + ")");
+      at.fail("agent file or directory '" + entries[i] + "' not found (looked at " + p + ")" +
+              near_hint(entries[i], p));
     }
     if (fs::is_directory(p, ec) && !has_clp_file(p)) {
       at.fail("agent directory '" + entries[i] + "' has no .clp files (looked at " + p + ")");
@@ -184,7 +194,8 @@ std::string inside(const core::ConfigNode& at, const std::string& root, const st
             " (an agent reads only its own directory: docs/security.md)");
   }
   if (!fs::exists(p, ec))
-    at.fail(std::string(what) + " '" + rel + "' not found (looked at " + p.string() + ")");
+    at.fail(std::string(what) + " '" + rel + "' not found (looked at " + p.string() + ")" +
+            near_hint(rel, p.string()));
   return p.string();
 }
 
@@ -194,7 +205,8 @@ void read_fawkes_agent(const core::ConfigNode& n, const std::string& dir, RobotS
   spec.agent_dir = resolve(dir, d.as_string());
   std::error_code ec;
   if (!fs::is_directory(spec.agent_dir, ec)) {
-    d.fail("agent directory '" + d.as_string() + "' not found (looked at " + spec.agent_dir + ")");
+    d.fail("agent directory '" + d.as_string() + "' not found (looked at " + spec.agent_dir + ")" +
+           near_hint(d.as_string(), spec.agent_dir));
   }
   const core::ConfigNode e = n.at("entry");
   std::string entry = e.as_string();

@@ -131,3 +131,67 @@ TEST_CASE("check and run warn on a time test CLIPS never evaluates again, with f
   CHECK(has(r.err, "llsfsim run: warn: "));
   CHECK(has(r.err, want));
 }
+
+TEST_CASE("check reads a Fawkes-style agent's files in the order its entry file loads them") {
+  // The entry loads zz_clock.clp (a deffunction that reads the time) before aa_rules.clp (a
+  // test that calls it): in name order the test would come first and look harmless.
+  const TempDir dir;
+  write(dir, "fk/agent/demo.clp",
+        "(path-load agent/zz_clock.clp)\n"
+        "(path-load \"agent/aa_rules.clp\")\n");
+  write(dir, "fk/agent/zz_clock.clp", "(deffunction clock-over (?t) (> (now) ?t))\n");
+  write(dir, "fk/agent/aa_rules.clp",
+        "(deftemplate alarm (slot at (type FLOAT)))\n"
+        "(defrule due\n"
+        "  ?f <- (alarm (at ?t))\n"
+        "  (test (clock-over ?t))\n"
+        "  =>\n"
+        "  (retract ?f))\n");
+  write(dir, "s.yaml",
+        "name: c\nduration_s: 1\nrobots:\n  count: 1\n"
+        "  agent: {fawkes: fk, entry: agent/demo.clp}\n");
+  const auto c = llsfsim({"check", dir.file("s.yaml")});
+  INFO(c.out, c.err);
+  CHECK(c.code == 0);  // a warning
+  CHECK(has(c.out,
+            "aa_rules.clp:4: rule due: (test ...) reads the time ((clock-over ...), which calls "
+            "(now))"));
+}
+
+TEST_CASE("a confval the agent does not read, with no path near it: what the agent reads") {
+  const TempDir dir;
+  write(dir, "agent/a.clp",
+        "(defrule roles (confval (path \"/clips-agent/roles\")) => )\n"
+        "(defrule ms (confval (path \"/clips-agent/machines\")) => )\n");
+  write(dir, "s.yaml",
+        "name: c\nduration_s: 1\nrobots:\n  count: 1\n  agent: [agent]\n"
+        "  config: {speed: 3}\n");
+  const std::string want =
+      "robots.config: the agent reads no confval /clips-agent/speed; it reads "
+      "/clips-agent/machines, /clips-agent/roles\n";
+  const auto c = llsfsim({"check", dir.file("s.yaml")});
+  INFO(c.out, c.err);
+  CHECK(c.code == 0);
+  CHECK(has(c.out, "warn " + dir.file("s.yaml") + ": " + want));
+  const auto r = llsfsim({"run", dir.file("s.yaml"), "--no-db", "--no-record"});
+  CHECK(has(r.err, "llsfsim run: warn: " + want));
+  // An agent that names no confval at all.
+  write(dir, "agent/a.clp", "(defrule idle (time $?) (not (idle)) => (assert (idle)))\n");
+  const auto n = llsfsim({"check", dir.file("s.yaml")});
+  CHECK(has(n.out,
+            "the agent reads no confval /clips-agent/speed; its files name no /clips-agent/ "
+            "path at all\n"));
+}
+
+TEST_CASE("a misspelt path: the scenario file or an agent directory gets the name meant") {
+  const TempDir dir;
+  write(dir, "agents/a.clp", "(defrule idle (time $?) (not (idle)) => (assert (idle)))\n");
+  write(dir, "s.yaml", "name: c\nduration_s: 1\nrobots: {count: 1, agent: [agnets]}\n");
+  const auto c = llsfsim({"check", dir.file("s.yaml")});
+  CHECK(c.code == 2);
+  CHECK(has(c.err, "robots.agent[0]: agent file or directory 'agnets' not found (looked at "));
+  CHECK(has(c.err, "agnets) (did you mean 'agents'?)"));
+  const auto r = llsfsim({"run", dir.file("s.yml"), "--no-db", "--no-record"});
+  CHECK(r.code == 2);
+  CHECK(has(r.err, "(No such file or directory) (did you mean '" + dir.file("s.yaml") + "'?)"));
+}

@@ -219,3 +219,17 @@ TEST_CASE("exercise: every state a step passes is printed; --trace says what too
   CHECK(has(f.out, "drive_to_point: DRIVE -> CHECK  (its sub-skills ended FINAL (final_to))\n"));
   CHECK(has(f.out, "drive_to_point: CHECK -> FINAL  ({\"CHECK\", \"FINAL\", cond=<function>} at "));
 }
+
+TEST_CASE("exercise: a condition on a key of vars nothing sets and no set key is near") {
+  // vars.reached, while the skill sets vars.arrived: no did-you-mean, so the why names what is
+  // set; no warning during the game (a key may be set later, by a loop that finds something).
+  const std::string path = kMistakes + "unset_vars.lua";
+  const Run r = llsfsim({"exercise", "01", "--skill", path});
+  INFO(r.out, r.err);
+  CHECK(r.code == llsf::app::kExitFailed);
+  CHECK(has(r.out, ", waiting for {\"CHECK\", \"FINAL\", cond=\"vars.reached\"} ("));
+  const std::size_t at = r.out.find("; vars.reached is never set (what is set: ");
+  REQUIRE(at != std::string::npos);
+  CHECK(r.out.substr(at, r.out.find('\n', at) - at).find("vars.arrived") != std::string::npos);
+  CHECK_FALSE(has(r.out, " warn: "));
+}

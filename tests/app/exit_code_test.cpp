@@ -135,6 +135,19 @@ TEST_CASE("counts and seeds out of range: a readable error, no wrap-around") {
   r = llsfsim({"run", kDefault, "--seed", "18446744073709551616", "--no-db", "--no-record"});
   CHECK(r.code == llsf::app::kExitBadInput);
   CHECK(has(r.err, "a seed is a whole number"));
+  // In a seed list: negative, not an "empty" first seed of a range.
+  r = llsfsim({"batch", kDefault, "--seeds", "-1", "--db", dir.file("s.db")});
+  CHECK(r.code == llsf::app::kExitBadInput);
+  CHECK(has(r.err, "--seeds -1: '-1' is negative: a seed is a whole number from 0"));
+}
+
+TEST_CASE("exercise: a misspelt skill file gets the name meant") {
+  const TempDir dir;
+  dir.write("my_drive.lua", "-- a skill\n");
+  const Run r = llsfsim({"exercise", "01", "--skill", dir.file("my_drvie.lua")});
+  CHECK(r.code == llsf::app::kExitBadInput);
+  CHECK(has(r.err, "no such skill file: " + dir.file("my_drvie.lua") + " (did you mean '" +
+                       dir.file("my_drive.lua") + "'?)"));
 }
 
 TEST_CASE("run --variant on a scenario without a matrix says there are no variants") {

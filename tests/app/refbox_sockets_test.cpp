@@ -13,6 +13,7 @@
 #include <llsf_msgs/VersionInfo.pb.h>
 
 #include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/write.hpp>
 #include <chrono>
 #include <cstdint>
 #include <ctime>
@@ -420,4 +421,57 @@ TEST_CASE("refbox sockets with radio lock_messages 2013: the peers' lock message
     }
   }
   CHECK(announces >= 1);
+}
+
+TEST_CASE("refbox sockets: a controller's malformed frame is logged and sent as a LogMessage") {
+  const llsf::test::TempDir dir("llsf_app_sockets_log");
+  dir.write("s.yaml", "name: lm\nstart: exploration\nduration_s: 3\nrobots: {count: 1}\n");
+  llsf::comm::SocketConfig sc;
+  sc.stream_port = 0;
+  std::vector<std::string> logged;
+  llsf::study::Scenario scenario = llsf::study::load_scenario(dir.file("s.yaml")).variants.at(0);
+  llsf::app::RefboxSockets sockets(sc, scenario.game.hub.lock_messages,
+                                   [&logged](std::string_view l) { logged.emplace_back(l); });
+  REQUIRE(sockets.stream_port() > 0);
+  const llsf::comm::MessageRegistry registry = refbox_registry();
+  // One controller listens; a second one sends a frame of a type nobody registered.
+  llsf::comm::StreamClient listener(registry);
+  REQUIRE(listener.connect("127.0.0.1", sockets.stream_port(), std::chrono::seconds(5)));
+  boost::asio::io_context io;
+  boost::asio::ip::tcp::socket raw(io);
+  raw.connect(boost::asio::ip::tcp::endpoint(boost::asio::ip::make_address("127.0.0.1"),
+                                             static_cast<unsigned short>(sockets.stream_port())));
+  llsf_msgs::BeaconSignal beacon;
+  beacon.mutable_time()->set_sec(0);
+  beacon.mutable_time()->set_nsec(0);
+  beacon.set_seq(1);
+  beacon.set_team_name("Carologistics");
+  beacon.set_peer_name("ext1");
+  beacon.set_number(7);
+  std::vector<std::uint8_t> bad = registry.encode(beacon);
+  bad[3] = 77;  // the message type's low byte: no such type
+  boost::asio::write(raw, boost::asio::buffer(bad));
+  std::vector<std::string> told;
+  llsf::study::RunHooks hooks;
+  hooks.attach = [&sockets](llsf::sim::Game& g) { sockets.attach(g); };
+  hooks.tick = [&](const llsf::sim::Game&) {
+    sockets.send_tick();
+    sockets.receive();
+    listener.run_for(std::chrono::milliseconds(1));
+    for (llsf::comm::StreamEvent& e : listener.take_events()) {
+      if (e.kind != llsf::comm::StreamEvent::Kind::kMessage ||
+          e.message->GetTypeName() != "llsf_log_msgs.LogMessage") {
+        continue;
+      }
+      told.push_back(static_cast<const llsf_log_msgs::LogMessage&>(*e.message).message());
+    }
+  };
+  (void)llsf::study::run_game(scenario, 1, hooks);
+  // The user's log line ...
+  REQUIRE(logged.size() == 1);
+  CHECK(logged[0].find("dropped a frame (component 2000, type 77") != std::string::npos);
+  // ... and the controllers' LogMessage with the same text (as refbox 0.6.1's network logger).
+  bool found = false;
+  for (const std::string& t : told) found = found || t.find(logged[0]) != std::string::npos;
+  CHECK(found);
 }

@@ -97,3 +97,37 @@ TEST_CASE("run and batch --fail-fast stop at the first agent error") {
   CHECK(has(list.out, "1 variant(s) x 4 run(s)  unfinished"));  // 3 seeds never played
   CHECK(llsfsim({"batch", dir.file("s.yaml"), "--slurm", "--fail-fast"}).code == 2);
 }
+
+TEST_CASE("the summary shows the agent-halted issue also after the first 10 issue lines") {
+  // (while TRUE) in every cycle: 10 runtime errors (the work budget), then the agent is halted.
+  const TempDir dir;
+  std::filesystem::create_directories(dir.file("agent"));
+  std::ofstream(dir.file("agent/a.clp"))
+      << "(defrule spin (time $?) => (while TRUE do (bind ?x 1)))\n";
+  std::ofstream(dir.file("s.yaml")) << "name: spin\nduration_s: 5\n"
+                                       "robots: {count: 1, agent: [agent]}\n";
+  const auto r = llsfsim({"run", dir.file("s.yaml"), "--no-db", "--no-record"});
+  INFO(r.out, r.err);
+  CHECK(r.code == 1);
+  CHECK(has(r.out, "robot1 agent-halted"));
+  CHECK_FALSE(has(r.out, "more mistakes"));  // 11 in all, every one shown
+}
+
+TEST_CASE("a rule that re-fires forever: the recording stays small (the agent is halted)") {
+  // 10,000 firings a cycle from 2 s on: before runaway agents were halted, every cycle of the
+  // game recorded them (578 MB for a 900 s game); now 10 cycles do. 60 s of game.
+  const TempDir dir;
+  std::filesystem::create_directories(dir.file("agent"));
+  std::ofstream(dir.file("agent/a.clp"))
+      << "(defrule start-spin (time ?s ?) (test (>= ?s 2)) (not (spun)) => (assert (spun) "
+         "(spin 0)))\n"
+         "(defrule spin ?f <- (spin ?n) => (retract ?f) (assert (spin (+ ?n 1))))\n";
+  std::ofstream(dir.file("s.yaml")) << "name: spin\nduration_s: 60\n"
+                                       "robots: {count: 1, agent: [agent]}\n";
+  const auto r =
+      llsfsim({"run", dir.file("s.yaml"), "--no-db", "--record", dir.file("r.jsonl.gz"), "-q"});
+  CHECK(r.code == 1);
+  const auto bytes = std::filesystem::file_size(dir.file("r.jsonl.gz"));
+  CAPTURE(bytes);
+  CHECK(bytes < 1'000'000);  // about 250 kB: the 10 cycles before the halt
+}

@@ -110,6 +110,22 @@ TEST_CASE("read_input_file names a file it cannot open; try_read_input_file retu
   CHECK(error.empty());
 }
 
+TEST_CASE("a misspelt file name gets the near name of its folder") {
+  const llsf::test::TempDir dir;
+  dir.write("default.yaml", "name: a\n");
+  dir.write("other.yaml", "name: b\n");
+  CHECK(read_error(dir.file("defualt.yaml")) ==
+        dir.file("defualt.yaml") +
+            ": cannot open file: cannot read the scenario file (No such file or directory) (did "
+            "you mean '" +
+            dir.file("default.yaml") + "'?)");
+  CHECK(llsf::core::near_path(dir.file("defualt.yaml")) == dir.file("default.yaml"));
+  // Nothing near, or no such folder: no hint.
+  CHECK(llsf::core::near_path(dir.file("zzzzzzzz.yaml")) == std::nullopt);
+  CHECK(llsf::core::near_path(dir.file("no-dir/default.yaml")) == std::nullopt);
+  CHECK(llsf::core::near_path_hint(dir.file("zzzzzzzz.yaml")).empty());
+}
+
 TEST_CASE("byte_size_text, text_position and find_invalid_utf8") {
   using llsf::core::byte_size_text;
   CHECK(byte_size_text(1) == "1 byte");

@@ -31,7 +31,7 @@ TEST_CASE("--seeds: lists and ranges, bounded, each seed once") {
   CHECK(parse_seed_list("9223372036854775807") == Seeds{9223372036854775807ULL});
   CHECK_THROWS_WITH_AS(parse_seed_list("1,,2"), doctest::Contains("is empty"), ConfigError);
   CHECK_THROWS_WITH_AS(parse_seed_list("1,a"), doctest::Contains("'a' is not a seed"), ConfigError);
-  CHECK_THROWS_WITH_AS(parse_seed_list("-3"), doctest::Contains("is empty"), ConfigError);
+  CHECK_THROWS_WITH_AS(parse_seed_list("-3"), doctest::Contains("'-3' is negative"), ConfigError);
   CHECK_THROWS_WITH_AS(parse_seed_list("5-3"), doctest::Contains("empty range"), ConfigError);
   CHECK_THROWS_WITH_AS(parse_seed_list("1-3,2"), doctest::Contains("seed 2 is given twice"),
                        ConfigError);

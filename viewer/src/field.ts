@@ -88,6 +88,20 @@ export interface DrawStats {
   sightings: number;
   /// Of them, from each robot's latest frame (age below one camera frame, 0.15 s).
   freshSightings: number;
+  /// Each robot drawn with a held puck: where its labels and the puck are (canvas CSS pixels,
+  /// y down), for the check that the labels keep clear of the puck (viewer_e2e).
+  heldLabels: HeldLabel[];
+}
+
+/// A robot holding a puck as drawn: its heading (rad), the bottom of its name label, the top of
+/// its skill label (null: none drawn) and the puck's top and bottom.
+export interface HeldLabel {
+  robot: string;
+  th: number;
+  nameBottom: number;
+  skillTop: number | null;
+  puckTop: number;
+  puckBottom: number;
 }
 
 /// Options of drawField.
@@ -158,6 +172,7 @@ export function drawField(
     cones: 0,
     sightings: 0,
     freshSightings: 0,
+    heldLabels: [],
   };
   const hack = header.hackathon;
 
@@ -493,12 +508,16 @@ export function drawField(
     // out there (it used to be drawn over the skill label when the robot faced down).
     let nameY = Y(y) - rr - 2;
     let skillY = Y(y) + rr + 2;
+    let held: HeldLabel | null = null;
     if (heldId > 0) {
       const hx = X(x) + Math.cos(th) * (rr + pr * 0.6);
       const hy = Y(y) - Math.sin(th) * (rr + pr * 0.6);
       drawPuck(ctx, hx, hy, pr, look(heldId), heldId, fontPx);
       nameY = Math.min(nameY, hy - pr - 2);
       skillY = Math.max(skillY, hy + pr + 2);
+      held = {robot: name, th, nameBottom: nameY, skillTop: null, puckTop: hy - pr,
+              puckBottom: hy + pr};
+      stats.heldLabels.push(held);
     }
     // A radio drop from this robot in the last second: a red flash on its rim.
     if (rs && time - rs.dropT >= 0 && time - rs.dropT < 1) {
@@ -527,6 +546,7 @@ export function drawField(
         rs.status === "FAILED" ? "#c0392b" : rs.status === "FINAL" ? "#2e7d32" : "#333";
       const st = rs.skillState && rs.status === "RUNNING" ? ` · ${rs.skillState}` : "";
       ctx.fillText(`${short} ${rs.status}${st}`, X(x), skillY);
+      if (held) held.skillTop = skillY;
     }
     stats.robots++;
   });

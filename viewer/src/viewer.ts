@@ -7,7 +7,7 @@
 //   #/live        the live game (WebSocket /api/live)
 // Test hook: window.llsfViewer (see Replay.hook); #app carries data-page and data-ready.
 import {AgentPanel, fmtTime, type AgentView} from "./agent_panel";
-import {colourCss, drawField, fieldScale, kPuckColors, kRobotColors} from "./field";
+import {colourCss, drawField, fieldScale, HeldLabel, kPuckColors, kRobotColors} from "./field";
 import {Cursor, kSightingMemory, Recording, type State} from "./recording";
 import {skillSection, verdictBanner, type SkillView} from "./skill_panel";
 import {el, renderReport, table, type Child, type ReportData} from "./report_view";
@@ -75,6 +75,8 @@ interface DebugView {
   markers: {t: number; kind: string; label: string; x: number}[];
   grid: boolean;
   mouse: string;
+  /// The robots drawn with a held puck: their labels' and the puck's extent (field.ts).
+  heldLabels: HeldLabel[];
 }
 
 declare global {
@@ -198,6 +200,7 @@ class Replay {
     cones: 0,
     sightings: 0,
     freshSightings: 0,
+    heldLabels: [] as HeldLabel[],
   };
   private maxSightings = 0;
   private skillViews: SkillView[] = [];
@@ -498,6 +501,7 @@ class Replay {
           })),
           grid: this.grid,
           mouse: this.mouseLabel.textContent ?? "",
+          heldLabels: this.lastStats.heldLabels.map((h) => ({...h})),
         };
       },
       setGrid: (on: boolean) => this.setGrid(on),

@@ -8,9 +8,10 @@
 // exercise 01 through the page's form -- first the unchanged skeleton (exercises/01-*/skill.lua,
 // it fails), then a reference solution (tests/app/exercises/01-drive-to-point.lua) -- waits until
 // both are played, and checks that the board ranks the reference first (5/5 seeds) and the
-// skeleton second, that a bad submission (no team) is refused with the server's message on the
-// page, and that no seed number reaches the page. Then restarts the server on the same store: the
-// board is still there. Saves a screenshot to ARTIFACT_DIR. Exit code 0, or 1 with a message.
+// skeleton second, that the skeleton's FAIL shows its reason on the page, that a bad submission
+// (no team) is refused with the server's message on the page, and that no seed number reaches the
+// page. Then restarts the server on the same store: the board is still there. Saves a screenshot
+// to ARTIFACT_DIR. Exit code 0, or 1 with a message.
 import {spawn} from "node:child_process";
 import {mkdirSync, mkdtempSync, rmSync} from "node:fs";
 import {tmpdir} from "node:os";
@@ -115,6 +116,13 @@ try {
   for (const seed of ["7771", "7772", "7773"]) {
     check(!html.includes(seed), `a hidden seed (${seed}) is on the page`);
   }
+  // The skeleton's FAIL says why on the page: its first run not passed (no seed named).
+  const reasonShown = () => [...document.querySelectorAll("#recent tbody td.error")]
+    .some((td) => td.textContent.includes("not solved yet"));
+  await page.waitForFunction(reasonShown, null, {timeout: 30_000}).catch(() => {});
+  const reasons = await page.$$eval("#recent tbody td.error", (tds) => tds.map((td) => td.textContent));
+  check(reasons.some((r) => r.startsWith("run 1 of 3: ") && r.includes("not solved yet")),
+    `the failed submission shows no reason on the page: ${JSON.stringify(reasons)}`);
   const api = await (await fetch(`${url}api/hackathon/submissions/2`)).text();
   check(!/777[123]/.test(api), `a hidden seed is in the API's answer: ${api}`);
   mkdirSync(artifacts, {recursive: true});

@@ -8,7 +8,11 @@
 // stdout line, then in Chromium (/usr/bin/chromium via playwright-core; no browser is downloaded):
 //   1. #/run/ID: the field shows 16 devices and every robot; seeking the timeline to two times
 //      moves the robots;
-//   2. #/batch/ID: one box per variant in the points plot, a row per run in the runs table;
+//      every robot holding a puck has its name and skill labels clear of the puck (sampled every
+//      0.5 s; at least one sample faces up or down);
+//   2. #/: a single game of `llsfsim run` in the same store is listed as "single games" (neither
+//      finished nor running); #/batch/ID: one box per variant in the points plot, a row per run
+//      in the runs table;
 //   3. #/live: a 300 s game played with `llsfsim run --speed 20 --serve --serve-exit --port 0`;
 //      the shown game time advances.
 // Screenshots go to ARTIFACT_DIR (default: the current directory). Exit code 0, or 1 with a
@@ -72,13 +76,18 @@ try {
     ["batch", "e2e.yaml", "--runs", String(kRuns), "--db", "tmp.db", "--jobs", "2", "--quiet"],
     {cwd: tmp, encoding: "utf8", stdio: ["ignore", "pipe", "pipe"], env, timeout: 300_000},
   );
+  // A single game of `llsfsim run` in the same store: the batches page calls it that, neither
+  // finished nor running.
+  execFileSync(llsfsim, ["run", "e2e.yaml", "--db", "tmp.db", "--no-record", "-q"],
+               {cwd: tmp, encoding: "utf8", stdio: ["ignore", "pipe", "pipe"], env, timeout: 300_000});
   mkdirSync(artifacts, {recursive: true});
   const {url} = await startServer(["serve", "--port", "0", "--db", "tmp.db"], tmp);
 
   // The API, as far as the pages need it.
   const batches = await getJson(`${url}api/batches`);
-  check(batches.length >= 1, "GET /api/batches: no batch");
-  const batch = batches[batches.length - 1];
+  check(batches.length >= 2, "GET /api/batches: not the batch and the single run");
+  const batch = batches.find((b) => b.kind !== "run");
+  check(batch, `GET /api/batches: no batch but single runs: ${JSON.stringify(batches)}`);
   const runs = await getJson(`${url}api/batches/${batch.id}/runs`);
   check(runs.length === kVariants * kRuns, `batch ${batch.id} has ${runs.length} run(s)`);
   const run = runs.find((r) => r.recording);
@@ -138,11 +147,34 @@ try {
     check(s.drawn === 2 && s.robots.length === 2,
           `${s.drawn} robot(s) drawn at ${s.time} s, expected 2`);
   }
+  // The labels keep clear of a held puck: every 0.5 s of the game, each robot holding one has
+  // its name label above the puck and its skill label below it, whichever way it faces.
+  const held = [];
+  for (let t = 0; t <= end; t += 0.5) {
+    held.push(...(await page.evaluate((at) => {
+      window.llsfViewer.seek(at);
+      return window.llsfViewer.debug().heldLabels.map((h) => ({...h, t: at}));
+    }, t)));
+  }
+  check(held.some((h) => Math.abs(Math.sin(h.th)) > 0.7),
+        `no robot held a puck facing up or down in ${held.length} sample(s): the check checks nothing`);
+  const clash = held.filter((h) => h.nameBottom > h.puckTop + 1e-6 ||
+                                   (h.skillTop !== null && h.skillTop < h.puckBottom - 1e-6));
+  check(clash.length === 0, `a label drawn over the held puck: ${JSON.stringify(clash.slice(0, 3))}`);
   const moved = a.robots.some((r, i) => Math.hypot(r.x - b.robots[i].x, r.y - b.robots[i].y) > 0.05);
   check(moved, `the robots did not move between ${a.time} s and ${b.time} s: ` +
         JSON.stringify([a.robots, b.robots]));
 
-  // 2. The batch: one box per variant in the points plot, a row per run.
+  // 2. The batches: the single game of `run` is neither finished nor running.
+  await page.goto(`${url}#/`);
+  await page.waitForSelector("#app[data-ready], #app[data-error]", {timeout: 30_000});
+  const rowsText = await page.locator('table[data-table="batches"] tbody tr').allInnerTexts();
+  check(rowsText.some((r) => r.includes("single games")),
+        `the batches table shows no single games row: ${JSON.stringify(rowsText)}`);
+  check(!rowsText.some((r) => r.includes("single games") && r.includes("running")),
+        `a single games row says running: ${JSON.stringify(rowsText)}`);
+
+  // The batch: one box per variant in the points plot, a row per run.
   await page.goto(`${url}#/batch/${batch.id}`);
   await page.waitForSelector("#app[data-ready], #app[data-error]", {timeout: 30_000});
   const batchError = await page.getAttribute("#app", "data-error");
@@ -185,7 +217,7 @@ try {
   ok = true;
   console.log(
     `${kName}: ok: run ${run.id} seeks ${a.time.toFixed(1)} s -> ${b.time.toFixed(1)} s, ` +
-      `${boxes} boxes, live ${t0.toFixed(1)} s -> ${t1.toFixed(1)} s; screenshots in ${artifacts}`,
+      `${held.length} held-puck samples with clear labels, ${boxes} boxes, live ${t0.toFixed(1)} s -> ${t1.toFixed(1)} s; screenshots in ${artifacts}`,
   );
 } catch (e) {
   const output = e.stderr ? `\n${e.stderr}` : "";

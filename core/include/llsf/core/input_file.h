@@ -16,7 +16,8 @@ inline constexpr std::uint64_t kMaxSourceBytes = std::uint64_t{16} << 20;
 
 /// The text of the file at `path`. Throws ConfigError, without ever opening a file that is not a
 /// regular one:
-///   "PATH: cannot open file: cannot read the WHAT (No such file or directory)"
+///   "PATH: cannot open file: cannot read the WHAT (No such file or directory)", then
+///   " (did you mean 'NEAR'?)" when the folder has a name near it (near_path)
 ///   "PATH: not a regular file (a named pipe); the WHAT must be one"
 ///   "PATH: 2.0 GiB is over the limit of 16 MiB for the WHAT"
 ///   "PATH:LINE:COLUMN: a NUL byte: the WHAT must be text"
@@ -28,6 +29,15 @@ std::string read_input_file(const std::string& path, std::uint64_t max_bytes,
 /// (for loaders with their own error type).
 std::optional<std::string> try_read_input_file(const std::string& path, std::uint64_t max_bytes,
                                                std::string_view what, std::string& error);
+
+/// For a path that does not exist: the path with its last part replaced by the name of its
+/// folder's entry nearest to it (a likely typo: `scenarios/defualt.yaml` ->
+/// `scenarios/default.yaml`; core::closest_match), else nullopt (the folder missing, or nothing
+/// near). Reads at most 10,000 entries of the folder.
+std::optional<std::string> near_path(const std::string& path);
+
+/// " (did you mean 'NEAR'?)" for near_path(path), else "".
+std::string near_path_hint(const std::string& path);
 
 /// A byte count for messages: "512 bytes", "1.5 KiB", "16 MiB", "2.0 GiB".
 std::string byte_size_text(std::uint64_t bytes);

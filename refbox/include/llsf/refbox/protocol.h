@@ -192,6 +192,13 @@ class RefboxProtocol {
   std::span<const Outgoing> outgoing() const { return out_; }
   /// The engine's output of the last step (referee actions, lights, awards, ...).
   const StepOutput& engine_output() const { return *engine_out_; }
+  /// A line from the transport in front of the adapter (a controller's frame the stream server
+  /// dropped as malformed): into the adapter's log, and to the stream clients as a LogMessage
+  /// with the next step, as refbox 0.6.1 logged a client's failed message (handle_client_fail)
+  /// through its network logger.
+  void log_transport(ProtocolLogLine::Level level, std::string text) {
+    log(level, std::move(text));
+  }
   /// The adapter's log lines of the last step (including those of receive() calls before it).
   std::span<const ProtocolLogLine> log() const { return log_out_; }
   /// The engine (its snapshot).
