@@ -969,6 +969,8 @@ function F.send(type_name, id, name, values)
   end
   local class = message_class(type_name, name, fields)
   local msg = class.new(class)
+  -- (a field not given is false: the writers take their default for it)
+  for _, f in ipairs(fields) do rawset(msg, f, false) end
   for k, v in pairs(values) do rawset(msg, k, v) end
   return common.msgq_enqueue_copy(obj, msg)
 end

@@ -457,10 +457,10 @@ TEST_CASE("blackboard: every interface type the skills have, read from the robot
   CHECK(f.has("(motor 0.25 \"skiller\")"));
   CHECK(f.has("(switch TRUE)"));
   CHECK(f.has("(ampel RED)"));
-  CHECK(f.facts("cluster").empty());           // nothing writes it
+  CHECK(f.facts("cluster").empty());                 // nothing writes it
   CHECK(f.has("(skiller S_RUNNING \"ppgoto{}\")"));  // the enum's value by its number
-  CHECK(f.has("(sensor 0.0 8)"));              // the array at its length, the rest defaults
-  CHECK(f.facts("NavigatorInterface").empty());  // retracted at the end of the cycle
+  CHECK(f.has("(sensor 0.0 8)"));                    // the array at its length, the rest defaults
+  CHECK(f.facts("NavigatorInterface").empty());      // retracted at the end of the cycle
   // Not written since: no new fact; written again: one.
   f.agent().load_string("(defrule count-nav (NavigatorInterface) => (assert (nav-seen (gensym*))))",
                         "count.clp");
@@ -523,8 +523,8 @@ TEST_CASE("blackboard: the agent writes interfaces and sends messages") {
   a.eval("(blackboard-write \"Position3DInterface::Goal\")");
   REQUIRE(bb.writes.size() == 2);
   CHECK(bb.writes[1].second[3].second ==
-        Value::multifield({Value::float_value(1.0), Value::float_value(2.0),
-                           Value::float_value(0.0)}));
+        Value::multifield(
+            {Value::float_value(1.0), Value::float_value(2.0), Value::float_value(0.0)}));
   // One writer per interface: what llsfsim's sensors write cannot be opened for writing.
   a.eval("(blackboard-open-writing \"SwitchInterface\" \"ampel_green\")");
   CHECK(f.logged("SwitchInterface::ampel_green has a writer"));
@@ -532,7 +532,7 @@ TEST_CASE("blackboard: the agent writes interfaces and sends messages") {
   CHECK(a.runtime_errors() == 4);
 
   // Messages: of an interface opened for reading; fields listed, set, sent (the id back).
-  a.eval("(go-to 1 2)");  // not opened: a warning, FALSE, and FALSE is no message
+  a.eval("(go-to 1 2)");           // not opened: a warning, FALSE, and FALSE is no message
   CHECK(a.runtime_errors() == 5);  // (set-msg-field on FALSE)
   CHECK(f.logged("no interface NavigatorInterface::Pathplan opened for reading"));
   a.eval("(blackboard-open \"NavigatorInterface\" \"Pathplan\")");
@@ -548,8 +548,7 @@ TEST_CASE("blackboard: the agent writes interfaces and sends messages") {
       "(defglobal ?*p* = (blackboard-create-msg \"NavigatorInterface::Pathplan\" "
       "\"PlaceGotoMessage\"))",
       "p.clp");
-  CHECK(a.eval("(blackboard-list-msg-fields ?*p*)") ==
-        Value::multifield({Value::symbol("place")}));
+  CHECK(a.eval("(blackboard-list-msg-fields ?*p*)") == Value::multifield({Value::symbol("place")}));
   a.eval("(blackboard-set-msg-field ?*p* \"place\" \"M3\")");
   CHECK(a.eval("(blackboard-send-msg ?*p*)") == Value::integer_value(42));
   CHECK(bb.sent[1].fields == InterfaceFields{{"place", Value::string("M3")}});
