@@ -274,6 +274,8 @@ std::optional<Value> coerce(const FieldDef& f, const Value& v, const Value& base
   return Value::multifield(std::move(items));
 }
 
+const Value kNoBase;  // coerce(): an array's elements not given are the defaults
+
 // Splits "Type::Id" (Fawkes' interface uid).
 bool parse_uid(std::string_view uid, std::string& type, std::string& id) {
   const std::size_t at = uid.find("::");
@@ -628,10 +630,10 @@ class BlackboardFeature final : public Feature {
     for (const FieldDef& f : def.fields) {
       const auto given = std::find_if(fields.begin(), fields.end(),
                                       [&](const auto& v) { return v.first == f.name; });
-      const Value base = default_value(f);
       std::optional<Value> v;
-      if (given != fields.end()) v = coerce(f, given->second, base);
-      values_[static_cast<std::size_t>(t.slot_index(f.name))] = v ? std::move(*v) : base;
+      if (given != fields.end()) v = coerce(f, given->second, kNoBase);
+      values_[static_cast<std::size_t>(t.slot_index(f.name))] =
+          v ? std::move(*v) : default_value(f);
     }
     FactHandle h = env.assert_fact(t, values_);
     env.release(h);
