@@ -415,7 +415,10 @@ class BlackboardFeature final : public Feature {
   }
 
   void after_reset(Environment&) override {
-    for (auto& [key, o] : opened_) o.read_serial = 0;  // the reset took the facts
+    for (auto& [key, o] : opened_) {  // the reset took the facts
+      o.read_serial = 0;
+      o.read_time.reset();
+    }
   }
 
   // The cycle's time fact is there (TimeFeature, before this feature): the facts of the

@@ -944,7 +944,9 @@ function F.set(type_name, id, values)
     local spec = m.t.fields[name]
     if not spec then error(fmt("%s has no field %s", common.uid(obj), name), 0) end
     if spec[2] then
-      for i = 1, spec[2] do d[name][i] = v[i] ~= nil and v[i] or d[name][i] end
+      for i = 1, spec[2] do
+        if v[i] ~= nil then d[name][i] = v[i] end
+      end
     else
       d[name] = v
     end
