@@ -931,8 +931,10 @@ function F.snapshot(type_name, id)
   if not obj then return nil, why end
   local m = meta_of[obj]
   if m.write then refresh(obj) end
-  return {has_writer = common.has_writer(obj), robot = m.write ~= nil,
-          written_ns = m.write and now_ns() or m.written_ns, fields = field_list(obj)}
+  local written_ns = m.write and now_ns() or m.written_ns
+  -- (never written: no data to copy; the agent asks again at every cycle)
+  return {has_writer = common.has_writer(obj), robot = m.write ~= nil, written_ns = written_ns,
+          fields = written_ns and field_list(obj) or {}}
 end
 -- Writes fields {name = value (a list for an array)} of an interface the agent writes.
 function F.set(type_name, id, values)
