@@ -911,9 +911,13 @@ local function object_of(type_name, id)
 end
 local function field_list(obj)
   local m = meta_of[obj]
-  local names = {}
-  for name in pairs(m.t.fields) do names[#names + 1] = name end
-  table.sort(names)
+  local names = m.t.sorted_names  -- (the field names in order, once per type)
+  if not names then
+    names = {}
+    for name in pairs(m.t.fields) do names[#names + 1] = name end
+    table.sort(names)
+    m.t.sorted_names = names
+  end
   local fields = {}
   local enums = m.t.enums or {}
   for _, name in ipairs(names) do
