@@ -418,6 +418,7 @@ class BlackboardFeature final : public Feature {
     for (auto& [key, o] : opened_) {  // the reset took the facts
       o.read_serial = 0;
       o.read_time.reset();
+      o.robot_writer = true;
     }
   }
 
@@ -435,6 +436,8 @@ class BlackboardFeature final : public Feature {
   struct Opened {
     std::uint64_t read_serial = 0;           // the host's data: their serial when last asserted
     std::optional<core::SimTime> read_time;  // the robot's data: their time when last asserted
+    bool robot_writer = true;                // as last read (else: read again on a new version)
+    std::int64_t version = 0;                // Blackboard::version() when last read
   };
 
   const InterfaceDef* known(const std::string& type, std::string_view function) {
@@ -606,9 +609,14 @@ class BlackboardFeature final : public Feature {
         continue;
       }
       if (s_.io.blackboard == nullptr) continue;
+      // An interface no sensor writes changes only with a write or a message.
+      const std::int64_t version = s_.io.blackboard->version();
+      if (!o.robot_writer && version != 0 && version == o.version) continue;
       InterfaceReading r;
       std::string error;
       if (!s_.io.blackboard->read(key.first, key.second, r, error)) continue;
+      o.robot_writer = r.robot_writer;
+      o.version = version;
       if (!r.has_writer || !r.written || r.written == o.read_time) continue;
       o.read_time = r.written;
       assert_fact(env, def, key.second, *r.written, r.fields);

@@ -712,8 +712,14 @@ end
 local common = {}
 function common.read(obj) refresh(obj) end
 local dirty = {}  -- objects skills wrote since F.written() last looked, in writing order
+-- Counts the writes and the messages to interfaces that hold what they are sent (what may change
+-- an interface no sensor writes): the agent's blackboard reads such an interface again only when
+-- this changed (SkillEngine::blackboard_version).
+F.state = {version = 0}
+local state = F.state
 local function mark_written(obj)
   local m = meta_of[obj]
+  state.version = state.version + 1
   m.written = true
   m.written_ns = now_ns()  -- (for the agent's blackboard: when its data last changed)
   if not m.dirty then
@@ -742,7 +748,10 @@ function common.msgq_enqueue_copy(obj, msg)
   epoch = epoch + 1
   local handle = m.t.handle
   local id = handle and handle(data_of[obj], class.name, msg, m.id, 3) or nil
-  if m.store then m.written_ns = now_ns() end  -- a message changed the data it holds
+  if m.store then  -- a message changed the data it holds
+    m.written_ns = now_ns()
+    state.version = state.version + 1
+  end
   return id or m.msgid
 end
 common.msgq_enqueue = common.msgq_enqueue_copy

@@ -1438,7 +1438,8 @@ function E.written_interfaces()
   return fawkes.written()
 end
 
--- The agent's side of the blackboard (fawkes.lua: F.snapshot, F.set, F.send).
+-- The agent's side of the blackboard (fawkes.lua: F.snapshot, F.set, F.send, F.state).
+E.blackboard_state = fawkes.state
 function E.interface_snapshot(type_name, id) return fawkes.snapshot(type_name, id) end
 function E.interface_set(type_name, id, values) return fawkes.set(type_name, id, values) end
 function E.interface_send(type_name, id, name, values)

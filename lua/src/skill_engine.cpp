@@ -1064,6 +1064,22 @@ std::vector<WrittenInterface> SkillEngine::written_interfaces() {
   return out;
 }
 
+std::int64_t SkillEngine::blackboard_version() const {
+  const Impl& e = *impl_;
+  if (e.L == nullptr) return 0;
+  lua_State* L = e.L;
+  lua_rawgeti(L, LUA_REGISTRYINDEX, e.engine_ref);
+  lua_getfield(L, -1, "blackboard_state");
+  std::int64_t v = 0;
+  if (lua_istable(L, -1)) {
+    lua_getfield(L, -1, "version");
+    v = static_cast<std::int64_t>(lua_tointeger(L, -1));
+    lua_pop(L, 1);
+  }
+  lua_pop(L, 2);
+  return v + 1;  // (0: unknown)
+}
+
 InterfaceSnapshot SkillEngine::read_interface(std::string_view type, std::string_view id) {
   Impl& e = *impl_;
   InterfaceSnapshot out;

@@ -43,6 +43,8 @@ class SkillBlackboard final : public clips::Blackboard {
     return true;
   }
 
+  std::int64_t version() override { return engine_.blackboard_version(); }
+
   std::string write(std::string_view type, std::string_view id,
                     const clips::InterfaceFields& fields) override {
     return engine_.write_interface(type, id, lua_fields(fields));

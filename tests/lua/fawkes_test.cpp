@@ -390,8 +390,12 @@ TEST_CASE("the agent's side of the blackboard: read, write and send to the skill
         0);
   CHECK(contains(error, "NavigatorInterface::Pathplan has no message FlyMessage"));
 
-  // What the agent writes, the skills read.
+  // What the agent writes, the skills read; the blackboard's version counts writes and messages
+  // (reads leave it).
   robot.time = core::SimTime::from_ms(600);
+  const std::int64_t version = engine.blackboard_version();
+  (void)engine.read_interface("SwitchInterface", "vision_switch");
+  CHECK(engine.blackboard_version() == version);
   lua::InterfaceField enabled{"enabled", lua::InterfaceField::Kind::kBool, false, {}, {1.0}};
   lua::InterfaceField value{"value", lua::InterfaceField::Kind::kFloat, false, {}, {0.5}};
   CHECK(engine.write_interface("SwitchInterface", "vision_switch", {enabled, value}).empty());
@@ -401,6 +405,7 @@ TEST_CASE("the agent's side of the blackboard: read, write and send to the skill
       contains(engine.write_interface("SwitchInterface", "vision_switch",
                                       {{"nope", lua::InterfaceField::Kind::kBool, false, {}, {1}}}),
                "SwitchInterface::vision_switch has no field nope"));
+  CHECK(engine.blackboard_version() > version);
   sw = engine.read_interface("SwitchInterface", "vision_switch");
   CHECK(sw.written == core::SimTime::from_ms(600));
   REQUIRE(engine.exec("sw{}"));

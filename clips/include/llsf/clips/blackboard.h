@@ -35,6 +35,10 @@ class Blackboard {
   /// Reads interface (type, id) now; false with `error` set for a type it does not offer.
   virtual bool read(std::string_view type, std::string_view id, InterfaceReading& out,
                     std::string& error) = 0;
+  /// A number that changes whenever an interface without a robot writer may have changed (a
+  /// write or a message); the host reads such an interface again only then. 0: unknown (the
+  /// host reads every opened interface at every cycle).
+  virtual std::int64_t version() { return 0; }
   /// Writes fields of interface (type, id) (the agent is its writer); "" or why not.
   virtual std::string write(std::string_view type, std::string_view id,
                             const InterfaceFields& fields) = 0;

@@ -222,6 +222,10 @@ class SkillEngine {
   /// The agent's side of the same blackboard (a Fawkes-style agent's blackboard feature,
   /// docs/fawkes.md): interface (type, id) as the skills' objects hold it, read now.
   InterfaceSnapshot read_interface(std::string_view type, std::string_view id);
+  /// Changes whenever skills or the agent write an interface or send a message (never 0): an
+  /// interface no sensor writes (InterfaceSnapshot::robot_writer false) is unchanged as long as
+  /// this is.
+  std::int64_t blackboard_version() const;
   /// Writes fields of interface (type, id), as a writer's set_field(...) and write() do (the
   /// skills read them); "" or why not (an unknown type or field).
   std::string write_interface(std::string_view type, std::string_view id,
