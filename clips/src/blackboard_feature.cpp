@@ -250,6 +250,34 @@ std::optional<Value> coerce_element(const FieldDef& f, const Value& v) {
   return std::nullopt;
 }
 
+// True if the element is of the field's type as it is.
+bool fits_element(const FieldDef& f, const Value& v) {
+  switch (f.kind) {
+    case Kind::kBool:
+      return v.is_symbol("TRUE") || v.is_symbol("FALSE");
+    case Kind::kInteger:
+      return v.type == Value::Type::kInteger;
+    case Kind::kFloat:
+      return v.type == Value::Type::kFloat;
+    case Kind::kString:
+      return v.type == Value::Type::kString;
+    case Kind::kEnum:
+      return v.type == Value::Type::kSymbol &&
+             std::any_of(f.items.begin(), f.items.end(),
+                         [&](const char* i) { return v.text == i; });
+  }
+  return false;
+}
+
+// True if the value is what the field holds as it is (its type; an array: its length).
+bool fits(const FieldDef& f, const Value& v) {
+  if (f.length <= 1) return fits_element(f, v);
+  return v.type == Value::Type::kMultifield &&
+         v.items.size() == static_cast<std::size_t>(f.length) &&
+         std::all_of(v.items.begin(), v.items.end(),
+                     [&](const Value& e) { return fits_element(f, e); });
+}
+
 // A value (or, for an array, a multifield or a list of values) as the field holds it: arrays
 // get their length (missing elements keep `base`'s). nullopt on a type error.
 std::optional<Value> coerce(const FieldDef& f, const Value& v, const Value& base) {
@@ -628,7 +656,7 @@ class BlackboardFeature final : public Feature {
   // the data lack, or cannot be held, its default).
   void assert_fact(Environment& env, const InterfaceDef& def, const std::string& id,
                    core::SimTime time, const InterfaceFields& fields) {
-    auto found = templates_.find(def.type);
+    auto found = templates_.find(std::string_view(def.type));
     if (found == templates_.end())
       found = templates_.emplace(def.type, env.find_template(def.type)).first;
     const Template& t = found->second;
@@ -641,10 +669,14 @@ class BlackboardFeature final : public Feature {
     for (const FieldDef& f : def.fields) {
       const auto given = std::find_if(fields.begin(), fields.end(),
                                       [&](const auto& v) { return v.first == f.name; });
+      Value& slot = values_[static_cast<std::size_t>(t.slot_index(f.name))];
+      if (given != fields.end() && fits(f, given->second)) {
+        slot = given->second;  // (the usual case: no conversion)
+        continue;
+      }
       std::optional<Value> v;
       if (given != fields.end()) v = coerce(f, given->second, kNoBase);
-      values_[static_cast<std::size_t>(t.slot_index(f.name))] =
-          v ? std::move(*v) : default_value(f);
+      slot = v ? std::move(*v) : default_value(f);
     }
     FactHandle h = env.assert_fact(t, values_);
     env.release(h);
@@ -671,11 +703,11 @@ class BlackboardFeature final : public Feature {
   std::map<std::pair<std::string, std::string>, Opened> opened_;  // for reading
   std::map<std::pair<std::string, std::string>, InterfaceFields> writing_;
   std::map<InterfaceMessage*, std::unique_ptr<InterfaceMessage>> messages_;  // not yet sent
-  std::vector<Value> values_;                  // assert_fact's slot values
-  std::map<std::string, Template> templates_;  // by type, looked up once
-  std::vector<std::string> defined_;           // the types with a template
-  std::vector<Template> cleanup_;              // their templates
-  bool time_read_ = false;                     // blackboard-enable-time-read
+  std::vector<Value> values_;                               // assert_fact's slot values
+  std::map<std::string, Template, std::less<>> templates_;  // by type, looked up once
+  std::vector<std::string> defined_;                        // the types with a template
+  std::vector<Template> cleanup_;                           // their templates
+  bool time_read_ = false;                                  // blackboard-enable-time-read
 };
 
 }  // namespace
