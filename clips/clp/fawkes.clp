@@ -52,6 +52,27 @@
 ; (string> ?a ?b): ?a sorts after ?b.
 (deffunction string> (?a ?b) (> (str-compare ?a ?b) 0))
 
+; ---- skills (the clips-agent's skills.clp) ------------------------------------------------
+; A (skill-update (name N) (status S)) fact sets the status of skill N's fact, as Fawkes'
+; clips-agent did with the updates it asserted from the skiller's interface. llsfsim's host
+; updates the skill fact itself; the template and its rules serve an agent that asserts updates.
+(deftemplate skill-update
+  (slot name (type STRING))
+  (slot status (type SYMBOL) (allowed-values IDLE RUNNING FINAL FAILED)))
+
+(defrule skill-update
+  ?su <- (skill-update (name ?n) (status ?new-status))
+  ?sf <- (skill (name ?n) (status ?old-status&~?new-status))
+  =>
+  (retract ?su)
+  (modify ?sf (status ?new-status)))
+
+(defrule skill-update-nochange
+  ?su <- (skill-update (name ?n) (status ?new-status))
+  (skill (name ?n) (status ?new-status))
+  =>
+  (retract ?su))
+
 ; ---- protobuf -----------------------------------------------------------------------------
 (deffunction pb-is-broadcast (?rcvd-via) (eq ?rcvd-via BROADCAST))
 

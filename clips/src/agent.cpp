@@ -149,6 +149,9 @@ struct AgentHost::Impl {
   // Fawkes' agent model (AgentConfig::fawkes).
   bool fawkes_started_ = false;
   std::vector<std::string>* load_failures_ = nullptr;  // while the entry file runs
+  // Fawkes' search path (path-add, ...): directories, the agent directory at first.
+  std::vector<std::string> search_path_;
+  std::vector<std::pair<std::string, std::string>> path_subst_;  // path-add-subst
   std::string batch_place_;  // "entry.clp:LINE" of the command being evaluated
 
   ~Impl() { env.observe(nullptr, false, false); }
@@ -207,6 +210,7 @@ struct AgentHost::Impl {
 
   // path-load, path-resolve and (reset) for Fawkes-style agents.
   void define_fawkes_functions() {
+    search_path_ = {state.config.agent_dir + "/"};
     // (path-load "dir/file.clp"): loads the constructs of a file of the agent directory, as
     // Fawkes' path-load (load*) did: TRUE, or FALSE after an error (a load error before the
     // game, a runtime error during it).
@@ -215,13 +219,53 @@ struct AgentHost::Impl {
       a.text(0, file);
       return Value::boolean(path_load(std::string(file)));
     });
-    // (path-resolve "dir/file.clp"): the file's path if the agent directory has it, else FALSE.
+    // (path-resolve "dir/file.clp"): the file's path, the first directory of the search path
+    // that has it, else FALSE.
     env.define_function("path-resolve", "11k", [this](detail::Args& a) {
       std::string_view file;
       a.text(0, file);
       std::string why;
-      const std::optional<std::string> p = resolve_agent_file(std::string(file), why);
+      const std::optional<std::string> p = resolve_on_path(std::string(file), why);
       return p ? Value::string(*p) : Value::boolean(false);
+    });
+    // Fawkes' search path (its path.clp): a list of directories, each put before the file name
+    // as it is (so they end in "/"), the agent directory at first. Paths outside the agent
+    // directory may be added but resolve no file (the sandbox). It survives a (reset), as in
+    // Fawkes since December 2013.
+    env.define_function("path-add", "0*k", [this](detail::Args& a) {
+      for (int i = 0; i < a.count(); ++i) {
+        std::string_view p;
+        a.text(i, p);
+        std::string dir(p);
+        for (const auto& [what, by] : path_subst_) {
+          if (const std::size_t at = dir.find(what); at != std::string::npos)
+            dir.replace(at, what.size(), by);
+        }
+        search_path_.push_back(std::move(dir));
+      }
+      return Value{};
+    });
+    env.define_function("path-add-subst", "22k", [this](detail::Args& a) {
+      std::string_view what, by;
+      a.text(0, what);
+      a.text(1, by);
+      path_subst_.emplace_back(what, by);
+      return Value{};
+    });
+    env.define_function("path-reset", "00", [this](detail::Args&) {
+      search_path_.clear();
+      path_subst_.clear();
+      return Value{};
+    });
+    env.define_function("path-get", "00", [this](detail::Args&) {
+      std::vector<Value> out;
+      for (const std::string& d : search_path_) out.push_back(Value::string(d));
+      return Value::multifield(std::move(out));
+    });
+    env.define_function("path-string", "00", [this](detail::Args&) {
+      std::string out;
+      for (const std::string& d : search_path_) out += (out.empty() ? "" : ":") + d;
+      return Value::string(out);
     });
     env.define_function("reset", "00", [this](detail::Args&) {
       reset_env();
@@ -253,6 +297,30 @@ struct AgentHost::Impl {
     return p.string();
   }
 
+  // `file` in the first directory of the search path that has it (inside the agent
+  // directory), or nullopt with the reason in `why`.
+  std::optional<std::string> resolve_on_path(const std::string& file, std::string& why) {
+    if (!file.empty() && file.front() == '/') return resolve_agent_file(file, why);
+    std::string first_why;
+    for (const std::string& dir : search_path_) {
+      std::string w;
+      // (the agent directory itself: the file as given, which the messages name)
+      const bool home = dir == state.config.agent_dir + "/";
+      if (auto p = resolve_agent_file(home ? file : dir + file, w)) return p;
+      if (first_why.empty()) first_why = std::move(w);
+    }
+    why = search_path_.size() == 1 ? first_why
+                                   : "no file " + file + " on the search path " + path_text() +
+                                         (first_why.empty() ? "" : " (" + first_why + ")");
+    if (search_path_.empty()) why = "no file " + file + ": the search path is empty (path-reset)";
+    return std::nullopt;
+  }
+  std::string path_text() const {
+    std::string out;
+    for (const std::string& d : search_path_) out += (out.empty() ? "" : ":") + d;
+    return out;
+  }
+
   // Fawkes' own CLIPS files, which every Fawkes environment had loaded: llsfsim's built-in
   // equivalents are loaded already, so a path-load of one of them loads nothing.
   static bool fawkes_builtin_file(std::string_view file) {
@@ -264,7 +332,7 @@ struct AgentHost::Impl {
 
   bool path_load(const std::string& file) {
     std::string why;
-    const std::optional<std::string> p = resolve_agent_file(file, why);
+    const std::optional<std::string> p = resolve_on_path(file, why);
     if (!p) {
       if (fawkes_builtin_file(file)) return true;
       load_failure("path-load: " + why);
@@ -800,7 +868,7 @@ void AgentHost::set_pose(const core::Pose2D& pose) {
 }
 
 void AgentHost::write_interface(std::string_view type, std::string_view id,
-                                std::vector<std::pair<std::string, Value>> fields) {
+                                InterfaceFields fields) {
   auto& d = impl_->state.blackboard[{std::string(type), std::string(id)}];
   d.time = impl_->state.now;
   d.fields = std::move(fields);

@@ -155,6 +155,28 @@ class ProtobufFeature final : public Feature {
       if (known_peer(a)) s_.peer_enabled = false;
       return Value{};
     });
+    // (pb-server-enable port) / (pb-server-disable): Fawkes' stream server, which clients
+    // connected to ((protobuf-server-client-connected ID HOST PORT) facts). Nothing in a game
+    // connects to a robot (the refbox and the other robots talk on the radio), so no client
+    // ever does: the server is accepted, and stays silent (docs/fawkes.md).
+    env.define_function("pb-server-enable", "11i", [this](Args& a) {
+      std::int64_t port = 0;
+      if (!a.integer(0, port) || port <= 0 || port > 65535) {
+        a.env().error(a.function(), "expects a port (1..65535)");
+        return Value{};
+      }
+      server_port_ = port;
+      s_.log(LogLevel::kDebug, "pb-server-enable: stream server on port " + std::to_string(port) +
+                                   " (no client connects in a simulated game)");
+      return Value{};
+    });
+    env.define_function("pb-server-disable", "00", [this](Args&) {
+      if (server_port_ != 0)
+        s_.log(LogLevel::kDebug,
+               "pb-server-disable: stream server on port " + std::to_string(server_port_) + " off");
+      server_port_ = 0;
+      return Value{};
+    });
     // (pb-connect host port): a stream client to the game's server, the refbox; its id, and
     // (protobuf-client-connected ID). (pb-send ID ?msg) sends to it, (pb-disconnect ID) ends it.
     env.define_function("pb-connect", "22*", [this, &env](Args& a) {
@@ -750,6 +772,7 @@ class ProtobufFeature final : public Feature {
   std::vector<const FieldDescriptor*> fields_scratch_;
   std::string key_scratch_, bytes_scratch_;
   std::vector<std::int64_t> clients_;  // pb-connect's open connections
+  std::int64_t server_port_ = 0;       // pb-server-enable's port (0: none)
   std::int64_t last_client_ = 0;
 };
 

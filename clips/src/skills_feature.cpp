@@ -153,6 +153,21 @@ class SkillsFeature final : public Feature {
   }
 
   void write_fact(Environment& env) {
+    if (!fact_.empty() && !env.exists(fact_)) {
+      // The agent modified the fact (a rule's modify, Fawkes' skill-update rule): the skill's
+      // fact is the one with its name and skill string now.
+      for (const FactCopy& f : env.facts("skill")) {
+        const auto slot = [&f](std::string_view n) -> const Value* {
+          for (const auto& [name, v] : f.slots)
+            if (name == n) return &v;
+          return nullptr;
+        };
+        const Value* name = slot("name");
+        const Value* sks = slot("skill-string");
+        if (name != nullptr && sks != nullptr && name->text == name_ && sks->text == skill_string_)
+          env.eval("(retract " + std::to_string(f.index) + ")");
+      }
+    }
     env.retract(fact_);
     const Value v[] = {Value::string(name_), Value::symbol(to_string(status_)),
                        Value::string(skill_string_), Value::string(error_), Value::string(result_)};

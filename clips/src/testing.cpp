@@ -24,8 +24,10 @@ void FakeSkillRunner::set_status(SkillStatus status, std::string error) {
   error_ = std::move(error);
 }
 
-AgentFixture::AgentFixture(AgentConfig config, const comm::MessageRegistry* messages) {
+AgentFixture::AgentFixture(AgentConfig config, const comm::MessageRegistry* messages,
+                           Blackboard* blackboard) {
   AgentIo io;
+  io.blackboard = blackboard;
   io.skills = &skills_;
   io.messages = messages;
   io.broadcast = [this](const google::protobuf::Message& m) {

@@ -631,6 +631,7 @@ def("SkillerInterface", {
   fields = {skill_string = {"string"}, error = {"string"}, exclusive_controller = {"uint32"},
             msgid = {"uint32"}, status = {"SkillStatusEnum"}},
   constants = {S_INACTIVE = 0, S_FINAL = 1, S_RUNNING = 2, S_FAILED = 3},
+  enums = {status = {[0] = "S_INACTIVE", "S_FINAL", "S_RUNNING", "S_FAILED"}},  -- (the agent's)
   messages = {},  -- skill strings come from the agent (llsfsim's skill runner), not from skills
   -- The skill string the agent sent, its status and error (the engine's own state).
   writer = function(id)
@@ -711,9 +712,16 @@ end
 local common = {}
 function common.read(obj) refresh(obj) end
 local dirty = {}  -- objects skills wrote since F.written() last looked, in writing order
+-- Counts the writes and the messages to interfaces that hold what they are sent (what may change
+-- an interface no sensor writes): the agent's blackboard reads such an interface again only when
+-- this changed (SkillEngine::blackboard_version).
+F.state = {version = 0}
+local state = F.state
 local function mark_written(obj)
   local m = meta_of[obj]
+  state.version = state.version + 1
   m.written = true
+  m.written_ns = now_ns()  -- (for the agent's blackboard: when its data last changed)
   if not m.dirty then
     m.dirty = true
     dirty[#dirty + 1] = obj
@@ -740,6 +748,10 @@ function common.msgq_enqueue_copy(obj, msg)
   epoch = epoch + 1
   local handle = m.t.handle
   local id = handle and handle(data_of[obj], class.name, msg, m.id, 3) or nil
+  if m.store then  -- a message changed the data it holds
+    m.written_ns = now_ns()
+    state.version = state.version + 1
+  end
   return id or m.msgid
 end
 common.msgq_enqueue = common.msgq_enqueue_copy
@@ -890,6 +902,94 @@ function F.written()
     out[#out + 1] = {type = m.type, id = m.id, serial = m.serial, fields = fields}
   end
   return out
+end
+
+-- The agent's side of the blackboard (docs/fawkes.md, "The blackboard"): a Fawkes-style
+-- agent reads, writes and sends messages to the same interface objects as the skills.
+local function object_of(type_name, id)
+  local t = types[type_name]
+  if not t then return nil, fmt("no interface type %s", type_name) end
+  if t.aliases and t.aliases[id] then id = t.default_id end
+  local uid = type_name .. "::" .. id
+  local obj = objects[uid]
+  if not obj then
+    obj = make_object(type_name, id, t)
+    objects[uid] = obj
+  end
+  return obj
+end
+local function field_list(obj)
+  local m = meta_of[obj]
+  local names = m.t.sorted_names  -- (the field names in order, once per type)
+  if not names then
+    names = {}
+    for name in pairs(m.t.fields) do names[#names + 1] = name end
+    table.sort(names)
+    m.t.sorted_names = names
+  end
+  local fields = {}
+  local enums = m.t.enums or {}
+  for _, name in ipairs(names) do
+    local v = data_of[obj][name]
+    if enums[name] then v = enums[name][v] or v end
+    fields[#fields + 1] = {name, field_kinds[m.t.fields[name][1]] or "symbol", v}
+  end
+  return fields
+end
+-- {has_writer=, robot=, written_ns=, fields=} of interface (type, id): `robot` if llsfsim's
+-- sensors or actuators write it (fresh at every time stamp: written_ns is now), else the time a
+-- skill or the agent last wrote it (nil: never); nil and why for an unknown type.
+function F.snapshot(type_name, id)
+  local obj, why = object_of(type_name, id)
+  if not obj then return nil, why end
+  local m = meta_of[obj]
+  if m.write then refresh(obj) end
+  local written_ns = m.write and now_ns() or m.written_ns
+  -- (never written: no data to copy; the agent asks again at every cycle)
+  return {has_writer = common.has_writer(obj), robot = m.write ~= nil, written_ns = written_ns,
+          fields = written_ns and field_list(obj) or {}}
+end
+-- Writes fields {name = value (a list for an array)} of an interface the agent writes.
+function F.set(type_name, id, values)
+  local obj, why = object_of(type_name, id)
+  if not obj then error(why, 0) end
+  local m = meta_of[obj]
+  local d = data_of[obj]
+  for name, v in pairs(values) do
+    local spec = m.t.fields[name]
+    if not spec then error(fmt("%s has no field %s", common.uid(obj), name), 0) end
+    if spec[2] then
+      for i = 1, spec[2] do
+        if v[i] ~= nil then d[name][i] = v[i] end
+      end
+    else
+      d[name] = v
+    end
+  end
+  epoch = epoch + 1
+  mark_written(obj)
+  m.writing = true
+end
+-- Sends message `name` ("CartesianGotoMessage") with fields {name = value} to the interface's
+-- writer, as msgq_enqueue_copy does; returns the message id.
+function F.send(type_name, id, name, values)
+  local obj, why = object_of(type_name, id)
+  if not obj then error(why, 0) end
+  local m = meta_of[obj]
+  local fields = m.t.messages[name]
+  if not fields then
+    local names = {}
+    for n in pairs(m.t.messages) do names[#names + 1] = n end
+    table.sort(names)
+    error(fmt("%s has no message %s (it has: %s)", common.uid(obj), name,
+              #names > 0 and table.concat(names, ", ") or "none"), 0)
+  end
+  local class = message_class(type_name, name, fields)
+  local msg = class.new(class)
+  -- (a field not given is false: the writers take their default for it)
+  for _, f in ipairs(fields) do rawset(msg, f, false) end
+  for k, v in pairs(values) do rawset(msg, k, v) end
+  return common.msgq_enqueue_copy(obj, msg)
 end
 
 -- Fawkes' skiller read every interface at the start of each loop: the visibility histories of

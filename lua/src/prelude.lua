@@ -1453,6 +1453,14 @@ function E.written_interfaces()
   return fawkes.written()
 end
 
+-- The agent's side of the blackboard (fawkes.lua: F.snapshot, F.set, F.send, F.state).
+E.blackboard_state = fawkes.state
+function E.interface_snapshot(type_name, id) return fawkes.snapshot(type_name, id) end
+function E.interface_set(type_name, id, values) return fawkes.set(type_name, id, values) end
+function E.interface_send(type_name, id, name, values)
+  return fawkes.send(type_name, id, name, values)
+end
+
 function E.reset_all()
   depth, caller = 0, nil
   for i = #active, 1, -1 do

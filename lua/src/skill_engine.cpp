@@ -943,15 +943,11 @@ std::vector<SkillInfo> SkillEngine::skills() const {
   return out;
 }
 
-std::vector<WrittenInterface> SkillEngine::written_interfaces() {
-  Impl& e = *impl_;
-  std::vector<WrittenInterface> out;
-  if (e.L == nullptr || e.call_entry("written_interfaces", 0, 1) != LUA_OK) {
-    lua_settop(e.L, 0);
-    return out;
-  }
-  // {{type=, id=, serial=, fields={{name, kind, value}, ...}}, ...} (fawkes.lua, F.written)
-  lua_State* L = e.L;
+namespace {
+
+// The field list at the top of the stack, {{name, kind, value}, ...} (fawkes.lua, field_list),
+// appended to `out`; the stack stays as it was.
+void read_field_list(lua_State* L, std::vector<InterfaceField>& out) {
   const auto text = [L](int index) {
     std::size_t n = 0;
     const char* s = lua_type(L, index) == LUA_TSTRING ? lua_tolstring(L, index, &n) : nullptr;
@@ -966,52 +962,189 @@ std::vector<WrittenInterface> SkillEngine::written_interfaces() {
       f.numbers.push_back(lua_tonumber(L, index));
     }
   };
+  const lua_Integer nf = static_cast<lua_Integer>(lua_rawlen(L, -1));
+  for (lua_Integer j = 1; j <= nf; ++j) {
+    lua_rawgeti(L, -1, j);
+    InterfaceField f;
+    lua_rawgeti(L, -1, 1);
+    f.name = text(-1);
+    lua_rawgeti(L, -2, 2);
+    const std::string kind = text(-1);
+    f.kind = kind == "string"    ? InterfaceField::Kind::kString
+             : kind == "integer" ? InterfaceField::Kind::kInteger
+             : kind == "float"   ? InterfaceField::Kind::kFloat
+             : kind == "bool"    ? InterfaceField::Kind::kBool
+                                 : InterfaceField::Kind::kSymbol;
+    lua_pop(L, 2);
+    lua_rawgeti(L, -1, 3);
+    if (lua_istable(L, -1)) {
+      f.array = true;
+      const lua_Integer ne = static_cast<lua_Integer>(lua_rawlen(L, -1));
+      for (lua_Integer k = 1; k <= ne; ++k) {
+        lua_rawgeti(L, -1, k);
+        add_value(f, -1);
+        lua_pop(L, 1);
+      }
+    } else {
+      add_value(f, -1);
+    }
+    lua_pop(L, 2);  // value, field entry
+    out.push_back(std::move(f));
+  }
+}
+
+// Pushes {name = value (a list for an array)} of `fields`.
+void push_field_values(lua_State* L, const std::vector<InterfaceField>& fields) {
+  lua_createtable(L, 0, static_cast<int>(fields.size()));
+  const auto push_element = [L](const InterfaceField& f, std::size_t i) {
+    switch (f.kind) {
+      case InterfaceField::Kind::kSymbol:
+      case InterfaceField::Kind::kString:
+        lua_pushlstring(L, f.texts[i].data(), f.texts[i].size());
+        return;
+      case InterfaceField::Kind::kBool:
+        lua_pushboolean(L, f.numbers[i] != 0.0 ? 1 : 0);
+        return;
+      case InterfaceField::Kind::kInteger:
+        lua_pushinteger(L, static_cast<lua_Integer>(f.numbers[i]));
+        return;
+      case InterfaceField::Kind::kFloat:
+        lua_pushnumber(L, f.numbers[i]);
+        return;
+    }
+  };
+  for (const InterfaceField& f : fields) {
+    const std::size_t n =
+        f.kind == InterfaceField::Kind::kSymbol || f.kind == InterfaceField::Kind::kString
+            ? f.texts.size()
+            : f.numbers.size();
+    if (f.array) {
+      lua_createtable(L, static_cast<int>(n), 0);
+      for (std::size_t i = 0; i < n; ++i) {
+        push_element(f, i);
+        lua_rawseti(L, -2, static_cast<lua_Integer>(i + 1));
+      }
+    } else if (n > 0) {
+      push_element(f, 0);
+    } else {
+      continue;
+    }
+    lua_setfield(L, -2, f.name.c_str());
+  }
+}
+
+}  // namespace
+
+std::vector<WrittenInterface> SkillEngine::written_interfaces() {
+  Impl& e = *impl_;
+  std::vector<WrittenInterface> out;
+  if (e.L == nullptr || e.call_entry("written_interfaces", 0, 1) != LUA_OK) {
+    lua_settop(e.L, 0);
+    return out;
+  }
+  // {{type=, id=, serial=, fields={{name, kind, value}, ...}}, ...} (fawkes.lua, F.written)
+  lua_State* L = e.L;
   const lua_Integer n = static_cast<lua_Integer>(lua_rawlen(L, -1));
   for (lua_Integer i = 1; i <= n; ++i) {
     lua_rawgeti(L, -1, i);
     WrittenInterface w;
     lua_getfield(L, -1, "type");
-    w.type = text(-1);
+    w.type = lua_isstring(L, -1) ? lua_tostring(L, -1) : "";
     lua_getfield(L, -2, "id");
-    w.id = text(-1);
+    w.id = lua_isstring(L, -1) ? lua_tostring(L, -1) : "";
     lua_getfield(L, -3, "serial");
     w.serial = static_cast<std::int64_t>(lua_tointeger(L, -1));
     lua_pop(L, 3);
     lua_getfield(L, -1, "fields");
-    const lua_Integer nf = static_cast<lua_Integer>(lua_rawlen(L, -1));
-    for (lua_Integer j = 1; j <= nf; ++j) {
-      lua_rawgeti(L, -1, j);
-      InterfaceField f;
-      lua_rawgeti(L, -1, 1);
-      f.name = text(-1);
-      lua_rawgeti(L, -2, 2);
-      const std::string kind = text(-1);
-      f.kind = kind == "string"    ? InterfaceField::Kind::kString
-               : kind == "integer" ? InterfaceField::Kind::kInteger
-               : kind == "float"   ? InterfaceField::Kind::kFloat
-               : kind == "bool"    ? InterfaceField::Kind::kBool
-                                   : InterfaceField::Kind::kSymbol;
-      lua_pop(L, 2);
-      lua_rawgeti(L, -1, 3);
-      if (lua_istable(L, -1)) {
-        f.array = true;
-        const lua_Integer ne = static_cast<lua_Integer>(lua_rawlen(L, -1));
-        for (lua_Integer k = 1; k <= ne; ++k) {
-          lua_rawgeti(L, -1, k);
-          add_value(f, -1);
-          lua_pop(L, 1);
-        }
-      } else {
-        add_value(f, -1);
-      }
-      lua_pop(L, 2);  // value, field entry
-      w.fields.push_back(std::move(f));
-    }
+    read_field_list(L, w.fields);
     lua_pop(L, 2);  // fields, entry
     out.push_back(std::move(w));
   }
   lua_settop(L, 0);
   return out;
+}
+
+std::int64_t SkillEngine::blackboard_version() const {
+  const Impl& e = *impl_;
+  if (e.L == nullptr) return 0;
+  lua_State* L = e.L;
+  lua_rawgeti(L, LUA_REGISTRYINDEX, e.engine_ref);
+  lua_getfield(L, -1, "blackboard_state");
+  std::int64_t v = 0;
+  if (lua_istable(L, -1)) {
+    lua_getfield(L, -1, "version");
+    v = static_cast<std::int64_t>(lua_tointeger(L, -1));
+    lua_pop(L, 1);
+  }
+  lua_pop(L, 2);
+  return v + 1;  // (0: unknown)
+}
+
+InterfaceSnapshot SkillEngine::read_interface(std::string_view type, std::string_view id) {
+  Impl& e = *impl_;
+  InterfaceSnapshot out;
+  if (e.L == nullptr) return out;
+  lua_State* L = e.L;
+  lua_pushlstring(L, type.data(), type.size());
+  lua_pushlstring(L, id.data(), id.size());
+  if (e.call_entry("interface_snapshot", 2, 2) != LUA_OK || !lua_istable(L, -2)) {
+    out.error = lua_isstring(L, -1) ? lua_tostring(L, -1) : "cannot read the interface";
+    lua_settop(L, 0);
+    return out;
+  }
+  lua_pop(L, 1);
+  out.known = true;
+  lua_getfield(L, -1, "has_writer");
+  out.has_writer = lua_toboolean(L, -1) != 0;
+  lua_getfield(L, -2, "robot");
+  out.robot_writer = lua_toboolean(L, -1) != 0;
+  lua_getfield(L, -3, "written_ns");
+  if (lua_isinteger(L, -1)) {
+    out.written = core::SimTime::from_ns(static_cast<std::int64_t>(lua_tointeger(L, -1)));
+  }
+  lua_pop(L, 3);
+  lua_getfield(L, -1, "fields");
+  read_field_list(L, out.fields);
+  lua_settop(L, 0);
+  return out;
+}
+
+std::string SkillEngine::write_interface(std::string_view type, std::string_view id,
+                                         const std::vector<InterfaceField>& fields) {
+  Impl& e = *impl_;
+  if (e.L == nullptr) return "the skill engine has no interpreter";
+  lua_State* L = e.L;
+  lua_pushlstring(L, type.data(), type.size());
+  lua_pushlstring(L, id.data(), id.size());
+  push_field_values(L, fields);
+  std::string error;
+  if (e.call_entry("interface_set", 3, 0) != LUA_OK) error = pop_message(L);
+  lua_settop(L, 0);
+  return error;
+}
+
+std::int64_t SkillEngine::send_interface_message(std::string_view type, std::string_view id,
+                                                 std::string_view message,
+                                                 const std::vector<InterfaceField>& fields,
+                                                 std::string& error) {
+  Impl& e = *impl_;
+  if (e.L == nullptr) {
+    error = "the skill engine has no interpreter";
+    return 0;
+  }
+  lua_State* L = e.L;
+  lua_pushlstring(L, type.data(), type.size());
+  lua_pushlstring(L, id.data(), id.size());
+  lua_pushlstring(L, message.data(), message.size());
+  push_field_values(L, fields);
+  std::int64_t msgid = 0;
+  if (e.call_entry("interface_send", 4, 1) != LUA_OK) {
+    error = pop_message(L);
+  } else {
+    msgid = static_cast<std::int64_t>(lua_tointeger(L, -1));
+  }
+  lua_settop(L, 0);
+  return msgid;
 }
 
 std::vector<std::string> SkillEngine::load_errors() const {

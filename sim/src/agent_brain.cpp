@@ -17,6 +17,85 @@ std::vector<std::string> agent_files(const std::vector<std::string>& entries) {
   return clips::expand_agent_files(entries);
 }
 
+namespace {
+
+clips::Value field_value(const lua::InterfaceField& f);
+
+// A Fawkes-style agent's blackboard (docs/fawkes.md, "The blackboard"): the interface objects of
+// the robot's skill engine, which llsfsim's sensors and actuators write; the agent reads,
+// writes and sends messages to the same objects as the skills.
+class SkillBlackboard final : public clips::Blackboard {
+ public:
+  explicit SkillBlackboard(lua::SkillEngine& engine) : engine_(engine) {}
+
+  bool read(std::string_view type, std::string_view id, clips::InterfaceReading& out,
+            std::string& error) override {
+    lua::InterfaceSnapshot s = engine_.read_interface(type, id);
+    if (!s.known) {
+      error = std::move(s.error);
+      return false;
+    }
+    out.has_writer = s.has_writer;
+    out.robot_writer = s.robot_writer;
+    out.written = s.written;
+    out.fields.clear();
+    for (const lua::InterfaceField& f : s.fields) out.fields.emplace_back(f.name, field_value(f));
+    return true;
+  }
+
+  std::int64_t version() override { return engine_.blackboard_version(); }
+
+  std::string write(std::string_view type, std::string_view id,
+                    const clips::InterfaceFields& fields) override {
+    return engine_.write_interface(type, id, lua_fields(fields));
+  }
+
+  std::int64_t send(std::string_view type, std::string_view id, std::string_view message,
+                    const clips::InterfaceFields& fields, std::string& error) override {
+    return engine_.send_interface_message(type, id, message, lua_fields(fields), error);
+  }
+
+ private:
+  // CLIPS values as the Lua objects hold them: TRUE/FALSE booleans, other symbols (enums) and
+  // strings as strings, numbers as numbers, multifields as arrays.
+  static std::vector<lua::InterfaceField> lua_fields(const clips::InterfaceFields& fields) {
+    using Kind = lua::InterfaceField::Kind;
+    std::vector<lua::InterfaceField> out;
+    for (const auto& [name, v] : fields) {
+      lua::InterfaceField f;
+      f.name = name;
+      f.array = v.type == clips::Value::Type::kMultifield;
+      const std::vector<clips::Value> one{v};
+      const std::vector<clips::Value>& items = f.array ? v.items : one;
+      bool first = true;
+      for (const clips::Value& e : items) {
+        Kind k = Kind::kSymbol;
+        if (e.is_symbol("TRUE") || e.is_symbol("FALSE")) {
+          k = Kind::kBool;
+          f.numbers.push_back(e.text == "TRUE" ? 1.0 : 0.0);
+        } else if (e.type == clips::Value::Type::kInteger) {
+          k = Kind::kInteger;
+          f.numbers.push_back(static_cast<double>(e.integer));
+        } else if (e.type == clips::Value::Type::kFloat) {
+          k = Kind::kFloat;
+          f.numbers.push_back(e.real);
+        } else {
+          k = e.type == clips::Value::Type::kString ? Kind::kString : Kind::kSymbol;
+          f.texts.push_back(e.text);
+        }
+        if (first) f.kind = k;
+        first = false;
+      }
+      out.push_back(std::move(f));
+    }
+    return out;
+  }
+
+  lua::SkillEngine& engine_;
+};
+
+}  // namespace
+
 AgentBrain::AgentBrain(Game& game, int index, AgentBrainConfig config, clips::LogSink log,
                        clips::LockListener locks, AgentReports reports) {
   skills_ = std::make_unique<SkillBrain>(game, index, std::move(config.skills));
@@ -54,6 +133,10 @@ AgentBrain::AgentBrain(Game& game, int index, AgentBrainConfig config, clips::Lo
   io.send = io.broadcast;
   RobotStack* robot = &game.robot(index);
   io.motor = [robot](bool on) { robot->set_motor_enabled(on); };
+  if (config.fawkes) {
+    blackboard_ = std::make_unique<SkillBlackboard>(skills_->engine());
+    io.blackboard = blackboard_.get();
+  }
   io.log = std::move(log);
   io.lock_events = std::move(locks);
   io.issues = std::move(reports.issues);

@@ -8,6 +8,7 @@
 #include <llsf_agent_msgs/Worldmodel.pb.h>
 
 #include <filesystem>
+#include <map>
 
 #include "llsf/clips/testing.h"
 #include "llsf/comm/registry.h"
@@ -351,4 +352,303 @@ TEST_CASE("pb peers, clients and Fawkes' field answers") {
   a.load_string("(defglobal ?*w* = (pb-create \"llsf_agent_msgs.WorldmodelChange\"))", "w.clp");
   CHECK(a.eval("(pb-field-value ?*w* \"machine\")") == Value::symbol("NOT-SET"));
   CHECK(a.runtime_errors() == errors + 2);  // the unknown peer and the unknown connection
+}
+
+namespace {
+
+// The robot's blackboard as a test sets it: interface data by (type, id), the writes and
+// messages the agent made.
+class FakeBlackboard final : public Blackboard {
+ public:
+  std::map<std::pair<std::string, std::string>, InterfaceReading> data;
+  std::vector<std::pair<std::string, InterfaceFields>> writes;  // uid, fields
+  struct Sent {
+    std::string uid, message;
+    InterfaceFields fields;
+  };
+  std::vector<Sent> sent;
+
+  bool read(std::string_view type, std::string_view id, InterfaceReading& out,
+            std::string& error) override {
+    const auto it = data.find({std::string(type), std::string(id)});
+    if (it == data.end()) {
+      out = InterfaceReading{};
+      return true;  // a known type nothing writes
+    }
+    (void)error;
+    out = it->second;
+    return true;
+  }
+  std::string write(std::string_view type, std::string_view id,
+                    const InterfaceFields& fields) override {
+    writes.emplace_back(std::string(type) + "::" + std::string(id), fields);
+    return {};
+  }
+  std::int64_t send(std::string_view type, std::string_view id, std::string_view message,
+                    const InterfaceFields& fields, std::string& error) override {
+    if (message == "TurnMessage") {
+      error = "no turning here";
+      return 0;
+    }
+    sent.push_back({std::string(type) + "::" + std::string(id), std::string(message), fields});
+    return 40 + static_cast<std::int64_t>(sent.size());
+  }
+  void set(const std::string& type, const std::string& id, core::SimTime written,
+           InterfaceFields fields, bool robot = true) {
+    InterfaceReading& r = data[{type, id}];
+    r.has_writer = true;
+    r.robot_writer = robot;
+    r.written = written;
+    r.fields = std::move(fields);
+  }
+};
+
+}  // namespace
+
+TEST_CASE("blackboard: every interface type the skills have, read from the robot's blackboard") {
+  AgentDir d;
+  d.write("demo/demo.clp", R"clp(
+(defrule use-blackboard
+  (ff-feature blackboard)
+  =>
+  (ff-feature-request "blackboard")
+  (blackboard-enable-time-read)
+  (blackboard-open "NavigatorInterface" "Pathplan")
+  (blackboard-open "MotorInterface" "Robotino")
+  (blackboard-open "SwitchInterface" "ampel_red")
+  (blackboard-open "RobotinoAmpelInterface" "Ampel")
+  (blackboard-open "LaserClusterInterface" "laser-cluster")
+  (blackboard-open "SkillerInterface" "Skiller")
+  (blackboard-open "RobotinoSensorInterface" "Robotino")
+  (path-load demo/sense.clp))
+)clp");
+  d.write("demo/sense.clp", R"clp(
+(defrule nav (NavigatorInterface (id "Pathplan") (msgid ?m) (final ?f) (dest_x ?x) (drive_mode ?dm))
+  => (assert (nav ?m ?f ?x ?dm)))
+(defrule motor (MotorInterface (id "Robotino") (vx ?vx) (controller_thread_name ?n))
+  => (assert (motor ?vx ?n)))
+(defrule switch (SwitchInterface (id "ampel_red") (enabled ?e)) => (assert (switch ?e)))
+(defrule ampel (RobotinoAmpelInterface (state ?s)) => (assert (ampel ?s)))
+(defrule cluster (LaserClusterInterface (max_x ?m)) => (assert (cluster ?m)))
+(defrule skiller (SkillerInterface (status ?s) (skill_string ?str)) => (assert (skiller ?s ?str)))
+(defrule sensor (RobotinoSensorInterface (distance $? ?d9) (digital_in $?di))
+  => (assert (sensor ?d9 (length$ ?di))))
+)clp");
+  FakeBlackboard bb;
+  const auto t1 = core::SimTime::from_ms(100);
+  bb.set("NavigatorInterface", "Pathplan", t1,
+         {{"msgid", Value::integer_value(3)},
+          {"final", Value::boolean(true)},
+          {"dest_x", Value::integer_value(2)}});  // an integer where Fawkes has a float
+  bb.set("MotorInterface", "Robotino", t1,
+         {{"vx", Value::float_value(0.25)},
+          {"controller_thread_name", Value::string("skiller")},
+          {"no_such_field", Value::integer_value(1)}});
+  bb.set("SwitchInterface", "ampel_red", t1, {{"enabled", Value::boolean(true)}});
+  bb.set("RobotinoAmpelInterface", "Ampel", t1, {{"state", Value::symbol("RED")}}, false);
+  bb.set("SkillerInterface", "Skiller", t1,
+         {{"status", Value::integer_value(2)}, {"skill_string", Value::string("ppgoto{}")}});
+  bb.set("RobotinoSensorInterface", "Robotino", t1,
+         {{"distance", Value::multifield({Value::float_value(0.0), Value::float_value(0.1)})}});
+  AgentFixture f(fawkes_config(d), nullptr, &bb);
+  f.load_file(d.path("demo/demo.clp"));
+  f.step();
+  CHECK(f.has("(nav 3 TRUE 2.0 MovingNotAllowed)"));  // coerced; the enum's first value
+  CHECK(f.has("(motor 0.25 \"skiller\")"));
+  CHECK(f.has("(switch TRUE)"));
+  CHECK(f.has("(ampel RED)"));
+  CHECK(f.facts("cluster").empty());                 // nothing writes it
+  CHECK(f.has("(skiller S_RUNNING \"ppgoto{}\")"));  // the enum's value by its number
+  CHECK(f.has("(sensor 0.0 8)"));                    // the array at its length, the rest defaults
+  CHECK(f.facts("NavigatorInterface").empty());      // retracted at the end of the cycle
+  // Not written since: no new fact; written again: one.
+  f.agent().load_string("(defrule count-nav (NavigatorInterface) => (assert (nav-seen (gensym*))))",
+                        "count.clp");
+  f.step();
+  CHECK(f.facts("nav-seen").empty());
+  bb.data[{"NavigatorInterface", "Pathplan"}].written = core::SimTime::from_ms(200);
+  f.step();
+  CHECK(f.facts("nav-seen").size() == 1);
+  // The template has every field of Fawkes' definition, in its order.
+  f.agent().assert_fact("(LaserClusterInterface (id \"x\") (time 1 2) (max_x 0.5))");
+  const std::vector<Fact> lc = f.facts("LaserClusterInterface");
+  REQUIRE(lc.size() == 1);
+  CHECK(lc[0].slots.size() == 3);
+  f.agent().assert_fact("(MotorInterface (id \"x\") (time 1 2))");
+  const std::vector<Fact> mi = f.facts("MotorInterface");
+  REQUIRE(mi.size() == 1);
+  REQUIRE(mi[0].slots.size() == 19);
+  CHECK(mi[0].slots[15].first == "des_vy");
+  CHECK(f.agent().runtime_errors() == 0);
+}
+
+TEST_CASE("blackboard: the agent writes interfaces and sends messages") {
+  AgentDir d;
+  d.write("demo/demo.clp", R"clp(
+(defglobal ?*msg* = FALSE)
+(deffunction go-to (?x ?y)
+  (bind ?m (blackboard-create-msg "NavigatorInterface::Pathplan" "CartesianGotoMessage"))
+  (blackboard-set-msg-field ?m "x" ?x)
+  (blackboard-set-msg-field ?m "y" ?y)
+  (blackboard-send-msg ?m))
+)clp");
+  FakeBlackboard bb;
+  bb.set("SwitchInterface", "ampel_green", core::SimTime{}, {});
+  AgentFixture f(fawkes_config(d), nullptr, &bb);
+  f.load_file(d.path("demo/demo.clp"));
+  AgentHost& a = f.agent();
+  // Writing: open, set fields (type-checked), write.
+  a.eval("(blackboard-open-writing \"SwitchInterface\" \"vision_switch\")");
+  a.eval("(blackboard-set \"SwitchInterface::vision_switch\" \"enabled\" TRUE)");
+  a.eval("(blackboard-set \"SwitchInterface::vision_switch\" \"value\" 2)");
+  a.eval("(blackboard-write \"SwitchInterface::vision_switch\")");
+  REQUIRE(bb.writes.size() == 1);
+  CHECK(bb.writes[0].first == "SwitchInterface::vision_switch");
+  const InterfaceFields& w = bb.writes[0].second;
+  REQUIRE(w.size() == 6);
+  CHECK(w[0] == std::pair<std::string, Value>{"enabled", Value::boolean(true)});
+  CHECK(w[1] == std::pair<std::string, Value>{"value", Value::float_value(2.0)});
+  CHECK(a.runtime_errors() == 0);
+  a.eval("(blackboard-set \"SwitchInterface::vision_switch\" \"enabled\" 1)");  // not a bool
+  CHECK(a.runtime_errors() == 1);
+  CHECK(f.logged("field enabled takes TRUE or FALSE, not 1"));
+  a.eval("(blackboard-set \"SwitchInterface::vision_switch\" \"nope\" 1)");
+  CHECK(f.logged("SwitchInterface::vision_switch has no field nope"));
+  a.eval("(blackboard-set \"SwitchInterface::other\" \"enabled\" TRUE)");  // not opened
+  CHECK(f.logged("SwitchInterface::other is not opened for writing"));
+  CHECK(a.runtime_errors() == 3);
+  // Arrays: blackboard-set-multifield.
+  a.eval("(blackboard-open-writing \"Position3DInterface\" \"Goal\")");
+  a.eval("(blackboard-set-multifield \"Position3DInterface::Goal\" \"translation\" 1.0 2.0)");
+  a.eval("(blackboard-write \"Position3DInterface::Goal\")");
+  REQUIRE(bb.writes.size() == 2);
+  CHECK(bb.writes[1].second[3].second ==
+        Value::multifield(
+            {Value::float_value(1.0), Value::float_value(2.0), Value::float_value(0.0)}));
+  // One writer per interface: what llsfsim's sensors write cannot be opened for writing.
+  a.eval("(blackboard-open-writing \"SwitchInterface\" \"ampel_green\")");
+  CHECK(f.logged("SwitchInterface::ampel_green has a writer"));
+  a.eval("(blackboard-set \"SwitchInterface::ampel_green\" \"enabled\" TRUE)");
+  CHECK(a.runtime_errors() == 4);
+
+  // Messages: of an interface opened for reading; fields listed, set, sent (the id back).
+  a.eval("(go-to 1 2)");           // not opened: a warning, FALSE, and FALSE is no message
+  CHECK(a.runtime_errors() == 5);  // (set-msg-field on FALSE)
+  CHECK(f.logged("no interface NavigatorInterface::Pathplan opened for reading"));
+  a.eval("(blackboard-open \"NavigatorInterface\" \"Pathplan\")");
+  const int errors = a.runtime_errors();
+  CHECK(a.eval("(go-to 1.5 2)") == Value::integer_value(41));
+  REQUIRE(bb.sent.size() == 1);
+  CHECK(bb.sent[0].uid == "NavigatorInterface::Pathplan");
+  CHECK(bb.sent[0].message == "CartesianGotoMessage");
+  CHECK(bb.sent[0].fields == InterfaceFields{{"x", Value::float_value(1.5)},
+                                             {"y", Value::float_value(2.0)},
+                                             {"orientation", Value::float_value(0.0)}});
+  a.load_string(
+      "(defglobal ?*p* = (blackboard-create-msg \"NavigatorInterface::Pathplan\" "
+      "\"PlaceGotoMessage\"))",
+      "p.clp");
+  CHECK(a.eval("(blackboard-list-msg-fields ?*p*)") == Value::multifield({Value::symbol("place")}));
+  a.eval("(blackboard-set-msg-field ?*p* \"place\" \"M3\")");
+  CHECK(a.eval("(blackboard-send-msg ?*p*)") == Value::integer_value(42));
+  CHECK(bb.sent[1].fields == InterfaceFields{{"place", Value::string("M3")}});
+  CHECK(a.runtime_errors() == errors);
+  a.eval("(blackboard-send-msg ?*p*)");  // sent already
+  CHECK(f.logged("not a message of blackboard-create-msg (or one already sent)"));
+  CHECK(a.eval("(blackboard-create-msg \"NavigatorInterface::Pathplan\" \"FlyMessage\")") ==
+        Value::boolean(false));
+  CHECK(f.logged("NavigatorInterface has no message FlyMessage"));
+  a.load_string(
+      "(defglobal ?*t* = (blackboard-create-msg \"NavigatorInterface::Pathplan\" "
+      "\"TurnMessage\"))",
+      "t.clp");
+  a.eval("(blackboard-send-msg ?*t*)");  // the writer refuses it: a runtime error
+  CHECK(f.logged("no turning here"));
+  CHECK(a.runtime_errors() == errors + 2);
+}
+
+TEST_CASE("blackboard: without a robot blackboard, what the agent writes it reads") {
+  AgentDir d;
+  d.write("demo/demo.clp", R"clp(
+(blackboard-enable-time-read)
+(blackboard-open-writing "RobotinoAmpelInterface" "Ampel")
+(blackboard-open "RobotinoAmpelInterface" "Ampel")
+(defrule seen (RobotinoAmpelInterface (id "Ampel") (state ?s)) => (assert (seen ?s)))
+(defrule write (start) =>
+  (blackboard-set "RobotinoAmpelInterface::Ampel" "state" GREEN)
+  (blackboard-write "RobotinoAmpelInterface::Ampel"))
+)clp");
+  AgentFixture f(fawkes_config(d));
+  f.load_file(d.path("demo/demo.clp"));
+  f.step();
+  CHECK(f.facts("seen").empty());
+  f.assert_fact("(start)");
+  f.step();  // the write
+  f.step();  // read at the next cycle's start
+  CHECK(f.has("(seen GREEN)"));
+  CHECK(f.agent().runtime_errors() == 0);
+}
+
+TEST_CASE("Fawkes' search path: path-add, path-add-subst, path-get, path-string, path-reset") {
+  AgentDir d;
+  std::filesystem::create_directories(d.dir.path / "demo" / "lib");
+  d.write("demo/lib/extra.clp", "(deffacts extra (extra-loaded))\n");
+  d.write("demo/demo.clp", "(deffacts none)\n");
+  AgentFixture f(fawkes_config(d));
+  f.load_file(d.path("demo/demo.clp"));
+  AgentHost& a = f.agent();
+  const std::string home = d.dir.path.string() + "/";
+  CHECK(a.eval("(path-get)") == Value::multifield({Value::string(home)}));
+  CHECK(a.eval("(path-resolve \"extra.clp\")") == Value::boolean(false));
+  a.eval("(path-add-subst \"@LIB@\" \"demo/lib\")");
+  a.eval("(path-add \"@LIB@/\")");
+  CHECK(a.eval("(path-string)") == Value::string(home + ":demo/lib/"));
+  CHECK(a.eval("(path-resolve \"extra.clp\")") ==
+        Value::string((d.dir.path / "demo/lib/extra.clp").string()));
+  CHECK(a.eval("(path-load \"extra.clp\")") == Value::boolean(true));
+  // A directory outside the agent directory resolves nothing (the sandbox).
+  a.eval("(path-add \"/etc/\")");
+  CHECK(a.eval("(path-resolve \"passwd\")") == Value::boolean(false));
+  // The path survives a reset; path-reset empties it.
+  a.eval("(reset)");
+  CHECK(a.eval("(path-get)").items.size() == 3);
+  a.eval("(path-reset)");
+  CHECK(a.eval("(path-get)") == Value::multifield({}));
+  CHECK(a.eval("(path-resolve \"demo/demo.clp\")") == Value::boolean(false));
+  CHECK(a.runtime_errors() == 0);
+}
+
+TEST_CASE("skill-update facts set the skill's status; pb-server-enable is accepted") {
+  AgentDir d;
+  d.write("demo/demo.clp", R"clp(
+(defrule call (start ?) => (skill-call ppgoto place "M1"))
+(defrule done (skill (name "ppgoto") (status FINAL)) => (assert (done)))
+)clp");
+  AgentFixture f(fawkes_config(d));
+  f.load_file(d.path("demo/demo.clp"));
+  f.assert_fact("(start 1)");
+  f.step();
+  REQUIRE(f.facts("skill").size() == 1);
+  f.skills().set_status(SkillStatus::kRunning);
+  f.step();
+  f.assert_fact("(skill-update (name \"ppgoto\") (status FINAL))");  // as Fawkes' clips-agent
+  f.step();
+  CHECK(f.has("(done)"));
+  CHECK(f.facts("skill-update").empty());
+  // The host's next update of the skill leaves one skill fact, not two.
+  f.agent().assert_fact("(start 2)");
+  f.step();
+  f.agent().assert_fact("(skill-update (name \"ppgoto\") (status RUNNING))");
+  f.step();  // a rule modified the host's fact: the host follows it
+  f.skills().set_status(SkillStatus::kFailed, "stuck");
+  f.step();
+  CHECK(f.find("skill", {{"status", Value::symbol("RUNNING")}}).empty());
+  CHECK(f.agent().runtime_errors() == 0);
+
+  f.agent().eval("(pb-server-enable 4444)");
+  f.agent().eval("(pb-server-disable)");
+  CHECK(f.agent().runtime_errors() == 0);
+  f.agent().eval("(pb-server-enable 0)");
+  CHECK(f.logged("pb-server-enable: expects a port (1..65535)"));
+  CHECK(f.agent().runtime_errors() == 1);
 }

@@ -337,3 +337,78 @@ TEST_CASE("skills: module_dirs, cfg_dirs and fawkes_config in a scenario's skill
   CHECK_THROWS_WITH_AS(lua::SkillEngineConfig::from_config(missing["skills"], kDir),
                        doctest::Contains("cfg directory"), core::ConfigError);
 }
+
+TEST_CASE("the agent's side of the blackboard: read, write and send to the skills' objects") {
+  test::TempDir dir;
+  dir.write("sw.lua", skill_running("sw",
+                                    "self.fsm.result = tostring(sw:is_enabled()) .. ' ' .. "
+                                    "tostring(sw:value()) .. ' ' .. tostring(amp:state())",
+                                    "{v='sw', type='SwitchInterface', id='vision_switch'}, "
+                                    "{v='amp', type='RobotinoAmpelInterface', id='Ampel'}"));
+  lua::SkillEngineConfig cfg = fawkes_config();
+  cfg.skill_dirs = {dir.path.string()};
+  FakeRobot robot;
+  robot.pose_estimate.pose = {1.0, 2.0, 0.0};
+  lua::SkillEngine engine(cfg, robot);
+  REQUIRE(engine.load_errors().empty());
+
+  const auto field = [](const lua::InterfaceSnapshot& s, const std::string& name) {
+    for (const lua::InterfaceField& f : s.fields)
+      if (f.name == name) return f;
+    return lua::InterfaceField{};
+  };
+  // What llsfsim's sensors write: fresh at every read, stamped now.
+  robot.time = core::SimTime::from_ms(500);
+  lua::InterfaceSnapshot motor = engine.read_interface("MotorInterface", "Robotino");
+  REQUIRE(motor.known);
+  CHECK(motor.has_writer);
+  CHECK(motor.robot_writer);
+  CHECK(motor.written == core::SimTime::from_ms(500));
+  CHECK(field(motor, "odometry_position_y").numbers == std::vector<double>{2.0});
+  CHECK(field(engine.read_interface("SkillerInterface", "Skiller"), "status").texts ==
+        std::vector<std::string>{"S_INACTIVE"});
+  // What nothing wrote yet: no writer, no time.
+  lua::InterfaceSnapshot sw = engine.read_interface("SwitchInterface", "vision_switch");
+  CHECK(sw.known);
+  CHECK_FALSE(sw.robot_writer);
+  CHECK_FALSE(sw.written);
+  CHECK_FALSE(engine.read_interface("NoInterface", "x").known);
+
+  // A message to the navigator drives the robot; its goal id comes back.
+  std::string error;
+  lua::InterfaceField x{"x", lua::InterfaceField::Kind::kFloat, false, {}, {3.0}};
+  lua::InterfaceField y{"y", lua::InterfaceField::Kind::kFloat, false, {}, {1.0}};
+  const std::int64_t msgid = engine.send_interface_message("NavigatorInterface", "Pathplan",
+                                                           "CartesianGotoMessage", {x, y}, error);
+  CHECK_MESSAGE(error.empty(), error);
+  CHECK(msgid > 0);
+  CHECK(robot.nav_goal == "pose");
+  lua::InterfaceSnapshot nav = engine.read_interface("NavigatorInterface", "Pathplan");
+  CHECK(field(nav, "dest_x").numbers == std::vector<double>{3.0});
+  CHECK(field(nav, "msgid").numbers == std::vector<double>{static_cast<double>(msgid)});
+  CHECK(engine.send_interface_message("NavigatorInterface", "Pathplan", "FlyMessage", {}, error) ==
+        0);
+  CHECK(contains(error, "NavigatorInterface::Pathplan has no message FlyMessage"));
+
+  // What the agent writes, the skills read; the blackboard's version counts writes and messages
+  // (reads leave it).
+  robot.time = core::SimTime::from_ms(600);
+  const std::int64_t version = engine.blackboard_version();
+  (void)engine.read_interface("SwitchInterface", "vision_switch");
+  CHECK(engine.blackboard_version() == version);
+  lua::InterfaceField enabled{"enabled", lua::InterfaceField::Kind::kBool, false, {}, {1.0}};
+  lua::InterfaceField value{"value", lua::InterfaceField::Kind::kFloat, false, {}, {0.5}};
+  CHECK(engine.write_interface("SwitchInterface", "vision_switch", {enabled, value}).empty());
+  lua::InterfaceField state{"state", lua::InterfaceField::Kind::kSymbol, false, {"RED"}, {}};
+  CHECK(engine.write_interface("RobotinoAmpelInterface", "Ampel", {state}).empty());
+  CHECK(
+      contains(engine.write_interface("SwitchInterface", "vision_switch",
+                                      {{"nope", lua::InterfaceField::Kind::kBool, false, {}, {1}}}),
+               "SwitchInterface::vision_switch has no field nope"));
+  CHECK(engine.blackboard_version() > version);
+  sw = engine.read_interface("SwitchInterface", "vision_switch");
+  CHECK(sw.written == core::SimTime::from_ms(600));
+  REQUIRE(engine.exec("sw{}"));
+  CHECK(test::run_until_done(engine, robot) == SkillStatus::kFinal);
+  CHECK(engine.result() == "true 0.5 RED");
+}

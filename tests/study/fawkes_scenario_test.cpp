@@ -311,3 +311,66 @@ skills: {skill_dirs: [skills]}
   CHECK(facts[0].fields().at(0).text == "ON");
   CHECK(facts[0].fields().at(1).text == "TRUE");
 }
+
+TEST_CASE("a Fawkes-style agent drives by NavigatorInterface messages and reads the navigator") {
+  test::TempDir dir{"llsf_fawkes_nav"};
+  std::filesystem::create_directories(dir.path / "agents/nav");
+  dir.write("agents/nav/nav.clp", R"clp(
+(defrule use-blackboard
+  (ff-feature blackboard)
+  =>
+  (ff-feature-request "blackboard")
+  (blackboard-enable-time-read)
+  (blackboard-open "Position3DInterface" "Pose")
+  (blackboard-open "NavigatorInterface" "Pathplan")
+  (blackboard-open "MotorInterface" "Robotino")
+  (path-load nav/drive.clp))
+)clp");
+  dir.write("agents/nav/drive.clp", R"clp(
+(defrule go
+  (Position3DInterface (id "Pose") (translation ?x ?y ?))
+  (not (goal $?))
+  =>
+  (bind ?m (blackboard-create-msg "NavigatorInterface::Pathplan" "PolarGotoMessage"))
+  (blackboard-set-msg-field ?m "phi" 0.0)
+  (blackboard-set-msg-field ?m "dist" 0.5)
+  (assert (goal (blackboard-send-msg ?m) ?x ?y)))
+(defrule arrived
+  (goal ?id ?x0 ?y0)
+  (NavigatorInterface (id "Pathplan") (msgid ?id) (final TRUE) (error_code 0))
+  (Position3DInterface (id "Pose") (translation ?x ?y ?))
+  (not (arrived $?))
+  =>
+  (assert (arrived (sqrt (+ (** (- ?x ?x0) 2) (** (- ?y ?y0) 2))))))
+(defrule motor-odometry
+  (MotorInterface (id "Robotino") (odometry_position_x ?x))
+  =>
+  (assert (odometry-read)))
+)clp");
+  dir.write("s.yaml", R"yaml(
+name: fawkes navigator
+duration_s: 12
+robots:
+  count: 1
+  agent: {fawkes: agents, entry: nav/nav}
+)yaml");
+  const ScenarioFile f = load_scenario(dir.file("s.yaml"));
+  const Scenario& s = f.variants.at(0);
+  sim::GameDriver driver(s.game);
+  sim::AgentBrainConfig c;
+  c.agent_files = s.robots.at(0).agent;
+  c.config = s.robots.at(0).config;
+  c.fawkes = true;
+  c.agent_dir = s.robots.at(0).agent_dir;
+  sim::AgentBrain& brain = driver.plug_agent(0, c);
+  driver.run_until(core::SimTime::from_seconds(10.0));
+  const clips::AgentHost& agent = brain.agent();
+  CHECK(agent.runtime_errors() == 0);
+  const auto goal = agent.facts("goal");
+  REQUIRE(goal.size() == 1);
+  CHECK(goal[0].fields().at(0).integer > 0);  // the navigator's goal id
+  const auto arrived = agent.facts("arrived");
+  REQUIRE(arrived.size() == 1);
+  CHECK(arrived[0].fields().at(0).real == doctest::Approx(0.5).epsilon(0.2));
+  CHECK(agent.facts("odometry-read").size() == 1);
+}

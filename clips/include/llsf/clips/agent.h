@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "llsf/clips/blackboard.h"
 #include "llsf/clips/config_values.h"
 #include "llsf/clips/lock_manager.h"
 #include "llsf/clips/skill_runner.h"
@@ -173,6 +174,10 @@ struct AgentIo {
   EventSink events;          ///< every (agent-event ...) the agent declares
   /// (motor-enable) / (motor-disable): switches the robot's motors (Fawkes' motor-switch).
   std::function<void(bool on)> motor;
+  /// The robot's blackboard for a Fawkes-style agent's blackboard feature (docs/fawkes.md):
+  /// the interfaces the host does not write itself are read, written and sent messages here.
+  /// Without it, only the host's own (the pose, write_interface) exist.
+  Blackboard* blackboard = nullptr;
   /// (pb-send ?client ?msg): a message to the stream server the agent connected to with
   /// (pb-connect host port) (the refbox: the only server of a game). Without it, pb-send drops.
   BroadcastFn send;
@@ -235,8 +240,7 @@ class AgentHost {
   /// interface `type` ("RobotinoLightInterface") with id `id` ("Light_State") by name, stamped
   /// with the time of the last cycle. (blackboard-read) asserts it once per write. The pose
   /// (set_pose) is written as Position3DInterface "Pose" by the host itself.
-  void write_interface(std::string_view type, std::string_view id,
-                       std::vector<std::pair<std::string, Value>> fields);
+  void write_interface(std::string_view type, std::string_view id, InterfaceFields fields);
   /// A message received from peer `from` (name and id) at `at`; it becomes a protobuf-msg fact
   /// at the next cycle. The host takes ownership.
   void receive(std::unique_ptr<google::protobuf::Message> message, std::string_view from,

@@ -49,7 +49,9 @@ struct LoggedLine {
 class AgentFixture {
  public:
   /// `messages` (optional, borrowed) enables pb-create and the protobuf-msg type ids.
-  explicit AgentFixture(AgentConfig config = {}, const comm::MessageRegistry* messages = nullptr);
+  /// `blackboard` (optional, borrowed) is the robot's blackboard (AgentIo::blackboard).
+  explicit AgentFixture(AgentConfig config = {}, const comm::MessageRegistry* messages = nullptr,
+                        Blackboard* blackboard = nullptr);
   ~AgentFixture();
   AgentFixture(const AgentFixture&) = delete;
   AgentFixture& operator=(const AgentFixture&) = delete;

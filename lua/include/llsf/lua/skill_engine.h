@@ -7,6 +7,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -132,6 +133,16 @@ struct WrittenInterface {
   std::vector<InterfaceField> fields;  ///< every field, by name
 };
 
+/// One blackboard interface as the robot's agent reads it (SkillEngine::read_interface).
+struct InterfaceSnapshot {
+  bool known = false;         ///< the type is one of Fawkes' the engine offers (docs/fawkes.md)
+  bool has_writer = false;    ///< something writes it (Fawkes' has_writer())
+  bool robot_writer = false;  ///< llsfsim's sensors or actuators write it (at every time stamp)
+  std::optional<core::SimTime> written;  ///< when its data were last written (none: never)
+  std::vector<InterfaceField> fields;    ///< every field, by name
+  std::string error;                     ///< why not, if !known
+};
+
 /// What the engine knows about one skill file.
 struct SkillInfo {
   std::string name;
@@ -208,6 +219,23 @@ class SkillEngine {
   /// as Fawkes' skiller wrote its writing interfaces after every loop: for the agent's
   /// blackboard (sim's AgentBrain forwards them to a Fawkes-style agent).
   std::vector<WrittenInterface> written_interfaces();
+  /// The agent's side of the same blackboard (a Fawkes-style agent's blackboard feature,
+  /// docs/fawkes.md): interface (type, id) as the skills' objects hold it, read now.
+  InterfaceSnapshot read_interface(std::string_view type, std::string_view id);
+  /// Changes whenever skills or the agent write an interface or send a message (never 0): an
+  /// interface no sensor writes (InterfaceSnapshot::robot_writer false) is unchanged as long as
+  /// this is.
+  std::int64_t blackboard_version() const;
+  /// Writes fields of interface (type, id), as a writer's set_field(...) and write() do (the
+  /// skills read them); "" or why not (an unknown type or field).
+  std::string write_interface(std::string_view type, std::string_view id,
+                              const std::vector<InterfaceField>& fields);
+  /// Sends message `message` ("CartesianGotoMessage") with `fields` to interface (type, id), as
+  /// msgq_enqueue_copy does; the message id, or 0 with `error` set.
+  std::int64_t send_interface_message(std::string_view type, std::string_view id,
+                                      std::string_view message,
+                                      const std::vector<InterfaceField>& fields,
+                                      std::string& error);
 
   /// Every skill file found, in name order.
   std::vector<SkillInfo> skills() const;

@@ -139,6 +139,8 @@ class AgentBrain final : public RobotBrain, private clips::SkillRunner {
   std::vector<FileStamp> stamp_files() const;
 
   std::unique_ptr<SkillBrain> skills_;
+  // A Fawkes-style agent's blackboard: the skill engine's interface objects (agent_brain.cpp).
+  std::unique_ptr<clips::Blackboard> blackboard_;
   std::vector<std::string> file_entries_;  // as configured (files and directories)
   bool locks_ = false;
   clips::AgentConfig host_config_;
