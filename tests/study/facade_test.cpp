@@ -52,6 +52,8 @@ TEST_CASE("llsfsim.h: bad input is an llsfsim::Error naming the place") {
   CHECK_THROWS_WITH_AS(llsfsim::Scenario::load("/nonexistent/llsfsim.yaml"),
                        doctest::Contains("/nonexistent/llsfsim.yaml"), llsfsim::Error);
   llsfsim::Scenario s = llsfsim::Scenario::load(kDefault).front();
-  CHECK_THROWS_AS(s.set_duration_s(0.0), llsfsim::Error);
+  CHECK_THROWS_WITH_AS(s.set_duration_s(0.0),
+                       "set_duration_s: 0 s is outside [1, 3600] s (the scenario limits)",
+                       llsfsim::Error);
   CHECK_THROWS_AS(s.set_duration_s(1e9), llsfsim::Error);
 }

@@ -3,6 +3,7 @@
 #include "llsfsim/llsfsim.h"
 
 #include <optional>
+#include <sstream>
 #include <utility>
 
 #include "llsf/core/error.h"
@@ -56,9 +57,10 @@ double Scenario::duration_s() const { return impl_->scenario.duration.seconds();
 void Scenario::set_duration_s(double seconds) {
   using Limits = llsf::study::ScenarioLimits;
   if (!(seconds >= Limits::kMinDurationS && seconds <= Limits::kMaxDurationS)) {
-    throw Error("set_duration_s: " + std::to_string(seconds) + " s is outside [" +
-                std::to_string(Limits::kMinDurationS) + ", " +
-                std::to_string(Limits::kMaxDurationS) + "] s");
+    std::ostringstream message;
+    message << "set_duration_s: " << seconds << " s is outside [" << Limits::kMinDurationS << ", "
+            << Limits::kMaxDurationS << "] s (the scenario limits)";
+    throw Error(message.str());
   }
   auto copy = std::make_shared<Impl>(*impl_);
   copy->scenario.duration = llsf::core::SimTime::from_sec(seconds);
