@@ -607,6 +607,14 @@ class BlackboardFeature final : public Feature {
                  " (llsfsim's writers handle: " + (have.empty() ? "none" : have) + ")");
       return Value::boolean(false);
     }
+    if (messages_.size() >= kMaxUnsentMessages) {
+      // An agent that creates messages and never sends them would grow the host without
+      // bound (CLIPS' memory budget does not see them).
+      s_.log(LogLevel::kWarn, "blackboard-create-msg: " + std::to_string(kMaxUnsentMessages) +
+                                  " messages created and not yet sent; send one "
+                                  "(blackboard-send-msg) before creating more");
+      return Value::boolean(false);
+    }
     auto m = std::make_unique<InterfaceMessage>();
     m->type = type;
     m->id = id;
@@ -703,6 +711,7 @@ class BlackboardFeature final : public Feature {
   std::map<std::pair<std::string, std::string>, Opened> opened_;  // for reading
   std::map<std::pair<std::string, std::string>, InterfaceFields> writing_;
   std::map<InterfaceMessage*, std::unique_ptr<InterfaceMessage>> messages_;  // not yet sent
+  static constexpr std::size_t kMaxUnsentMessages = 1000;
   std::vector<Value> values_;                               // assert_fact's slot values
   std::map<std::string, Template, std::less<>> templates_;  // by type, looked up once
   std::vector<std::string> defined_;                        // the types with a template

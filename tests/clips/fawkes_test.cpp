@@ -589,6 +589,23 @@ TEST_CASE("blackboard: without a robot blackboard, what the agent writes it read
   CHECK(f.agent().runtime_errors() == 0);
 }
 
+TEST_CASE("blackboard: messages created and never sent are bounded") {
+  AgentDir d;
+  d.write("demo/demo.clp", "(blackboard-open \"NavigatorInterface\" \"Pathplan\")\n");
+  FakeBlackboard bb;
+  AgentFixture f(fawkes_config(d), nullptr, &bb);
+  f.load_file(d.path("demo/demo.clp"));
+  AgentHost& a = f.agent();
+  a.eval(R"clp((loop-for-count 1000
+    (blackboard-create-msg "NavigatorInterface::Pathplan" "CartesianGotoMessage")))clp");
+  CHECK_FALSE(f.logged("messages created and not yet sent"));
+  CHECK(a.eval("(blackboard-create-msg \"NavigatorInterface::Pathplan\" "
+               "\"CartesianGotoMessage\")")
+            .is_symbol("FALSE"));
+  CHECK(f.logged("1000 messages created and not yet sent; send one"));
+  CHECK(a.runtime_errors() == 0);
+}
+
 TEST_CASE("Fawkes' search path: path-add, path-add-subst, path-get, path-string, path-reset") {
   AgentDir d;
   std::filesystem::create_directories(d.dir.path / "demo" / "lib");
