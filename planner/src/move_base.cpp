@@ -113,9 +113,12 @@ MoveBaseNavigator::MoveBaseNavigator(const Planner& planner, MoveBaseConfig conf
   const int n =
       std::max(1, static_cast<int>(std::lround(config_.local_size_m / config_.local_resolution_m)));
   local_ = Costmap(Vec2(0.0, 0.0), n, n, config_.local_resolution_m, config_);
-  const std::size_t cells = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
+  grid_w_ = n + 2;
+  const std::size_t cells = static_cast<std::size_t>(n + 2) * static_cast<std::size_t>(n + 2);
   path_dist_.assign(cells, 0);
   goal_dist_.assign(cells, 0);
+  grid_init_.assign(cells, 0);
+  queue_.assign(cells, 0);
   unreachable_ = n * n;
 }
 
@@ -857,52 +860,55 @@ bool MoveBaseNavigator::make_plan(const Pose2D& pose) {
 void MoveBaseNavigator::update_grids(const Pose2D& pose) {
   // Path and goal distances on the local costmap (cells, 4-connected), as base_local_planner's
   // MapGrid: from every plan cell inside the window, and from the last one (the local goal).
+  // A cell the search reaches is its distance, or `obstacle` when it is inscribed or lethal; a
+  // cell it never reaches is `unknown`.
   const Costmap& m = local_;
   const int nx = m.nx(), ny = m.ny();
   const int obstacle = unreachable_;
   const int unknown = unreachable_ + 1;
-  std::fill(path_dist_.begin(), path_dist_.end(), unknown);
-  std::fill(goal_dist_.begin(), goal_dist_.end(), unknown);
+  // Before a search: free cells unknown, blocked cells `blocked` (an obstacle once reached, else
+  // unknown), the frame `obstacle` (never entered, never read).
+  const int blocked = unreachable_ + 2;
+  const int w = grid_w_;
+  std::fill(grid_init_.begin(), grid_init_.end(), obstacle);
+  for (int j = 0; j < ny; ++j) {
+    int* row = grid_init_.data() + grid_index(0, j);
+    for (int i = 0; i < nx; ++i) row[i] = m.cost(i, j) >= Costmap::kInscribed ? blocked : unknown;
+  }
+  path_dist_ = grid_init_;
+  goal_dist_ = grid_init_;
   // Prune: plan points more than 1 m from the robot at the plan's start are passed.
   const std::vector<Vec2>& pts = plan_.points;
   while (prune_from_ + 1 < pts.size() && (pts[prune_from_] - pose.position()).squaredNorm() > 1.0) {
     ++prune_from_;
   }
-  auto index = [nx](int i, int j) {
-    return static_cast<std::size_t>(j) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(i);
-  };
-  auto bfs = [&](std::vector<int>& dist) {
-    // The queue holds cell indices; a cell's column and row are kept beside it (no division).
-    std::size_t head = 0;
-    queue_ij_.resize(queue_.size());
-    for (std::size_t q = 0; q < queue_.size(); ++q) {
-      const std::size_t k = static_cast<std::size_t>(queue_[q]);
-      queue_ij_[q] = {static_cast<int>(k % static_cast<std::size_t>(nx)),
-                      static_cast<int>(k / static_cast<std::size_t>(nx))};
-    }
-    while (head < queue_.size()) {
-      const std::size_t k = static_cast<std::size_t>(queue_[head]);
-      const auto [i, j] = queue_ij_[head++];
-      const int d = dist[k];
-      constexpr int kDi[4] = {1, -1, 0, 0};
-      constexpr int kDj[4] = {0, 0, 1, -1};
-      for (int e = 0; e < 4; ++e) {
-        const int a = i + kDi[e], b = j + kDj[e];
-        if (a < 0 || b < 0 || a >= nx || b >= ny) continue;
-        const std::size_t kk = index(a, b);
-        if (dist[kk] != unknown) continue;
-        if (m.cost(a, b) >= Costmap::kInscribed) {
-          dist[kk] = obstacle;
-          continue;
+  // Breadth-first from the queue's first `tail` cells; the frame needs no bounds checks.
+  int* queue = queue_.data();
+  auto bfs = [&](std::vector<int>& dist, std::size_t tail) {
+    int* g = dist.data();
+    const std::ptrdiff_t step[4] = {1, -1, w, -w};
+    for (std::size_t head = 0; head < tail; ++head) {
+      const std::ptrdiff_t k = queue[head];
+      const int d = g[k] + 1;
+      for (const std::ptrdiff_t s : step) {
+        int& n = g[k + s];
+        if (n == unknown) {
+          n = d;
+          queue[tail++] = static_cast<int>(k + s);
+        } else if (n == blocked) {
+          n = obstacle;
         }
-        dist[kk] = d + 1;
-        queue_.push_back(static_cast<int>(kk));
-        queue_ij_.push_back({a, b});
+      }
+    }
+    for (int j = 0; j < ny; ++j) {
+      int* row = g + grid_index(0, j);
+      for (int i = 0; i < nx; ++i) {
+        if (row[i] == blocked) row[i] = unknown;
       }
     }
   };
   // The plan at the local map's resolution: points at most one cell apart.
-  queue_.clear();
+  std::size_t tail = 0;
   bool started = false;
   int last_i = -1, last_j = -1;
   for (std::size_t s = prune_from_; s < pts.size(); ++s) {
@@ -919,23 +925,23 @@ void MoveBaseNavigator::update_grids(const Pose2D& pose) {
         continue;
       }
       started = true;
-      const std::size_t k = index(i, j);
+      const std::size_t k = grid_index(i, j);
       if (path_dist_[k] != 0) {
         path_dist_[k] = 0;
-        queue_.push_back(static_cast<int>(k));
+        queue[tail++] = static_cast<int>(k);
       }
       last_i = i;
       last_j = j;
     }
     if (left) break;
   }
-  bfs(path_dist_);
-  queue_.clear();
+  bfs(path_dist_, tail);
+  tail = 0;
   if (last_i >= 0) {
-    goal_dist_[index(last_i, last_j)] = 0;
-    queue_.push_back(static_cast<int>(index(last_i, last_j)));
+    goal_dist_[grid_index(last_i, last_j)] = 0;
+    queue[tail++] = static_cast<int>(grid_index(last_i, last_j));
   }
-  bfs(goal_dist_);
+  bfs(goal_dist_, tail);
 }
 
 void MoveBaseNavigator::generate(const Pose2D& pose, const VelocityCommand& vel, double vx_s,
@@ -963,8 +969,7 @@ void MoveBaseNavigator::generate(const Pose2D& pose, const VelocityCommand& vel,
     const std::uint8_t cost = m.cost(i, j);
     if (cost >= Costmap::kInscribed) return;  // the footprint hits an obstacle
     occ = std::max(occ, static_cast<double>(cost));
-    const std::size_t k = static_cast<std::size_t>(j) * static_cast<std::size_t>(m.nx()) +
-                          static_cast<std::size_t>(i);
+    const std::size_t k = grid_index(i, j);
     path_d = path_dist_[k];
     goal_d = goal_dist_[k];
     if (path_d >= unreachable_ || goal_d >= unreachable_) {
@@ -1037,8 +1042,7 @@ MoveBaseNavigator::Traj MoveBaseNavigator::create_trajectories(const Pose2D& pos
                  t.end_y + c.heading_lookahead_m * std::sin(t.end_th));
     int i = 0, j = 0;
     if (!local_.to_cell(p, i, j)) return -1;
-    return goal_dist_[static_cast<std::size_t>(j) * static_cast<std::size_t>(local_.nx()) +
-                      static_cast<std::size_t>(i)];
+    return goal_dist_[grid_index(i, j)];
   };
   double heading_dist = std::numeric_limits<double>::max();
   double vth = min_vth;

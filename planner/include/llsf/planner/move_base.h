@@ -344,12 +344,18 @@ class MoveBaseNavigator {
   bool rotating_ = false;
   double rotate_start_offset_ = 0.0;
   bool rotate_got_180_ = false;
-  // Rollout controller's grids (local costmap sized) and memory.
+  // Rollout controller's grids, the local costmap's cells with a one-cell frame around them
+  // (row length grid_w_; cell (i, j) at grid_index()), and memory.
   std::vector<int> path_dist_;
   std::vector<int> goal_dist_;
+  std::vector<int> grid_init_;  // update_grids(): the grids before a search
   std::vector<int> queue_;
-  std::vector<std::pair<int, int>> queue_ij_;  // update_grids(): queue_ cells' column and row
+  int grid_w_ = 0;
   int unreachable_ = 0;
+  std::size_t grid_index(int i, int j) const {
+    return static_cast<std::size_t>(j + 1) * static_cast<std::size_t>(grid_w_) +
+           static_cast<std::size_t>(i + 1);
+  }
   bool rotating_to_goal_ = false;
   bool stuck_left_ = false, stuck_right_ = false;
   bool stuck_left_strafe_ = false, stuck_right_strafe_ = false;
