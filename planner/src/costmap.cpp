@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 
 #include "llsf/core/assert.h"
 #include "llsf/planner/move_base.h"
@@ -70,16 +71,18 @@ Costmap::Costmap(Vec2 origin, int nx, int ny, double resolution_m, const MoveBas
       if (k.dj == dj) row.costs[static_cast<std::size_t>(k.di - lo)] = k.cost;
     }
     rows_.push_back(std::move(row));
+    kernel_r_ = std::max(kernel_r_, std::max(std::abs(dj), std::max(-lo, hi)));
   }
 }
 
-void Costmap::stamp(std::vector<std::uint8_t>& grid, int i, int j) const {
+void Costmap::stamp(std::vector<std::uint8_t>& grid, int i, int j, int ci0, int cj0, int ci1,
+                    int cj1) const {
   for (const KernelRow& row : rows_) {
     const int b = j + row.dj;
-    if (b < 0 || b >= ny_) continue;
+    if (b < cj0 || b > cj1) continue;
     const int first = i + row.di0;
-    const int a0 = std::max(0, first);
-    const int a1 = std::min(nx_ - 1, first + static_cast<int>(row.costs.size()) - 1);
+    const int a0 = std::max(ci0, first);
+    const int a1 = std::min(ci1, first + static_cast<int>(row.costs.size()) - 1);
     std::uint8_t* out = grid.data() + idx(0, b);
     const std::uint8_t* k = row.costs.data() - first;
     for (int a = a0; a <= a1; ++a) out[a] = std::max(out[a], k[a]);
@@ -129,6 +132,7 @@ void Costmap::set_static(const Planner& planner) {
   for (std::size_t n = 0; n < obstacle_.size(); ++n) {
     if (static_lethal_[n] != 0) obstacle_[n] = 0;
   }
+  mark_all_dirty();
   inflate();
 }
 
@@ -151,6 +155,7 @@ void Costmap::recenter(const Vec2& center) {
   }
   obstacle_.swap(moved);
   origin_ = Vec2(origin_.x() + si * res_, origin_.y() + sj * res_);
+  mark_all_dirty();
 }
 
 void Costmap::update(const Vec2& origin, std::span<const Vec2> hits, const Vec2& robot,
@@ -184,6 +189,7 @@ bool Costmap::erase_within(const Vec2& center, double radius_m) {
       if (o != 0) {
         o = 0;
         any = true;
+        mark_dirty(i, j);
       }
     }
   }
@@ -270,6 +276,7 @@ void Costmap::mark_and_clear(const Vec2& origin, std::span<const Vec2> hits) {
         const int num = 2 * k * minor - major, den = 2 * major;
         if (k < steps && num <= m * den && num > (m - 1) * den) {
           obstacle_[idx(i0 + cells[c].a, j0 + cells[c].b)] = 0;
+          mark_dirty(i0 + cells[c].a, j0 + cells[c].b);
           cells[c] = cells.back();  // cleared: no later beam needs to test it
           cells.pop_back();
           continue;
@@ -285,7 +292,11 @@ void Costmap::mark_and_clear(const Vec2& origin, std::span<const Vec2> hits) {
     int i = 0, j = 0;
     if (!to_cell(h, i, j)) continue;
     if (static_lethal_[idx(i, j)] != 0) continue;  // already an obstacle for good
-    obstacle_[idx(i, j)] = 1;
+    std::uint8_t& o = obstacle_[idx(i, j)];
+    if (o == 0) {
+      o = 1;
+      mark_dirty(i, j);
+    }
   }
 }
 
@@ -295,7 +306,11 @@ void Costmap::reset_outside(const Vec2& center, double size_m) {
     for (int i = 0; i < nx_; ++i) {
       const Vec2 c = cell_center(i, j);
       if (std::abs(c.x() - center.x()) > h || std::abs(c.y() - center.y()) > h) {
-        obstacle_[idx(i, j)] = 0;
+        std::uint8_t& o = obstacle_[idx(i, j)];
+        if (o != 0) {
+          o = 0;
+          mark_dirty(i, j);
+        }
       }
     }
   }
@@ -303,12 +318,33 @@ void Costmap::reset_outside(const Vec2& center, double size_m) {
 }
 
 void Costmap::inflate() {
-  cost_ = static_cost_;
-  for (int j = 0; j < ny_; ++j) {
-    for (int i = 0; i < nx_; ++i) {
-      if (obstacle_[idx(i, j)] != 0) stamp(cost_, i, j);
+  if (dirty_i0_ > dirty_i1_) return;  // no laser obstacle changed: nor did a cost
+  // The cells a changed obstacle cell reaches, and the obstacle cells that reach them.
+  const int r = kernel_r_;
+  const int ri0 = std::max(0, dirty_i0_ - r), ri1 = std::min(nx_ - 1, dirty_i1_ + r);
+  const int rj0 = std::max(0, dirty_j0_ - r), rj1 = std::min(ny_ - 1, dirty_j1_ + r);
+  const int oi0 = std::max(0, ri0 - r), oi1 = std::min(nx_ - 1, ri1 + r);
+  const int oj0 = std::max(0, rj0 - r), oj1 = std::min(ny_ - 1, rj1 + r);
+  const std::size_t n = static_cast<std::size_t>(ri1 - ri0 + 1);
+  for (int j = rj0; j <= rj1; ++j) {
+    std::memcpy(cost_.data() + idx(ri0, j), static_cost_.data() + idx(ri0, j), n);
+  }
+  for (int j = oj0; j <= oj1; ++j) {
+    const std::uint8_t* row = obstacle_.data() + idx(0, j);
+    for (int i = oi0; i <= oi1; ++i) {
+      if (i + 8 <= oi1 + 1) {  // eight free cells at a time
+        std::uint64_t block = 0;
+        std::memcpy(&block, row + i, sizeof block);
+        if (block == 0) {
+          i += 7;
+          continue;
+        }
+      }
+      if (row[i] != 0) stamp(cost_, i, j, ri0, rj0, ri1, rj1);
     }
   }
+  dirty_i0_ = dirty_j0_ = std::numeric_limits<int>::max();
+  dirty_i1_ = dirty_j1_ = -1;
 }
 
 }  // namespace llsf::planner

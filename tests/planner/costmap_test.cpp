@@ -2,7 +2,9 @@
 // The move_base-2013 costmap's laser update against a plain reference: every beam walked cell
 // by cell with the textbook Bresenham line (costmap_2d's raytraceLine), the hits marked, the
 // robot's circle cleared. Costmap::update tests beams against the obstacle cells instead of
-// walking them (planner/src/costmap.cpp); the cells it leaves must be the same.
+// walking them (planner/src/costmap.cpp); the cells it leaves must be the same. Costs: every
+// obstacle cell's inflation kernel (costmap_2d's cost of a distance) maxed over the whole grid;
+// Costmap::inflate recomputes only the cells a changed obstacle reaches.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -86,6 +88,34 @@ struct Reference {
       }
     }
   }
+
+  // The inflated costs of the whole grid, from nothing (no static layer here).
+  std::vector<std::uint8_t> costs(const MoveBaseConfig& c) const {
+    std::vector<std::uint8_t> out(obstacle.size(), Costmap::kFree);
+    const int inscribed = static_cast<int>(std::ceil(c.robot_radius_m / res - 1e-9));
+    const int reach = static_cast<int>(std::ceil(c.inflation_radius_m / res - 1e-9));
+    for (int b = 0; b < ny; ++b) {
+      for (int a = 0; a < nx; ++a) {
+        if (obstacle[static_cast<std::size_t>(b * nx + a)] == 0) continue;
+        for (int j = std::max(0, b - reach); j <= std::min(ny - 1, b + reach); ++j) {
+          for (int i = std::max(0, a - reach); i <= std::min(nx - 1, a + reach); ++i) {
+            const double d = std::hypot(double(i - a), double(j - b));
+            if (d > reach) continue;
+            const auto cost =
+                d == 0.0 ? Costmap::kLethal
+                : d <= inscribed
+                    ? Costmap::kInscribed
+                    : static_cast<std::uint8_t>(
+                          (Costmap::kInscribed - 1) *
+                          std::exp(-c.cost_scaling_factor * (d * res - c.robot_radius_m)));
+            std::uint8_t& o = out[static_cast<std::size_t>(j * nx + i)];
+            o = std::max(o, cost);
+          }
+        }
+      }
+    }
+    return out;
+  }
 };
 
 // `scans` random scans of `beams` beams from random origins, some reaching past the grid.
@@ -102,7 +132,8 @@ void compare(double res, int nx, int ny, int scans, int beams, std::uint32_t see
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const double w = nx * res, h = ny * res;
-  int cleared = 0, marked = 0;
+  int cleared = 0, marked = 0, costs_changed = 0;
+  std::vector<std::uint8_t> costs_before(static_cast<std::size_t>(nx * ny), Costmap::kFree);
   for (int scan = 0; scan < scans; ++scan) {
     // Origins mostly inside, now and then outside the grid.
     const Vec2 from(origin.x() + (u(rng) * 1.2 - 0.1) * w, origin.y() + (u(rng) * 1.2 - 0.1) * h);
@@ -129,15 +160,31 @@ void compare(double res, int nx, int ny, int scans, int beams, std::uint32_t see
         marked += (!was && want) ? 1 : 0;
       }
     }
+    const std::vector<std::uint8_t> costs = ref.costs(config);
+    for (int j = 0; j < ny; ++j) {
+      for (int i = 0; i < nx; ++i) {
+        const std::uint8_t want = costs[static_cast<std::size_t>(j * nx + i)];
+        if (costmap.cost(i, j) != want) {
+          FAIL_CHECK("scan " << scan << " cell " << i << "," << j << ": cost "
+                             << int(costmap.cost(i, j)) << ", reference " << int(want));
+          return;
+        }
+      }
+    }
+    costs_changed += costs != costs_before ? 1 : 0;
+    costs_before = costs;
   }
   // The comparison saw both kinds of change.
   CHECK(cleared > 100);
   CHECK(marked > 100);
+  CHECK(costs_changed > scans / 2);
 }
 
 }  // namespace
 
-TEST_CASE("costmap: the laser update leaves the cells the textbook beam walk leaves") {
+TEST_CASE(
+    "costmap: the laser update leaves the cells and costs of the textbook beam walk and "
+    "inflation") {
   SUBCASE("the global costmap's resolution") { compare(0.05, 112, 96, 60, 360, 7); }
   SUBCASE("the local rolling window's") { compare(0.1, 30, 30, 200, 360, 11); }
   SUBCASE("few beams, coarse cells") { compare(0.25, 23, 17, 300, 17, 13); }

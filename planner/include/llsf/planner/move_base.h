@@ -12,6 +12,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <string>
 #include <string_view>
@@ -177,7 +178,16 @@ class Costmap {
     return static_cast<std::size_t>(j) * static_cast<std::size_t>(nx_) +
            static_cast<std::size_t>(i);
   }
+  // Inflates the cells the laser obstacles changed since the last call could reach (all of them
+  // after set_static or recenter): only those cells' costs can differ.
   void inflate();
+  void mark_dirty(int i, int j) {
+    dirty_i0_ = std::min(dirty_i0_, i);
+    dirty_j0_ = std::min(dirty_j0_, j);
+    dirty_i1_ = std::max(dirty_i1_, i);
+    dirty_j1_ = std::max(dirty_j1_, j);
+  }
+  void mark_all_dirty() { dirty_i0_ = 0, dirty_j0_ = 0, dirty_i1_ = nx_ - 1, dirty_j1_ = ny_ - 1; }
   void mark_and_clear(const Vec2& origin, std::span<const Vec2> hits);
   bool erase_within(const Vec2& center, double radius_m);
 
@@ -203,7 +213,17 @@ class Costmap {
     std::vector<std::uint8_t> costs;
   };
   std::vector<KernelRow> rows_;
-  void stamp(std::vector<std::uint8_t>& grid, int i, int j) const;
+  int kernel_r_ = 0;  // the largest |dj| (and |di|) of the kernel
+  // The cells whose laser obstacle changed since the last inflate() (none: i0 > i1).
+  int dirty_i0_ = std::numeric_limits<int>::max(), dirty_j0_ = std::numeric_limits<int>::max();
+  int dirty_i1_ = -1, dirty_j1_ = -1;
+  // Raises `grid`'s cells within columns [ci0, ci1] and rows [cj0, cj1] to the kernel around
+  // (i, j).
+  void stamp(std::vector<std::uint8_t>& grid, int i, int j, int ci0, int cj0, int ci1,
+             int cj1) const;
+  void stamp(std::vector<std::uint8_t>& grid, int i, int j) const {
+    stamp(grid, i, j, 0, 0, nx_ - 1, ny_ - 1);
+  }
   double raytrace_range_ = 3.0;
   double obstacle_range_ = 3.0;
 };
