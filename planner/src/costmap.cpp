@@ -244,6 +244,43 @@ void Costmap::mark_and_clear(const Vec2& origin, std::span<const Vec2> hits) {
         any = true;
       }
     }
+    // Each cell by slope bins: a cell k cells along the major axis and m along the minor one is
+    // on the lines of slopes in ((2m - 1) / 2k, (2m + 1) / 2k] (the closed form below), so a
+    // line needs to test only the cells of its slope's bin.
+    constexpr int kB = kSlopeBins;
+    auto slope_bins = [](const OffsetCell& cell, int o, int& lo, int& hi) {
+      const int a = (o & 1) != 0 ? -cell.a : cell.a, b = (o & 2) != 0 ? -cell.b : cell.b;
+      const int k = (o & 4) != 0 ? b : a, m = (o & 4) != 0 ? a : b;
+      if (k == 0) {  // the origin's own cell: on every line
+        lo = 0;
+        hi = kB - 1;
+        return;
+      }
+      lo = m == 0 ? 0 : ((2 * m - 1) * kB) / (2 * k);
+      hi = std::min(kB - 1, ((2 * m + 1) * kB) / (2 * k));
+    };
+    slope_start_.fill(0);
+    for (int o = 0; o < 8; ++o) {
+      for (const OffsetCell& cell : octant_cells_[o]) {
+        int lo = 0, hi = 0;
+        slope_bins(cell, o, lo, hi);
+        for (int b = lo; b <= hi; ++b) ++slope_start_[o * kB + b + 1];
+      }
+    }
+    for (std::size_t n = 1; n < slope_start_.size(); ++n) slope_start_[n] += slope_start_[n - 1];
+    slope_cells_.resize(static_cast<std::size_t>(slope_start_.back()));
+    {
+      std::array<int, 8 * kB + 1> fill = slope_start_;
+      for (int o = 0; o < 8; ++o) {
+        for (const OffsetCell& cell : octant_cells_[o]) {
+          int lo = 0, hi = 0;
+          slope_bins(cell, o, lo, hi);
+          for (int b = lo; b <= hi; ++b) {
+            slope_cells_[static_cast<std::size_t>(fill[o * kB + b]++)] = cell;
+          }
+        }
+      }
+    }
     for (const Vec2& h : any ? hits : std::span<const Vec2>{}) {
       // The end point, clipped to the grid along the beam.
       Vec2 e = h;
@@ -262,12 +299,17 @@ void Costmap::mark_and_clear(const Vec2& origin, std::span<const Vec2> hits) {
       const int dx = std::abs(da), dy = std::abs(db);
       const int steps = std::min(std::max(dx, dy), max_cells);
       if (steps == 0) continue;
-      std::vector<OffsetCell>& cells = octant_cells_[octant_of(da, db)];
       const int sx = da >= 0 ? 1 : -1, sy = db >= 0 ? 1 : -1;
       const bool x_major = dx >= dy;
       const int major = x_major ? dx : dy, minor = x_major ? dy : dx;
-      for (std::size_t c = 0; c < cells.size();) {
-        const int a = cells[c].a * sx, b = cells[c].b * sy;  // both >= 0 in this octant
+      const int bin = octant_of(da, db) * kB + std::min(kB - 1, (minor * kB) / major);
+      const int first = slope_start_[static_cast<std::size_t>(bin)];
+      const int last = slope_start_[static_cast<std::size_t>(bin) + 1];
+      for (int c = first; c < last; ++c) {
+        const OffsetCell& cell = slope_cells_[static_cast<std::size_t>(c)];
+        std::uint8_t& o = obstacle_[idx(i0 + cell.a, j0 + cell.b)];
+        if (o == 0) continue;                        // cleared by an earlier beam
+        const int a = cell.a * sx, b = cell.b * sy;  // both >= 0 in this octant
         const int k = x_major ? a : b;
         const int m = x_major ? b : a;
         // The textbook Bresenham's minor offset at major step k is ceil(num / den) with
@@ -275,13 +317,9 @@ void Costmap::mark_and_clear(const Vec2& origin, std::span<const Vec2> hits) {
         // up to 90 cells): m is it iff (m - 1) den < num <= m den.
         const int num = 2 * k * minor - major, den = 2 * major;
         if (k < steps && num <= m * den && num > (m - 1) * den) {
-          obstacle_[idx(i0 + cells[c].a, j0 + cells[c].b)] = 0;
-          mark_dirty(i0 + cells[c].a, j0 + cells[c].b);
-          cells[c] = cells.back();  // cleared: no later beam needs to test it
-          cells.pop_back();
-          continue;
+          o = 0;
+          mark_dirty(i0 + cell.a, j0 + cell.b);
         }
-        ++c;
       }
     }
   }

@@ -2,7 +2,8 @@
 // The move_base-2013 costmap's laser update against a plain reference: every beam walked cell
 // by cell with the textbook Bresenham line (costmap_2d's raytraceLine), the hits marked, the
 // robot's circle cleared. Costmap::update tests beams against the obstacle cells instead of
-// walking them (planner/src/costmap.cpp); the cells it leaves must be the same. Costs: every
+// walking them (planner/src/costmap.cpp: only the obstacle cells in a line's octant and slope bin);
+// the cells it leaves must be the same. Costs: every
 // obstacle cell's inflation kernel (costmap_2d's cost of a distance) maxed over the whole grid;
 // Costmap::inflate recomputes only the cells a changed obstacle reaches.
 #include <doctest/doctest.h>

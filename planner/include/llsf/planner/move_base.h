@@ -207,6 +207,12 @@ class Costmap {
     int b;
   };
   std::array<std::vector<OffsetCell>, 8> octant_cells_;
+  // ... and by the slopes of the lines through them: bin b of octant o holds the cells whose
+  // lines' slopes (minor / major) reach [b / kSlopeBins, (b + 1) / kSlopeBins] (a flat list,
+  // bin o * kSlopeBins + b starting at slope_start_[o * kSlopeBins + b]).
+  static constexpr int kSlopeBins = 64;
+  std::vector<OffsetCell> slope_cells_;
+  std::array<int, 8 * kSlopeBins + 1> slope_start_{};
   struct KernelRow {  // the inflation kernel by rows: costs of cells di0, di0 + 1, ... of row dj
     int dj;
     int di0;
