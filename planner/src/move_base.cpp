@@ -886,19 +886,22 @@ void MoveBaseNavigator::update_grids(const Pose2D& pose) {
   int* queue = queue_.data();
   auto bfs = [&](std::vector<int>& dist, std::size_t tail) {
     int* g = dist.data();
-    const std::ptrdiff_t step[4] = {1, -1, w, -w};
     for (std::size_t head = 0; head < tail; ++head) {
       const std::ptrdiff_t k = queue[head];
       const int d = g[k] + 1;
-      for (const std::ptrdiff_t s : step) {
-        int& n = g[k + s];
+      auto visit = [&](std::ptrdiff_t kk) {
+        int& n = g[kk];
         if (n == unknown) {
           n = d;
-          queue[tail++] = static_cast<int>(k + s);
+          queue[tail++] = static_cast<int>(kk);
         } else if (n == blocked) {
           n = obstacle;
         }
-      }
+      };
+      visit(k + 1);
+      visit(k - 1);
+      visit(k + w);
+      visit(k - w);
     }
     for (int j = 0; j < ny; ++j) {
       int* row = g + grid_index(0, j);
