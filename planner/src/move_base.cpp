@@ -947,6 +947,33 @@ void MoveBaseNavigator::update_grids(const Pose2D& pose) {
   bfs(goal_dist_, tail);
 }
 
+MoveBaseNavigator::TrigRun& MoveBaseNavigator::trig_run(const Pose2D& pose,
+                                                        const VelocityCommand& vel, double vth_s,
+                                                        int steps) const {
+  const auto theta_bits = std::bit_cast<std::uint64_t>(pose.theta);
+  const auto omega_bits = std::bit_cast<std::uint64_t>(vel.omega_rps);
+  if (trig_used_ == 0 || trig_used_ >= 256 || theta_bits != trig_theta_bits_ ||
+      omega_bits != trig_omega_bits_) {
+    trig_used_ = 0;
+    trig_theta_bits_ = theta_bits;
+    trig_omega_bits_ = omega_bits;
+    trig_cos0_ = std::cos(pose.theta);
+    trig_sin0_ = std::sin(pose.theta);
+  }
+  const auto vth_bits = std::bit_cast<std::uint64_t>(vth_s);
+  for (std::size_t n = 0; n < trig_used_; ++n) {
+    TrigRun& r = trig_runs_[n];
+    if (r.vth_s_bits == vth_bits && r.steps == steps) return r;
+  }
+  if (trig_used_ == trig_runs_.size()) trig_runs_.emplace_back();
+  TrigRun& r = trig_runs_[trig_used_++];
+  r.vth_s_bits = vth_bits;
+  r.steps = steps;
+  r.cos_th.clear();
+  r.sin_th.clear();
+  return r;
+}
+
 void MoveBaseNavigator::generate(const Pose2D& pose, const VelocityCommand& vel, double vx_s,
                                  double vy_s, double vth_s, Traj& t) const {
   const MoveBaseConfig& c = config_;
@@ -965,7 +992,8 @@ void MoveBaseNavigator::generate(const Pose2D& pose, const VelocityCommand& vel,
   t.cost = -1.0;
   double occ = 0.0;
   int path_d = 0, goal_d = 0;
-  double trig_th = th, cos_th = std::cos(th), sin_th = std::sin(th);
+  TrigRun& run = trig_run(pose, vel, vth_s, steps);
+  double trig_th = th, cos_th = trig_cos0_, sin_th = trig_sin0_;
   for (int s = 0; s < steps; ++s) {
     int i = 0, j = 0;
     if (!m.to_cell(Vec2(x, y), i, j)) return;  // off the known map
@@ -985,10 +1013,19 @@ void MoveBaseNavigator::generate(const Pose2D& pose, const VelocityCommand& vel,
     vx = ramp(vx_s, vx, c.acc_lim_x, dt);
     vy = ramp(vy_s, vy, c.acc_lim_y, dt);
     vth = ramp(vth_s, vth, c.acc_lim_th, dt);
-    if (th != trig_th) {  // the same values, computed once per heading
-      cos_th = std::cos(th);
-      sin_th = std::sin(th);
+    const auto step = static_cast<std::size_t>(s);
+    if (step < run.cos_th.size()) {  // this heading's values, from an earlier sample
+      cos_th = run.cos_th[step];
+      sin_th = run.sin_th[step];
       trig_th = th;
+    } else {
+      if (th != trig_th) {  // the same values, computed once per heading
+        cos_th = std::cos(th);
+        sin_th = std::sin(th);
+        trig_th = th;
+      }
+      run.cos_th.push_back(cos_th);
+      run.sin_th.push_back(sin_th);
     }
     x += (vx * cos_th - vy * sin_th) * dt;
     y += (vx * sin_th + vy * cos_th) * dt;

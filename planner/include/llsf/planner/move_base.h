@@ -307,6 +307,19 @@ class MoveBaseNavigator {
   Traj create_trajectories(const Pose2D& pose, const VelocityCommand& vel);
   void generate(const Pose2D& pose, const VelocityCommand& vel, double vx_s, double vy_s,
                 double vth_s, Traj& t) const;
+  // generate()'s headings depend only on the start heading, the turn rate, the sampled turn rate
+  // and the number of steps: their cosines and sines, step by step, kept for the other samples
+  // of the same controller cycle (the trigonometry was a third of a rollout's cost).
+  struct TrigRun {
+    std::uint64_t vth_s_bits = 0;
+    int steps = 0;
+    std::vector<double> cos_th, sin_th;  // at step 0, 1, ... as far as a rollout went
+  };
+  mutable std::vector<TrigRun> trig_runs_;
+  mutable std::size_t trig_used_ = 0;
+  mutable std::uint64_t trig_theta_bits_ = 0, trig_omega_bits_ = 0;
+  mutable double trig_cos0_ = 1.0, trig_sin0_ = 0.0;
+  TrigRun& trig_run(const Pose2D& pose, const VelocityCommand& vel, double vth_s, int steps) const;
   bool rotation_free(const Pose2D& pose) const;
   void start_recovery(core::SimTime now, const Pose2D& pose);
   VelocityCommand run_recovery(core::SimTime now, const Pose2D& pose);
