@@ -37,6 +37,7 @@
 #include "llsf/core/input_file.h"
 #include "llsf/core/version.h"
 #include "llsf/sim/game.h"
+#include "llsf/sim/hackathon_extension.h"
 #include "llsf/sim/skill_brain.h"
 #include "llsf/study/batch.h"
 #include "llsf/study/player.h"
@@ -197,7 +198,7 @@ std::string find_why_not(const sim::Game& game, const Exercise& ex, int robot, c
            "(robot frame) turned into field coordinates";
   }
   // Another colour's puck.
-  for (const sim::HackathonPuck& k : game.hackathon_layout()->pucks) {
+  for (const sim::HackathonPuck& k : sim::hackathon_of(game)->layout().pucks) {
     if (k.colour == h.colour_index(ex.goal.colour) || !w.has_puck(k.id)) continue;
     if ((w.puck_position(k.id) - p).norm() > within) continue;
     return fmt::format(
@@ -352,7 +353,7 @@ SeedRun play_seed(const Exercise& ex, const ExerciseOptions& o, std::uint64_t se
       case Goal::Kind::kFind:
         return "searching";
       case Goal::Kind::kPoints: {
-        const sim::HackathonScore s = *game.hackathon_score();
+        const sim::HackathonScore s = *sim::hackathon_score(game);
         return fmt::format("{} points ({} of {} rescued, {} decoys)", s.points, s.rescued,
                            s.rescuable, s.decoys);
       }
@@ -445,7 +446,7 @@ SeedRun play_seed(const Exercise& ex, const ExerciseOptions& o, std::uint64_t se
         double best = 1e9;
         int best_id = -1;
         const int colour = ex.scenario.game.hackathon->colour_index(ex.goal.colour);
-        for (const sim::HackathonPuck& k : game.hackathon_layout()->pucks) {
+        for (const sim::HackathonPuck& k : sim::hackathon_of(game)->layout().pucks) {
           if (k.colour != colour || !game.world().has_puck(k.id)) continue;
           const double d = (game.world().puck_position(k.id) - *p).norm();
           if (d < best) best = d, best_id = k.id.value();
@@ -459,7 +460,7 @@ SeedRun play_seed(const Exercise& ex, const ExerciseOptions& o, std::uint64_t se
       break;
     }
     case Goal::Kind::kPoints: {
-      const sim::HackathonScore s = *game.hackathon_score();
+      const sim::HackathonScore s = *sim::hackathon_score(game);
       score = fmt::format("{} points: {} of {} rescued, {} decoys, need >= {}", s.points, s.rescued,
                           s.rescuable, s.decoys, ex.goal.points);
       passed = failed < 0 && s.points >= ex.goal.points;
