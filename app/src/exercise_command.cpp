@@ -181,7 +181,7 @@ void friendly(const std::string& message, const std::string& tmp, const std::str
 std::string find_why_not(const sim::Game& game, const Exercise& ex, int robot, core::Vec2 p,
                          int goal_puck) {
   const kinematic::World& w = game.world();
-  const sim::HackathonConfig& h = *ex.scenario.game.hackathon;
+  const sim::HackathonConfig& h = *sim::hackathon_config(ex.scenario.game);
   const double within = ex.goal.within_m;
   const core::RobotId rid = w.robot_by_name(game.robot(robot).name());
   const core::Pose2D pose = w.robot_pose(rid);
@@ -445,7 +445,7 @@ SeedRun play_seed(const Exercise& ex, const ExerciseOptions& o, std::uint64_t se
       } else {
         double best = 1e9;
         int best_id = -1;
-        const int colour = ex.scenario.game.hackathon->colour_index(ex.goal.colour);
+        const int colour = sim::hackathon_config(ex.scenario.game)->colour_index(ex.goal.colour);
         for (const sim::HackathonPuck& k : sim::hackathon_of(game)->layout().pucks) {
           if (k.colour != colour || !game.world().has_puck(k.id)) continue;
           const double d = (game.world().puck_position(k.id) - *p).norm();

@@ -3,16 +3,12 @@
 
 #include <utility>
 
-#include "llsf/sim/hackathon_extension.h"
-
 namespace llsf::sim {
 
 PreparedGame prepare_game(GameConfig config) {
   config.validate();
   PreparedGame p;
-  // The variants in their fixed order: the hackathon's, then GameConfig::extensions.
-  if (config.hackathon)
-    p.extensions.push_back(std::make_unique<HackathonExtension>(*config.hackathon));
+  // The variants in the order of GameConfig::extensions.
   for (const auto& factory : config.extensions) p.extensions.push_back(factory->make());
   // Each draws from its own named streams of the seed, so the order of setup() changes no draw.
   const core::Rng rng(config.seed);

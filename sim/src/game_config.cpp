@@ -131,13 +131,6 @@ void GameConfig::validate() const {
   hub.validate();
   planner.validate();
   controller.validate();
-  if (hackathon) {
-    try {
-      hackathon->validate(world);
-    } catch (const core::ConfigError& e) {
-      throw core::ConfigError("game." + std::string(e.what()));
-    }
-  }
   for (const auto& extension : extensions) {
     LLSF_DEMAND(extension != nullptr);
     extension->validate(*this);

@@ -91,7 +91,7 @@ TEST_CASE("GameDriver: no start leaves the refbox in PRE_GAME; same config, same
 
 TEST_CASE("prepare_game_config: the config the game plays; the hackathon layout drawn before it") {
   GameConfig c = test::small_game(1, 11);
-  c.hackathon = HackathonConfig{};
+  set_hackathon(c, HackathonConfig{});
   const GameConfig prepared = prepare_game_config(c);
   CHECK(prepared.world.obstacles.size() == c.world.obstacles.size() + 4);
   CHECK(prepared.planner.places.extra.size() == c.planner.places.extra.size() + 1);

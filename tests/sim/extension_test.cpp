@@ -211,17 +211,26 @@ TEST_CASE("game extension: setup changes the world from its own stream; add-ons;
 
 TEST_CASE("game extension: the hackathon world is one, found by type") {
   GameConfig c = test::small_game(2, 5);
-  c.hackathon = HackathonConfig{};
+  set_hackathon(c, HackathonConfig{});
   std::vector<Call> log;
   c.extensions.push_back(std::make_shared<CountingFactory>(&log, false));
   // The counting extension gives robot 0 interfaces as the hackathon does: refused.
   CHECK_THROWS_WITH_AS(Game{c}, doctest::Contains("hackathon and counting both give robot1"),
                        core::ConfigError);
-  c.extensions.clear();
+  c.extensions.pop_back();
+  // set_hackathon replaces the variant in its place; hackathon_config reads it back.
+  HackathonConfig seven;
+  seven.points_per_puck = 7;
+  set_hackathon(c, seven);
+  REQUIRE(c.extensions.size() == 1);
+  REQUIRE(hackathon_config(c) != nullptr);
+  CHECK(hackathon_config(c)->points_per_puck == 7);
+  CHECK(hackathon_config(test::small_game(1)) == nullptr);
   Game game(c);
   const HackathonExtension* h = game.extension<HackathonExtension>();
   REQUIRE(h != nullptr);
   CHECK(h == hackathon_of(game));
+  CHECK(h->config().points_per_puck == 7);
   CHECK(game.extension_count() == 1);
   for (int i = 0; i < game.robot_count(); ++i) {
     CHECK(game.robot(i).add_on() != nullptr);

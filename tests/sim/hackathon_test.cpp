@@ -35,14 +35,14 @@ struct CameraRig {
         planner(field_map_from_world(config.world), config.planner),
         stack("robot1", 0, config.world.robots[0].pose, config, planner, {"robot1"}, {},
               core::Rng(seed)),
-        info(hackathon_rescue_info(*config.hackathon, config.world)),
-        add_on(*config.hackathon, core::Rng(seed).stream("sim/robot1/colour"), &info) {
+        info(hackathon_rescue_info(*hackathon_config(config), config.world)),
+        add_on(*hackathon_config(config), core::Rng(seed).stream("sim/robot1/colour"), &info) {
     stack.set_add_on(&add_on);
   }
   static GameConfig make(HackathonConfig h, std::uint64_t seed) {
     GameConfig c;
     c.seed = seed;
-    c.hackathon = std::move(h);
+    set_hackathon(c, std::move(h));
     return c;
   }
   void tick() {
@@ -216,7 +216,7 @@ TEST_CASE("hackathon game: a Lua skill sees a puck, takes it and brings it to th
   h.camera.fov_rad = 2.0 * core::kPi;
   h.camera.miss_rate = 0.0;
   h.camera.false_colour_rate = 0.0;
-  c.hackathon = h;
+  set_hackathon(c, h);
   Game game(c);
   REQUIRE(hackathon_of(game) != nullptr);
   CHECK(game.world().pucks().size() == 3);

@@ -97,9 +97,8 @@ struct PreparedGame {
   std::vector<std::unique_ptr<GameExtension>> extensions;
 };
 
-/// Validates `config`, makes its extensions (the hackathon's first when GameConfig::hackathon is
-/// set, then GameConfig::extensions in order) and calls their setup() in that order with the
-/// Rng of `config.seed`. Throws core::ConfigError.
+/// Validates `config`, makes its extensions (one per GameConfig::extensions entry, in order) and
+/// calls their setup() in that order with the Rng of `config.seed`. Throws core::ConfigError.
 PreparedGame prepare_game(GameConfig config);
 
 }  // namespace llsf::sim

@@ -17,7 +17,6 @@
 #include "llsf/planner/move_base.h"
 #include "llsf/refbox/config.h"
 #include "llsf/refbox/protocol.h"
-#include "llsf/sim/hackathon.h"
 
 namespace llsf::sim {
 
@@ -204,13 +203,9 @@ struct GameConfig {
   /// product, a puck out of the game): 0 at once. A delivery gate shows its three lamps until
   /// then (shared/specs/llsf2013-rules.md §2.4: the referee is told to remove the puck).
   SimTime referee_remove_delay;
-  /// The hackathon variant (docs/hackathon.md): when set, the game gets a HackathonExtension
-  /// (hackathon_extension.h) that adds the obstacles, replaces the pucks by a coloured layout
-  /// drawn from the seed, adds the safe place to the planner and gives every robot the colour
-  /// camera and the rescue interface.
-  std::optional<HackathonConfig> hackathon;
-  /// Further variants (extension.h): each game makes its own extension from every entry, after
-  /// the hackathon's, and calls them in this order at the fixed points of the tick.
+  /// The game's variants (extension.h), e.g. the hackathon world (HackathonVariant, set by
+  /// set_hackathon()): each game makes its own extension from every entry and calls them in this
+  /// order at the fixed points of the tick.
   std::vector<std::shared_ptr<const GameExtensionFactory>> extensions;
   /// Radio peers outside the simulation (none unless the game is served on sockets); added to
   /// the hub after the refbox and the robots, in this order.
@@ -220,7 +215,8 @@ struct GameConfig {
   std::vector<std::shared_ptr<const comm::ProtoLibrary>> agent_protos;
 
   /// Throws core::ConfigError "game.<field>: reason" for the first bad field (the world,
-  /// refbox, protocol, hub and navigation configs are validated by their own validate()).
+  /// refbox, protocol, hub and navigation configs are validated by their own validate(), then
+  /// every extension by its factory's, in order).
   void validate() const;
 };
 

@@ -7,15 +7,47 @@
 
 #include <memory>
 #include <optional>
+#include <span>
+#include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "llsf/core/geometry.h"
 #include "llsf/sim/extension.h"
 #include "llsf/sim/hackathon.h"
-#include "llsf/sim/perception.h"
 
 namespace llsf::sim {
+
+/// The hackathon's flashlight camera (ColourCameraConfig): coloured pucks in a cone ahead, with
+/// seeded misses, false colours and position noise.
+class ColourCamera {
+ public:
+  ColourCamera(const ColourCameraConfig& config, std::vector<std::string> colour_names,
+               core::RandomStream rng);
+  /// Tick step 6. `colours`: the colour index of each entry of `pucks` (-1 none).
+  void update(SimTime now, const core::Pose2D& truth, std::span<const core::Vec2> pucks,
+              std::span<const int> colours);
+  std::span<const lua::ColourPuckSighting> sightings() const { return sightings_; }
+  /// When the current sightings were taken (the last frame; zero before the first) and the true
+  /// pose they are relative to: `frame_pose().to_parent(s.position)` is a sighting's field
+  /// position (recordings, the viewer).
+  SimTime frame_time() const { return frame_time_; }
+  const core::Pose2D& frame_pose() const { return frame_pose_; }
+  /// Frames taken so far (a new frame changes it, even with the same sightings).
+  std::int64_t frames() const { return frames_; }
+  const ColourCameraConfig& config() const { return c_; }
+
+ private:
+  ColourCameraConfig c_;
+  std::vector<std::string> colour_names_;
+  core::RandomStream rng_;
+  SimTime next_frame_;
+  SimTime frame_time_;
+  core::Pose2D frame_pose_;
+  std::int64_t frames_ = 0;
+  std::vector<lua::ColourPuckSighting> sightings_;
+};
 
 /// What a rescue skill knows about the task of `config` on `world` (lua::RobotApi::rescue).
 lua::RescueInfo hackathon_rescue_info(const HackathonConfig& config,
@@ -46,7 +78,7 @@ class HackathonRobot final : public RobotAddOn {
   const lua::RescueInfo* rescue_;
 };
 
-/// The hackathon world of one game (made by prepare_game when GameConfig::hackathon is set).
+/// The hackathon world of one game (made from the game config's HackathonVariant).
 class HackathonExtension final : public GameExtension {
  public:
   explicit HackathonExtension(HackathonConfig config);
@@ -87,6 +119,26 @@ class HackathonExtension final : public GameExtension {
   std::vector<core::Vec2> puck_positions_;
   std::vector<int> puck_colours_;  // colour index per entry of puck_positions_
 };
+
+/// The hackathon variant's entry in GameConfig::extensions (a scenario's `hackathon:` section):
+/// its configuration, validated against the game's world, and the factory of its extension.
+class HackathonVariant final : public GameExtensionFactory {
+ public:
+  explicit HackathonVariant(HackathonConfig config) : config_(std::move(config)) {}
+  const HackathonConfig& config() const { return config_; }
+  /// Throws core::ConfigError "game.hackathon.<field>: reason" (HackathonConfig::validate).
+  void validate(const GameConfig& game) const override;
+  std::unique_ptr<GameExtension> make() const override;
+
+ private:
+  HackathonConfig config_;
+};
+
+/// Makes `game` a hackathon game of `config`: its HackathonVariant entry in `game.extensions`,
+/// replacing an earlier one in its place or added at the end.
+void set_hackathon(GameConfig& game, HackathonConfig config);
+/// The hackathon configuration of `game` (its HackathonVariant), or nullptr outside the variant.
+const HackathonConfig* hackathon_config(const GameConfig& game);
 
 /// The hackathon extension of `game`, or nullptr outside the variant.
 const HackathonExtension* hackathon_of(const Game& game);
