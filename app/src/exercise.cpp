@@ -15,6 +15,7 @@
 #include "llsf/core/config.h"
 #include "llsf/core/data_dir.h"
 #include "llsf/core/error.h"
+#include "llsf/sim/hackathon_extension.h"
 
 namespace llsf::app {
 
@@ -50,7 +51,8 @@ Exercise load_exercise(const std::string& dir) {
   sc.require_map();
   if (!sc["name"].defined()) sc.set("name", core::ConfigNode::parse("'" + ex.name + "'", ex.file));
   ex.scenario = study::read_scenario_map(sc, ex.file);
-  if (!ex.scenario.game.hackathon) {
+  const sim::HackathonConfig* hackathon = sim::hackathon_config(ex.scenario.game);
+  if (hackathon == nullptr) {
     sc.fail("an exercise plays the hackathon variant: add `hackathon: {}` (docs/hackathon.md)");
   }
   for (const study::RobotSpec& r : ex.scenario.robots) {
@@ -87,7 +89,7 @@ Exercise load_exercise(const std::string& dir) {
     f.require_map();
     ex.goal.kind = Goal::Kind::kFind;
     ex.goal.colour = f.at("colour").as_string();
-    if (ex.scenario.game.hackathon->colour_index(ex.goal.colour) < 0) {
+    if (hackathon->colour_index(ex.goal.colour) < 0) {
       f["colour"].fail("'" + ex.goal.colour + "' is not a colour of scenario.hackathon.colours");
     }
     ex.goal.within_m = 0.3;
@@ -114,7 +116,8 @@ std::string describe_goal(const Exercise& ex) {
           ">= {} points in {:.0f} s (a puck of a counted colour released in the "
           "safe area: +{}, a decoy: -{}); the skill must not fail",
           ex.goal.points, ex.scenario.duration.seconds(),
-          ex.scenario.game.hackathon->points_per_puck, ex.scenario.game.hackathon->decoy_penalty);
+          sim::hackathon_config(ex.scenario.game)->points_per_puck,
+          sim::hackathon_config(ex.scenario.game)->decoy_penalty);
   }
   return "";
 }

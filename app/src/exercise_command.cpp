@@ -37,6 +37,7 @@
 #include "llsf/core/input_file.h"
 #include "llsf/core/version.h"
 #include "llsf/sim/game.h"
+#include "llsf/sim/hackathon_extension.h"
 #include "llsf/sim/skill_brain.h"
 #include "llsf/study/batch.h"
 #include "llsf/study/player.h"
@@ -180,7 +181,7 @@ void friendly(const std::string& message, const std::string& tmp, const std::str
 std::string find_why_not(const sim::Game& game, const Exercise& ex, int robot, core::Vec2 p,
                          int goal_puck) {
   const kinematic::World& w = game.world();
-  const sim::HackathonConfig& h = *ex.scenario.game.hackathon;
+  const sim::HackathonConfig& h = *sim::hackathon_config(ex.scenario.game);
   const double within = ex.goal.within_m;
   const core::RobotId rid = w.robot_by_name(game.robot(robot).name());
   const core::Pose2D pose = w.robot_pose(rid);
@@ -197,7 +198,7 @@ std::string find_why_not(const sim::Game& game, const Exercise& ex, int robot, c
            "(robot frame) turned into field coordinates";
   }
   // Another colour's puck.
-  for (const sim::HackathonPuck& k : game.hackathon_layout()->pucks) {
+  for (const sim::HackathonPuck& k : sim::hackathon_of(game)->layout().pucks) {
     if (k.colour == h.colour_index(ex.goal.colour) || !w.has_puck(k.id)) continue;
     if ((w.puck_position(k.id) - p).norm() > within) continue;
     return fmt::format(
@@ -352,7 +353,7 @@ SeedRun play_seed(const Exercise& ex, const ExerciseOptions& o, std::uint64_t se
       case Goal::Kind::kFind:
         return "searching";
       case Goal::Kind::kPoints: {
-        const sim::HackathonScore s = *game.hackathon_score();
+        const sim::HackathonScore s = *sim::hackathon_score(game);
         return fmt::format("{} points ({} of {} rescued, {} decoys)", s.points, s.rescued,
                            s.rescuable, s.decoys);
       }
@@ -444,8 +445,8 @@ SeedRun play_seed(const Exercise& ex, const ExerciseOptions& o, std::uint64_t se
       } else {
         double best = 1e9;
         int best_id = -1;
-        const int colour = ex.scenario.game.hackathon->colour_index(ex.goal.colour);
-        for (const sim::HackathonPuck& k : game.hackathon_layout()->pucks) {
+        const int colour = sim::hackathon_config(ex.scenario.game)->colour_index(ex.goal.colour);
+        for (const sim::HackathonPuck& k : sim::hackathon_of(game)->layout().pucks) {
           if (k.colour != colour || !game.world().has_puck(k.id)) continue;
           const double d = (game.world().puck_position(k.id) - *p).norm();
           if (d < best) best = d, best_id = k.id.value();
@@ -459,7 +460,7 @@ SeedRun play_seed(const Exercise& ex, const ExerciseOptions& o, std::uint64_t se
       break;
     }
     case Goal::Kind::kPoints: {
-      const sim::HackathonScore s = *game.hackathon_score();
+      const sim::HackathonScore s = *sim::hackathon_score(game);
       score = fmt::format("{} points: {} of {} rescued, {} decoys, need >= {}", s.points, s.rescued,
                           s.rescuable, s.decoys, ex.goal.points);
       passed = failed < 0 && s.points >= ex.goal.points;

@@ -27,6 +27,7 @@
 #include "llsf/planner/planner.h"
 #include "llsf/sim/game.h"
 #include "llsf/sim/game_config.h"
+#include "llsf/sim/hackathon_extension.h"
 #include "llsf/study/scenario.h"
 
 namespace llsf::app {
@@ -254,6 +255,7 @@ std::string place_label(const planner::Place& p) {
 
 std::string draw_svg(const MapSource& src, const planner::Planner& planner) {
   const sim::GameConfig& c = src.config;
+  const sim::HackathonConfig* hackathon = sim::hackathon_config(c);
   const kinematic::FieldConfig& f = c.world.field;
   const planner::FieldMap& map = planner.field();
   const double r = planner.config().inflated_radius_m();
@@ -305,11 +307,12 @@ std::string draw_svg(const MapSource& src, const planner::Planner& planner) {
     }
   };
   area(map.insertion_area, "area-insertion", "insertion area", "area-insertion");
-  area(map.input_storage, "area-storage", c.hackathon ? "" : "input storage", "area-storage");
+  area(map.input_storage, "area-storage", hackathon != nullptr ? "" : "input storage",
+       "area-storage");
   area(map.late_order_area, "area-late", "late orders", "area-late-order");
   area(map.delivery_zone, "area-delivery", "delivery zone", "area-delivery");
-  if (c.hackathon) {
-    const kinematic::Rect& a = c.hackathon->safe_area;
+  if (hackathon != nullptr) {
+    const kinematic::Rect& a = hackathon->safe_area;
     area(planner::AreaRect{a.lo, a.hi}, "area-safe", "SAFE AREA", "safe-area");
   }
   s.circle(map.late_order_slot.x(), map.late_order_slot.y(), 0.05 * kScale, "rfid");
@@ -370,7 +373,7 @@ std::string draw_svg(const MapSource& src, const planner::Planner& planner) {
   }
 
   // Pucks at their start (not in the hackathon: its layout is drawn from each seed).
-  if (!c.hackathon) {
+  if (hackathon == nullptr) {
     for (const kinematic::PuckPlacement& p : c.world.pucks) {
       s.circle(p.position.x(), p.position.y(), c.world.puck.radius_m * kScale, "puck");
     }
@@ -411,12 +414,12 @@ std::string draw_svg(const MapSource& src, const planner::Planner& planner) {
     }
     py += 6;
   }
-  if (c.hackathon) {
-    const kinematic::Rect& a = c.hackathon->safe_area;
+  if (hackathon != nullptr) {
+    const kinematic::Rect& a = hackathon->safe_area;
     line("Safe area", "panel-h");
     line(fmt::format("x {}..{}, y {}..{}", m2(a.lo.x()), m2(a.hi.x()), m2(a.lo.y()), m2(a.hi.y())),
          "panel");
-    if (const planner::Place* p = planner.place(c.hackathon->safe_place)) {
+    if (const planner::Place* p = planner.place(hackathon->safe_place)) {
       line(fmt::format("{} ({}, {}) {}", p->name, m2(p->pose.x), m2(p->pose.y), deg(p->pose.theta)),
            "panel");
     }
@@ -458,6 +461,7 @@ std::string draw_svg(const MapSource& src, const planner::Planner& planner) {
 /// The same content as Markdown tables (docs/field.md embeds it).
 std::string draw_table(const MapSource& src, const planner::Planner& planner) {
   const sim::GameConfig& c = src.config;
+  const sim::HackathonConfig* hackathon = sim::hackathon_config(c);
   const planner::FieldMap& map = planner.field();
   std::ostringstream o;
   o << "Field " << m2(map.width_m) << " x " << m2(map.height_m) << " m (" << src.title
@@ -485,7 +489,7 @@ std::string draw_table(const MapSource& src, const planner::Planner& planner) {
   area("input storage", {map.input_storage.lo, map.input_storage.hi});
   area("late-order area", {map.late_order_area.lo, map.late_order_area.hi});
   area("delivery zone", {map.delivery_zone.lo, map.delivery_zone.hi});
-  if (c.hackathon) area("safe area", {c.hackathon->safe_area.lo, c.hackathon->safe_area.hi});
+  if (hackathon != nullptr) area("safe area", {hackathon->safe_area.lo, hackathon->safe_area.hi});
   o << "\n| robot | x | y | heading (deg) |\n|---|---|---|---|\n";
   for (const kinematic::RobotStart& rb : c.world.robots) {
     o << "| " << rb.name << " | " << m2(rb.pose.x) << " | " << m2(rb.pose.y) << " | "

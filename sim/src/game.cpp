@@ -25,6 +25,7 @@
 #include <utility>
 
 #include "llsf/core/assert.h"
+#include "llsf/core/error.h"
 
 namespace llsf::sim {
 
@@ -117,16 +118,12 @@ planner::FieldMap field_map_from_world(const kinematic::WorldConfig& w) {
 
 // --- construction ----------------------------------------------------------------------------
 
-Game::Game(GameConfig config)
-    : config_(prepare_game_config(std::move(config))), rng_(config_.seed) {
-  // The hackathon variant: the colour of every puck of the layout, by puck id.
-  if (config_.hackathon_layout) {
-    for (const HackathonPuck& p : config_.hackathon_layout->pucks) {
-      const auto id = static_cast<std::size_t>(p.id.value());
-      if (id >= puck_colour_by_id_.size()) puck_colour_by_id_.resize(id + 1, -1);
-      puck_colour_by_id_[id] = p.colour;
-    }
-  }
+Game::Game(GameConfig config) : Game(prepare_game(std::move(config))) {}
+
+Game::Game(PreparedGame prepared)
+    : extensions_(std::move(prepared.extensions)),
+      config_(std::move(prepared.config)),
+      rng_(config_.seed) {
   world_ = std::make_unique<kinematic::World>(config_.world, rng_);
   protocol_ = std::make_unique<refbox::RefboxProtocol>(config_.refbox, rng_, config_.protocol);
 
@@ -186,8 +183,24 @@ Game::Game(GameConfig config)
   discs_.reserve(robots);
   others_.reserve(robots);
   puck_positions_.reserve(config_.world.pucks.size() + 32);
-  puck_colours_.reserve(config_.world.pucks.size() + 32);
   events_ = &no_events_;
+
+  // The extensions on the built game; what they give the robots' skill API (one each at most).
+  for (const auto& e : extensions_) e->on_built(*this);
+  for (int i = 0; i < robot_count(); ++i) {
+    const GameExtension* giver = nullptr;
+    for (const auto& e : extensions_) {
+      const RobotAddOn* add_on = e->robot_add_on(i);
+      if (add_on == nullptr) continue;
+      if (giver != nullptr) {
+        throw core::ConfigError("game.extensions: " + std::string(giver->name()) + " and " +
+                                std::string(e->name()) + " both give " +
+                                std::string(robot(i).name()) + " skill interfaces");
+      }
+      giver = e.get();
+      robot(i).set_add_on(add_on);
+    }
+  }
 }
 
 Game::~Game() = default;
@@ -345,6 +358,7 @@ void Game::step() {
   // 1. Time advances by the physics step; everything in this tick happens at `now`.
   const SimTime now = world_->time() + config_.world.physics.step;
   const int n = robot_count();
+  for (const auto& e : extensions_) e->pre_step(*this, now);
 
   // 2. Actuators: symbolic skills' changes of the world first; then each stack's navigator or
   //    motor command, with the other robots as discs.
@@ -475,14 +489,7 @@ void Game::step() {
   const auto lights = world_->all_lights();
   std::copy(lights.begin(), lights.end(), lights_.begin());
   puck_positions_.clear();
-  puck_colours_.clear();
   world_->puck_positions(puck_positions_);
-  if (config_.hackathon_layout) {
-    for (const core::PuckId p : world_->pucks()) {
-      const auto id = static_cast<std::size_t>(p.value());
-      puck_colours_.push_back(id < puck_colour_by_id_.size() ? puck_colour_by_id_[id] : -1);
-    }
-  }
   for (int i = 0; i < n; ++i) {
     const core::RobotId id(i);
     RobotPercept p;
@@ -491,9 +498,9 @@ void Game::step() {
     p.sensors = &world_->sensors(id);
     p.lights = lights_;
     p.pucks = puck_positions_;
-    p.puck_colours = puck_colours_;
     stacks_[static_cast<std::size_t>(i)]->sense(p);
   }
+  for (const auto& e : extensions_) e->sense(*this, now);
 
   mark(5);
 
@@ -519,8 +526,9 @@ void Game::step() {
 
   mark(7);
 
-  // 9. Recorder and statistics.
+  // 9. Extensions, then recorder and statistics.
   ++ticks_;
+  for (const auto& e : extensions_) e->post_step(*this, now);
   if (tick_hook_) tick_hook_(*this);
   mark(8);
   if (profiling_) ++profile_.ticks;
@@ -605,24 +613,6 @@ core::Vec2 Game::free_storage_spot() const {
 }
 
 // --- summary ---------------------------------------------------------------------------------
-
-std::optional<HackathonScore> Game::hackathon_score() const {
-  if (!config_.hackathon_layout) return std::nullopt;
-  std::vector<HackathonPuckState> states;
-  std::vector<core::PuckId> held;
-  for (int r = 0; r < robot_count(); ++r) {
-    if (const auto p = puck_in_pocket(r)) held.push_back(*p);
-  }
-  for (const HackathonPuck& p : config_.hackathon_layout->pucks) {
-    HackathonPuckState s;
-    s.id = p.id;
-    s.on_field = world_->has_puck(p.id);
-    if (s.on_field) s.position = world_->puck_position(p.id);
-    s.held = std::find(held.begin(), held.end(), p.id) != held.end();
-    states.push_back(s);
-  }
-  return score_hackathon(*config_.hackathon, *config_.hackathon_layout, states);
-}
 
 GameSummary Game::summary() const {
   const refbox::Refbox& rb = refbox();

@@ -2,9 +2,12 @@
 #include "llsf/sim/game_config.h"
 
 #include <cmath>
+#include <utility>
 
+#include "llsf/core/assert.h"
 #include "llsf/core/error.h"
 #include "llsf/core/geometry.h"
+#include "llsf/sim/extension.h"
 
 namespace llsf::sim {
 
@@ -128,25 +131,12 @@ void GameConfig::validate() const {
   hub.validate();
   planner.validate();
   controller.validate();
-  if (hackathon) {
-    try {
-      hackathon->validate(world);
-    } catch (const core::ConfigError& e) {
-      throw core::ConfigError("game." + std::string(e.what()));
-    }
+  for (const auto& extension : extensions) {
+    LLSF_DEMAND(extension != nullptr);
+    extension->validate(*this);
   }
 }
 
-GameConfig prepare_game_config(GameConfig config) {
-  config.validate();
-  if (!config.hackathon || config.hackathon_layout) return config;
-  const HackathonConfig& h = *config.hackathon;
-  config.hackathon_layout = generate_hackathon_layout(h, config.world, core::Rng(config.seed));
-  apply_hackathon_layout(h, *config.hackathon_layout, config.world);
-  config.planner.places.extra.push_back(
-      {h.safe_place,
-       hackathon_safe_pose(h, config.world, config.planner.places.held_puck_offset_m)});
-  return config;
-}
+GameConfig prepare_game_config(GameConfig config) { return prepare_game(std::move(config)).config; }
 
 }  // namespace llsf::sim

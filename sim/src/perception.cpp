@@ -364,49 +364,4 @@ void PuckVision::update(SimTime now, const core::Pose2D& truth, std::span<const 
   }
 }
 
-// --- the hackathon's colour camera -------------------------------------------------------------
-
-ColourCamera::ColourCamera(const ColourCameraConfig& config, std::vector<std::string> colour_names,
-                           core::RandomStream rng)
-    : c_(config), colour_names_(std::move(colour_names)), rng_(rng) {
-  sightings_.reserve(64);
-}
-
-// A cone ahead of the robot, one frame every 1/frame_rate_hz; per puck in the cone three draws
-// (miss, false colour, which colour) and two for the position noise, whatever the outcome, so
-// that one puck's luck does not shift the others'.
-void ColourCamera::update(SimTime now, const core::Pose2D& truth, std::span<const core::Vec2> pucks,
-                          std::span<const int> puck_colours) {
-  if (now < next_frame_) return;
-  const SimTime period = SimTime::period_of_hz(c_.frame_rate_hz);
-  next_frame_ += period;
-  if (next_frame_ <= now) next_frame_ = now + period;
-  sightings_.clear();
-  frame_time_ = now;
-  frame_pose_ = truth;
-  ++frames_;
-  const double half_fov = 0.5 * c_.fov_rad;
-  const int colours = static_cast<int>(colour_names_.size());
-  for (std::size_t i = 0; i < pucks.size() && i < puck_colours.size(); ++i) {
-    const int colour = puck_colours[i];
-    if (colour < 0) continue;
-    const core::Vec2 l = truth.to_local(pucks[i]);
-    const double d = l.norm();
-    if (d > c_.range_m || std::abs(std::atan2(l.y(), l.x())) > half_fov) continue;
-    const bool missed = rng_.bernoulli(c_.miss_rate);
-    const bool wrong = rng_.bernoulli(c_.false_colour_rate);
-    const std::int64_t other = colours > 1 ? rng_.uniform_int(0, colours - 2) : 0;
-    const core::Vec2 noise(rng_.normal(0.0, c_.position_noise_m),
-                           rng_.normal(0.0, c_.position_noise_m));
-    if (missed) continue;
-    int seen = colour;
-    if (wrong && colours > 1)
-      seen =
-          static_cast<int>(other) >= colour ? static_cast<int>(other) + 1 : static_cast<int>(other);
-    const core::Vec2 at = l + noise;
-    sightings_.push_back(
-        {at, at.norm(), std::atan2(at.y(), at.x()), colour_names_[static_cast<std::size_t>(seen)]});
-  }
-}
-
 }  // namespace llsf::sim

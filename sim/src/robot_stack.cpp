@@ -65,22 +65,6 @@ RobotStack::RobotStack(std::string name, int index, const core::Pose2D& start,
     move_base_.emplace(planner, config.levels.move_base);
     laser_mount_ = {config.world.sensors.laser.mount_x_m, config.world.sensors.laser.mount_y_m};
   }
-  if (config.hackathon) {
-    const HackathonConfig& h = *config.hackathon;
-    std::vector<std::string> colour_names;
-    lua::RescueInfo info;
-    info.safe_lo = h.safe_area.lo;
-    info.safe_hi = h.safe_area.hi;
-    info.safe_place = h.safe_place;
-    for (const HackathonColour& c : h.colours) {
-      colour_names.push_back(c.name);
-      (c.decoy ? info.decoys : info.counted).push_back(c.name);
-    }
-    info.held_puck_offset_m = config.world.robot.radius_m + config.world.puck.radius_m;
-    rescue_ = std::move(info);
-    colour_camera_.emplace(h.camera, std::move(colour_names),
-                           rng.stream("sim/" + name_ + "/colour"));
-  }
 }
 
 // --- actuation -------------------------------------------------------------------------------
@@ -386,7 +370,6 @@ void RobotStack::sense(const RobotPercept& p) {
   }
   light_.update(p.now, p.true_pose, p.lights);
   puck_vision_.update(p.now, p.true_pose, p.pucks);
-  if (colour_camera_) colour_camera_->update(p.now, p.true_pose, p.pucks, p.puck_colours);
 }
 
 }  // namespace llsf::sim

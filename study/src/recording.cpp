@@ -20,6 +20,7 @@
 #include "llsf/core/error.h"
 #include "llsf/planner/move_base.h"
 #include "llsf/refbox/refbox.h"
+#include "llsf/sim/hackathon_extension.h"
 
 namespace llsf::study {
 
@@ -261,8 +262,9 @@ Recorder::Recorder(const std::string& path, const sim::Game& game, const Recordi
     }
     h["obstacles"] = std::move(obstacles);
   }
-  if (const sim::HackathonLayout* layout = game.hackathon_layout()) {
-    const sim::HackathonConfig& hc = *game.config().hackathon;
+  if (const sim::HackathonExtension* hackathon = sim::hackathon_of(game)) {
+    const sim::HackathonLayout* layout = &hackathon->layout();
+    const sim::HackathonConfig& hc = hackathon->config();
     const kinematic::Rect& a = hc.safe_area;
     Json colours = Json::array();
     for (const auto& c : hc.colours) colours.push_back({{"name", c.name}, {"decoy", c.decoy}});
@@ -573,10 +575,11 @@ void Recorder::frame(const sim::Game& game) {
 
   // The colour camera's new frames (hackathon): its sightings in the field frame, written when a
   // frame saw pucks or the previous written one did. The navigators' refusals and failures.
+  const sim::HackathonExtension* hackathon = sim::hackathon_of(game);
   for (int i = 0; i < game.robot_count(); ++i) {
     const auto r = static_cast<std::size_t>(i);
     const sim::RobotStack& stack = game.robot(i);
-    if (const sim::ColourCamera* cam = stack.colour_camera();
+    if (const sim::ColourCamera* cam = hackathon != nullptr ? &hackathon->camera(i) : nullptr;
         cam != nullptr && cam->frames() != m.camera_frames[r]) {
       m.camera_frames[r] = cam->frames();
       const auto seen = cam->sightings();
@@ -717,7 +720,7 @@ void Recorder::frame(const sim::Game& game) {
   m.write(f);
 
   // The hackathon score, at the frame rate, when it changed.
-  if (const std::optional<sim::HackathonScore> score = game.hackathon_score()) {
+  if (const std::optional<sim::HackathonScore> score = sim::hackathon_score(game)) {
     if (!m.score_known || score->points != m.score.points || score->rescued != m.score.rescued ||
         score->decoys != m.score.decoys || score->in_safe_area != m.score.in_safe_area) {
       if (m.score_known || score->rescued != 0 || score->decoys != 0) {

@@ -19,6 +19,7 @@
 #include "llsf/refbox/protocol.h"
 #include "llsf/sim/agent_brain.h"
 #include "llsf/sim/driver.h"
+#include "llsf/sim/hackathon_extension.h"
 #include "llsf/study/metrics.h"
 #include "llsf/study/player.h"
 #include "llsf/study/recording.h"
@@ -749,7 +750,7 @@ RunResult run_game(const Scenario& scenario, std::uint64_t seed, const RunHooks&
     verdicts.push_back(std::move(v));
   }
   r.tests = std::move(verdicts);
-  r.hackathon = game.hackathon_score();
+  r.hackathon = sim::hackathon_score(game);
   if (hooks.profile) {
     for (int i = 0; i < sim::Game::TickProfile::kSteps; ++i) {
       r.time_split.emplace_back(

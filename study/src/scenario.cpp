@@ -23,6 +23,7 @@
 #include "llsf/kinematic/world_config.h"
 #include "llsf/planner/config.h"
 #include "llsf/refbox/config.h"
+#include "llsf/sim/hackathon_extension.h"
 #include "llsf/study/profile.h"
 
 namespace llsf::study {
@@ -547,7 +548,7 @@ Scenario read_scenario(const core::ConfigNode& root, const std::string& file) {
     n.no_other_keys();
   }
   if (const core::ConfigNode n = root["hackathon"]; n.defined()) {
-    s.game.hackathon = sim::load_hackathon_config(n, s.game.world);
+    sim::set_hackathon(s.game, sim::load_hackathon_config(n, s.game.world));
     s.start = StartMode::kNone;
   }
   root.read_enum("start", s.start,
@@ -562,7 +563,7 @@ Scenario read_scenario(const core::ConfigNode& root, const std::string& file) {
   if (s.start == StartMode::kGame && !rb.team.empty() && !rb.skip_setup) {
     duration += rb.setup_duration.seconds();
   }
-  if (s.game.hackathon) duration = kHackathonDefaultDuration.seconds();
+  if (sim::hackathon_config(s.game) != nullptr) duration = kHackathonDefaultDuration.seconds();
   root.read("duration_s", duration,
             core::in_range(ScenarioLimits::kMinDurationS, ScenarioLimits::kMaxDurationS));
   s.duration = core::SimTime::from_seconds(duration);
@@ -584,7 +585,7 @@ Scenario read_scenario(const core::ConfigNode& root, const std::string& file) {
   } catch (const core::ConfigError& e) {
     fail_at_game_key(root, e);
   }
-  if (s.game.hackathon) {
+  if (sim::hackathon_config(s.game) != nullptr) {
     // The layout of the first seed: pucks that find no free spot are an error of the file.
     try {
       (void)sim::prepare_game_config(s.game);

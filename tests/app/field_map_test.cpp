@@ -16,6 +16,7 @@
 #include "cli_fixture.h"
 #include "llsf/core/geometry.h"
 #include "llsf/kinematic/world_config.h"
+#include "llsf/sim/hackathon_extension.h"
 #include "llsf/study/scenario.h"
 
 namespace {
@@ -120,17 +121,18 @@ TEST_CASE("field-map: the hackathon's obstacles, safe area and SAFE place at the
   const llsf::study::ScenarioFile f =
       llsf::study::load_scenario(kSource + "/scenarios/hackathon.yaml");
   const llsf::sim::GameConfig& c = f.variants.front().game;
-  REQUIRE(c.hackathon);
-  REQUIRE(!c.hackathon->obstacles.empty());
+  const llsf::sim::HackathonConfig* hackathon = llsf::sim::hackathon_config(c);
+  REQUIRE(hackathon != nullptr);
+  REQUIRE(!hackathon->obstacles.empty());
   const std::string svg = read_text(kSource + "/docs/images/hackathon-map.svg");
-  for (const llsf::kinematic::ObstacleConfig& o : c.hackathon->obstacles) {
+  for (const llsf::kinematic::ObstacleConfig& o : hackathon->obstacles) {
     check_named_at(svg, "obstacle-" + o.name, o.pose.x, o.pose.y, o.name);
   }
-  const llsf::kinematic::Rect& a = c.hackathon->safe_area;
+  const llsf::kinematic::Rect& a = hackathon->safe_area;
   CHECK(has(svg, "id=\"safe-area\" data-x-min=\"" + m2(a.lo.x()) + "\" data-y-min=\"" +
                      m2(a.lo.y()) + "\" data-x-max=\"" + m2(a.hi.x()) + "\" data-y-max=\"" +
                      m2(a.hi.y()) + "\""));
-  CHECK(!group(svg, "place-" + c.hackathon->safe_place).empty());
+  CHECK(!group(svg, "place-" + hackathon->safe_place).empty());
   for (const llsf::kinematic::RobotStart& rb : c.world.robots) {
     check_named_at(svg, "robot-" + rb.name, rb.pose.x, rb.pose.y, rb.name);
   }

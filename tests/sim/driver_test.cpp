@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "fixture.h"
+#include "llsf/sim/hackathon_extension.h"
 
 using namespace llsf;
 using namespace llsf::sim;
@@ -88,31 +89,30 @@ TEST_CASE("GameDriver: no start leaves the refbox in PRE_GAME; same config, same
   CHECK(a.world_hash != none.world_hash);
 }
 
-TEST_CASE("prepare_game_config: the hackathon layout is drawn before the game, once") {
+TEST_CASE("prepare_game_config: the config the game plays; the hackathon layout drawn before it") {
   GameConfig c = test::small_game(1, 11);
-  c.hackathon = HackathonConfig{};
+  set_hackathon(c, HackathonConfig{});
   const GameConfig prepared = prepare_game_config(c);
-  REQUIRE(prepared.hackathon_layout);
   CHECK(prepared.world.obstacles.size() == c.world.obstacles.size() + 4);
   CHECK(prepared.planner.places.extra.size() == c.planner.places.extra.size() + 1);
-  // Idempotent: a prepared config is taken as it is.
-  const GameConfig twice = prepare_game_config(prepared);
-  CHECK(twice.world.obstacles.size() == prepared.world.obstacles.size());
-  CHECK(twice.planner.places.extra.size() == prepared.planner.places.extra.size());
-  // The game plays the prepared config and never changes it.
+  // The game plays the prepared config and never changes it; its extension keeps the layout
+  // that was put into the world.
   Game game(c);
-  REQUIRE(game.config().hackathon_layout);
   CHECK(game.config().world.obstacles.size() == prepared.world.obstacles.size());
-  REQUIRE(game.hackathon_layout() != nullptr);
-  CHECK(game.hackathon_layout()->pucks.size() == prepared.hackathon_layout->pucks.size());
-  for (std::size_t i = 0; i < prepared.hackathon_layout->pucks.size(); ++i) {
-    CHECK(game.hackathon_layout()->pucks[i].position.x() ==
-          prepared.hackathon_layout->pucks[i].position.x());
+  CHECK(game.config().planner.places.extra.size() == prepared.planner.places.extra.size());
+  const HackathonExtension* h = hackathon_of(game);
+  REQUIRE(h != nullptr);
+  REQUIRE(h->layout().pucks.size() == prepared.world.pucks.size());
+  for (std::size_t i = 0; i < h->layout().pucks.size(); ++i) {
+    CHECK(h->layout().pucks[i].id.value() == prepared.world.pucks[i].id);
+    CHECK(h->layout().pucks[i].position.x() == prepared.world.pucks[i].position.x());
   }
-  // Without the variant nothing is added.
+  // Without the variant nothing is added and the game has no extension.
   const GameConfig plain = prepare_game_config(test::small_game(1, 11));
-  CHECK_FALSE(plain.hackathon_layout);
   CHECK(plain.world.obstacles.size() == test::small_game(1, 11).world.obstacles.size());
+  const Game plain_game(test::small_game(1, 11));
+  CHECK(hackathon_of(plain_game) == nullptr);
+  CHECK(plain_game.extension_count() == 0);
 }
 
 TEST_CASE("the radio's game side: robots by hub peer, inbox filled and cleared by the game") {

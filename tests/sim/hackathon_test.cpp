@@ -12,6 +12,7 @@
 #include "llsf/core/error.h"
 #include "llsf/sim/game.h"
 #include "llsf/sim/hackathon.h"
+#include "llsf/sim/hackathon_extension.h"
 #include "llsf/sim/skill_brain.h"
 
 using namespace llsf;
@@ -26,17 +27,22 @@ double box_distance(const core::Vec2& p, const core::OrientedBox& b) {
   return (l - n).norm();
 }
 
-/// A stack of robot1 without a world, fed with synthetic percepts (as levels_test.cpp).
+/// A stack of robot1 without a world, fed with synthetic percepts (as levels_test.cpp), with
+/// the hackathon's part of robot1 (as HackathonExtension gives it) as its add-on.
 struct CameraRig {
   explicit CameraRig(HackathonConfig h, std::uint64_t seed = 5)
       : config(make(std::move(h), seed)),
         planner(field_map_from_world(config.world), config.planner),
         stack("robot1", 0, config.world.robots[0].pose, config, planner, {"robot1"}, {},
-              core::Rng(seed)) {}
+              core::Rng(seed)),
+        info(hackathon_rescue_info(*hackathon_config(config), config.world)),
+        add_on(*hackathon_config(config), core::Rng(seed).stream("sim/robot1/colour"), &info) {
+    stack.set_add_on(&add_on);
+  }
   static GameConfig make(HackathonConfig h, std::uint64_t seed) {
     GameConfig c;
     c.seed = seed;
-    c.hackathon = std::move(h);
+    set_hackathon(c, std::move(h));
     return c;
   }
   void tick() {
@@ -47,12 +53,14 @@ struct CameraRig {
     p.sensors = &sensors;
     p.lights = lights;
     p.pucks = pucks;
-    p.puck_colours = colours;
     stack.sense(p);
+    add_on.update(now, pose, pucks, colours);  // the extension's step 6, after the stacks
   }
   GameConfig config;
   planner::Planner planner;
   RobotStack stack;
+  lua::RescueInfo info;
+  HackathonRobot add_on;
   kinematic::RobotSensors sensors;
   std::array<kinematic::SignalLights, kinematic::kDeviceCount> lights{};
   std::vector<core::Vec2> pucks;
@@ -208,12 +216,12 @@ TEST_CASE("hackathon game: a Lua skill sees a puck, takes it and brings it to th
   h.camera.fov_rad = 2.0 * core::kPi;
   h.camera.miss_rate = 0.0;
   h.camera.false_colour_rate = 0.0;
-  c.hackathon = h;
+  set_hackathon(c, h);
   Game game(c);
-  REQUIRE(game.hackathon_layout() != nullptr);
+  REQUIRE(hackathon_of(game) != nullptr);
   CHECK(game.world().pucks().size() == 3);
   CHECK(game.planner().place("SAFE") != nullptr);
-  CHECK(game.hackathon_score()->points == 0);
+  CHECK(hackathon_score(game)->points == 0);
 
   const std::string dir =
       (std::filesystem::temp_directory_path() / "llsf_hackathon_skill").string();
@@ -264,7 +272,7 @@ function LEAVE:init() self.args["leave_puck"] = {distance = 0.3} end
   while (game.time() < end && brain.engine().status() == lua::SkillStatus::kRunning) game.step();
   INFO(brain.engine().error());
   CHECK(brain.engine().status() == lua::SkillStatus::kFinal);
-  const HackathonScore score = *game.hackathon_score();
+  const HackathonScore score = *hackathon_score(game);
   CHECK(score.rescued == 1);
   CHECK(score.decoys == 0);
   CHECK(score.points == 10);

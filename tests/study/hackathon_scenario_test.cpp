@@ -7,6 +7,7 @@
 #include <string>
 
 #include "llsf/core/error.h"
+#include "llsf/sim/hackathon_extension.h"
 #include "llsf/study/scenario.h"
 
 using namespace llsf;
@@ -30,12 +31,13 @@ hackathon:
 )");
   const ScenarioFile f = load_scenario(ok);
   const Scenario& s = f.variants.at(0);
-  REQUIRE(s.game.hackathon);
+  const sim::HackathonConfig* hackathon = sim::hackathon_config(s.game);
+  REQUIRE(hackathon != nullptr);
   CHECK(s.start == StartMode::kNone);
   CHECK(s.duration == core::SimTime::from_sec(300));
-  CHECK(s.game.hackathon->camera.range_m == 0.5);
-  CHECK(s.game.hackathon->camera.fov_rad == doctest::Approx(60.0 * core::kPi / 180.0));
-  CHECK(s.game.hackathon->obstacles.size() == 4);
+  CHECK(hackathon->camera.range_m == 0.5);
+  CHECK(hackathon->camera.fov_rad == doctest::Approx(60.0 * core::kPi / 180.0));
+  CHECK(hackathon->obstacles.size() == 4);
 
   auto error_of = [](const std::string& name, const std::string& text) {
     try {

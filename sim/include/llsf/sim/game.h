@@ -24,6 +24,7 @@
 #include "llsf/planner/planner.h"
 #include "llsf/refbox/protocol.h"
 #include "llsf/refbox/refbox.h"
+#include "llsf/sim/extension.h"
 #include "llsf/sim/game_config.h"
 #include "llsf/sim/robot_stack.h"
 
@@ -63,17 +64,18 @@ struct GameSummary {
 /// not thread-safe; games in different threads are independent.
 class Game {
  public:
-  /// Completes `config` with prepare_game_config() (validation, the hackathon layout; throws
-  /// core::ConfigError), then builds everything from it and never changes it: world, refbox +
-  /// protocol adapter (hub peer "refbox" on "*"), hub with the refbox and agent messages
-  /// registered, planner, and a RobotStack + hub peer (channel "team") per world robot.
+  /// Completes `config` with prepare_game() (validation, the extensions made and set up: the
+  /// hackathon layout; throws core::ConfigError), then builds everything from it and never
+  /// changes it: world, refbox + protocol adapter (hub peer "refbox" on "*"), hub with the refbox
+  /// and agent messages registered, planner, and a RobotStack + hub peer (channel "team") per
+  /// world robot; then calls every extension's on_built() and gives the robots their add-ons.
   explicit Game(GameConfig config);
   ~Game();
   Game(const Game&) = delete;
   Game& operator=(const Game&) = delete;
 
-  /// One tick:
-  /// 1. time advances by the physics step;
+  /// One tick (the extensions' hooks are called in the order of their list):
+  /// 1. time advances by the physics step; extensions' pre_step();
   /// 2. actuators: every stack's command (navigator or motor) goes to World::set_command;
   /// 3. the world steps; its RFID and collision events are collected;
   /// 4. refbox: RFID events in (same device and puck ids), insertion-slot occupancy, messages
@@ -81,10 +83,11 @@ class Game {
   ///    are carried out (delivered pucks removed, late-order S0 added), its messages broadcast;
   /// 5. comm: robots' beacons (every beacon_period) broadcast, the hub steps, deliveries go to
   ///    the refbox (llsf_msgs only) and to the inboxes of robots with a brain;
-  /// 6. sensors: every stack perceives the world at its abstraction levels;
+  /// 6. sensors: every stack perceives the world at its abstraction levels; then extensions'
+  ///    sense();
   /// 7. skills: brains' on_skill_cycle at skill_rate_hz;
   /// 8. agents: brains' on_agent_cycle at agent_rate_hz (inboxes are then cleared);
-  /// 9. the tick hook, if set.
+  /// 9. extensions' post_step(), then the tick hook, if set.
   void step();
   /// Steps until time() >= `until`.
   void run_until(SimTime until);
@@ -158,12 +161,23 @@ class Game {
 
   GameSummary summary() const;
 
-  /// The hackathon variant's puck layout of this game (GameConfig::hackathon), or nullptr.
-  const HackathonLayout* hackathon_layout() const {
-    return config_.hackathon_layout ? &*config_.hackathon_layout : nullptr;
+  /// The game's first extension of type T (e.g. HackathonExtension), or nullptr.
+  template <class T>
+  T* extension() {
+    for (const auto& e : extensions_) {
+      if (auto* t = dynamic_cast<T*>(e.get())) return t;
+    }
+    return nullptr;
   }
-  /// The hackathon score now (pucks released in the safe area), or nullopt outside the variant.
-  std::optional<HackathonScore> hackathon_score() const;
+  template <class T>
+  const T* extension() const {
+    for (const auto& e : extensions_) {
+      if (const auto* t = dynamic_cast<const T*>(e.get())) return t;
+    }
+    return nullptr;
+  }
+  /// How many extensions the game has (prepare_game's order).
+  int extension_count() const { return static_cast<int>(extensions_.size()); }
 
   /// Where a tick's time goes: steady-clock nanoseconds per tick step (1..9 of step()), summed
   /// over the ticks since profiling was enabled. For benchmarks; costs a few clock reads a tick.
@@ -184,6 +198,7 @@ class Game {
   const TickProfile& profile() const { return profile_; }
 
  private:
+  explicit Game(PreparedGame prepared);
   void apply_refbox_output(const refbox::StepOutput& out, SimTime now);
   /// Carries out robot `robot`'s symbolic skill requests (tick step 2).
   void apply_symbolic(int robot);
@@ -199,7 +214,8 @@ class Game {
   core::Vec2 free_storage_spot() const;
   bool insertion_slot_occupied() const;
 
-  const GameConfig config_;  // frozen: prepare_game_config() before anything is built
+  std::vector<std::unique_ptr<GameExtension>> extensions_;  // called in this order
+  const GameConfig config_;  // frozen: prepare_game() before anything is built
   core::Rng rng_;
   std::unique_ptr<kinematic::World> world_;
   std::unique_ptr<refbox::RefboxProtocol> protocol_;
@@ -238,10 +254,6 @@ class Game {
   std::vector<planner::DiscObstacle> discs_;
   std::vector<planner::DiscObstacle> others_;
   std::vector<core::Vec2> puck_positions_;
-  std::vector<int> puck_colours_;  // hackathon: colour index per entry of puck_positions_
-
-  // The hackathon variant.
-  std::vector<int> puck_colour_by_id_;  // indexed by puck id; -1: no colour
   std::array<kinematic::SignalLights, kinematic::kDeviceCount> lights_{};
 
   // Counters.

@@ -17,11 +17,12 @@
 #include "llsf/planner/move_base.h"
 #include "llsf/refbox/config.h"
 #include "llsf/refbox/protocol.h"
-#include "llsf/sim/hackathon.h"
 
 namespace llsf::sim {
 
 using core::SimTime;
+
+class GameExtensionFactory;  // extension.h
 
 /// Localization abstraction level: what RobotApi::pose() returns.
 enum class LocalizationLevel : std::uint8_t {
@@ -202,13 +203,10 @@ struct GameConfig {
   /// product, a puck out of the game): 0 at once. A delivery gate shows its three lamps until
   /// then (shared/specs/llsf2013-rules.md §2.4: the referee is told to remove the puck).
   SimTime referee_remove_delay;
-  /// The hackathon variant (docs/hackathon.md): when set, the Game adds its obstacles, replaces
-  /// the pucks by a coloured layout drawn from the seed, adds the safe place to the planner and
-  /// gives every robot the colour camera and the rescue interface.
-  std::optional<HackathonConfig> hackathon;
-  /// The hackathon variant's puck layout for `seed`, drawn and applied to `world` and
-  /// `planner` by prepare_game_config() before a Game is built (never set it by hand).
-  std::optional<HackathonLayout> hackathon_layout;
+  /// The game's variants (extension.h), e.g. the hackathon world (HackathonVariant, set by
+  /// set_hackathon()): each game makes its own extension from every entry and calls them in this
+  /// order at the fixed points of the tick.
+  std::vector<std::shared_ptr<const GameExtensionFactory>> extensions;
   /// Radio peers outside the simulation (none unless the game is served on sockets); added to
   /// the hub after the refbox and the robots, in this order.
   std::vector<ExternalPeerConfig> external_peers;
@@ -217,15 +215,17 @@ struct GameConfig {
   std::vector<std::shared_ptr<const comm::ProtoLibrary>> agent_protos;
 
   /// Throws core::ConfigError "game.<field>: reason" for the first bad field (the world,
-  /// refbox, protocol, hub and navigation configs are validated by their own validate()).
+  /// refbox, protocol, hub and navigation configs are validated by their own validate(), then
+  /// every extension by its factory's, in order).
   void validate() const;
 };
 
-/// The configuration a Game plays, complete before the game is built (a Game never changes its
-/// config): validated, and in the hackathon variant with the layout of `config.seed` drawn
-/// (generate_hackathon_layout, stream "sim/hackathon/layout"), put into the world (boxes added,
-/// pucks replaced) and the safe place added to the planner's places. A config whose layout is
-/// drawn already is returned unchanged (after validation). Throws core::ConfigError.
+/// The configuration a Game built from `config` plays (Game::config()): validated, with its
+/// extensions' setup() applied (in the hackathon variant the layout of `config.seed` drawn,
+/// stream "sim/hackathon/layout", put into the world -- boxes added, pucks replaced -- and the
+/// safe place added to the planner's places). For looking at and checking a configuration; a
+/// Game is built from the unprepared one (its extensions would add their changes again).
+/// Throws core::ConfigError.
 GameConfig prepare_game_config(GameConfig config);
 
 }  // namespace llsf::sim

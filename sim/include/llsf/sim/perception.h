@@ -120,34 +120,4 @@ class PuckVision {
   std::vector<int> cluster_;
 };
 
-/// The hackathon's flashlight camera (ColourCameraConfig): coloured pucks in a cone ahead, with
-/// seeded misses, false colours and position noise.
-class ColourCamera {
- public:
-  ColourCamera(const ColourCameraConfig& config, std::vector<std::string> colour_names,
-               core::RandomStream rng);
-  /// Tick step 6. `colours`: the colour index of each entry of `pucks` (-1 none).
-  void update(SimTime now, const core::Pose2D& truth, std::span<const core::Vec2> pucks,
-              std::span<const int> colours);
-  std::span<const lua::ColourPuckSighting> sightings() const { return sightings_; }
-  /// When the current sightings were taken (the last frame; zero before the first) and the true
-  /// pose they are relative to: `frame_pose().to_parent(s.position)` is a sighting's field
-  /// position (recordings, the viewer).
-  SimTime frame_time() const { return frame_time_; }
-  const core::Pose2D& frame_pose() const { return frame_pose_; }
-  /// Frames taken so far (a new frame changes it, even with the same sightings).
-  std::int64_t frames() const { return frames_; }
-  const ColourCameraConfig& config() const { return c_; }
-
- private:
-  ColourCameraConfig c_;
-  std::vector<std::string> colour_names_;
-  core::RandomStream rng_;
-  SimTime next_frame_;
-  SimTime frame_time_;
-  core::Pose2D frame_pose_;
-  std::int64_t frames_ = 0;
-  std::vector<lua::ColourPuckSighting> sightings_;
-};
-
 }  // namespace llsf::sim

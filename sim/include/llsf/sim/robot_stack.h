@@ -23,6 +23,7 @@
 #include "llsf/kinematic/world.h"
 #include "llsf/lua/robot_api.h"
 #include "llsf/planner/navigator.h"
+#include "llsf/sim/extension.h"
 #include "llsf/sim/game_config.h"
 #include "llsf/sim/perception.h"
 
@@ -37,9 +38,6 @@ struct RobotPercept {
   std::span<const kinematic::SignalLights> lights;
   /// Field positions of every puck on the field.
   std::span<const core::Vec2> pucks;
-  /// Hackathon: the colour (index into HackathonConfig::colours, -1 none) of each entry of
-  /// `pucks`; empty outside the variant.
-  std::span<const int> puck_colours;
 };
 
 /// A change of the world a symbolic skill asked for (lua::RobotApi::symbolic_*); the Game
@@ -175,10 +173,12 @@ class RobotStack final : public lua::RobotApi {
   std::span<const lua::PuckSighting> pucks() const override { return puck_vision_.sightings(); }
   lua::LaserView laser() const override { return laser_; }
   std::span<const lua::ColourPuckSighting> colour_pucks() const override {
-    return colour_camera_ ? colour_camera_->sightings()
-                          : std::span<const lua::ColourPuckSighting>{};
+    return add_on_ != nullptr ? add_on_->colour_pucks()
+                              : std::span<const lua::ColourPuckSighting>{};
   }
-  const lua::RescueInfo* rescue() const override { return rescue_ ? &*rescue_ : nullptr; }
+  const lua::RescueInfo* rescue() const override {
+    return add_on_ != nullptr ? add_on_->rescue() : nullptr;
+  }
   std::optional<lua::PlaceInfo> place(std::string_view name) const override;
   bool symbolic() const override { return levels_.skill == SkillLevel::kSymbolic; }
   lua::TravelEstimate symbolic_travel(const core::Pose2D& goal) const override;
@@ -199,8 +199,10 @@ class RobotStack final : public lua::RobotApi {
   void set_motor_enabled(bool on) { motor_enabled_ = on; }
   int jam_device() const { return jam_device_; }
   int jams() const { return jams_; }
-  /// The hackathon's colour camera (its sightings, frame time and pose), nullptr outside it.
-  const ColourCamera* colour_camera() const { return colour_camera_ ? &*colour_camera_ : nullptr; }
+  /// What a game extension gives this robot's skill API (borrowed from the extension; set by
+  /// the Game before the first tick), or nullptr.
+  const RobotAddOn* add_on() const { return add_on_; }
+  void set_add_on(const RobotAddOn* add_on) { add_on_ = add_on; }
   /// How many navigations failed so far (NavFailure), for recordings and tools.
   std::int64_t nav_failures() const { return nav_failure_count_; }
   /// The failure number `n` (0-based, < nav_failures()) if it is among the last
@@ -272,8 +274,7 @@ class RobotStack final : public lua::RobotApi {
   Localization localization_;
   LightDetection light_;
   PuckVision puck_vision_;
-  std::optional<ColourCamera> colour_camera_;  ///< hackathon only
-  std::optional<lua::RescueInfo> rescue_;      ///< hackathon only
+  const RobotAddOn* add_on_ = nullptr;  ///< a game extension's interfaces (the hackathon's)
 };
 
 }  // namespace llsf::sim

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "llsf/sim/game.h"
+#include "llsf/sim/hackathon.h"
 #include "llsf/sim/skill_brain.h"
 #include "llsf/study/scenario.h"
 
