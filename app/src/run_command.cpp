@@ -5,7 +5,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
@@ -15,7 +14,6 @@
 #include <memory>
 #include <optional>
 #include <ostream>
-#include <regex>
 #include <set>
 #include <sstream>
 #include <string>
@@ -28,12 +26,12 @@
 #include "live.h"
 #include "llsf/app/cli.h"
 #include "llsf/clips/agent.h"
+#include "llsf/clips/agent_files.h"
 #include "llsf/clips/source_check.h"
 #include "llsf/comm/socket_config.h"
 #include "llsf/core/config.h"
 #include "llsf/core/error.h"
-#include "llsf/core/input_file.h"
-#include "llsf/core/text.h"
+#include "llsf/lua/skill_doc.h"
 #include "llsf/sim/agent_brain.h"
 #include "llsf/study/metrics.h"
 #include "llsf/study/player.h"
@@ -418,168 +416,6 @@ int run(const RunOptions& o, std::ostream& out, std::ostream& err) {
   return r.passed() ? kExitOk : kExitFailed;
 }
 
-/// An agent's source with its comments blanked (strings kept), and where each line starts.
-struct AgentSource {
-  std::string file;
-  std::string code;
-  int line_of(std::size_t pos) const {
-    return 1 +
-           static_cast<int>(std::count(code.begin(), code.begin() + static_cast<long>(pos), '\n'));
-  }
-};
-
-/// One agent file's code with its comments blanked (lines and columns kept); "" when it cannot
-/// be read (the agent's load reports that).
-AgentSource read_agent_source(const std::string& f) {
-  std::string error;  // reported when the agent loads
-  AgentSource src{
-      f, core::try_read_input_file(f, core::kMaxSourceBytes, "CLIPS file", error).value_or("")};
-  bool in_string = false;
-  bool comment = false;
-  for (char& c : src.code) {
-    if (c == '\n') {
-      comment = false;
-    } else if (comment) {
-      c = ' ';
-    } else if (c == '"') {
-      in_string = !in_string;
-    } else if (c == ';' && !in_string) {
-      comment = true;
-      c = ' ';
-    }
-  }
-  return src;
-}
-
-std::vector<AgentSource> read_agent_sources(const std::vector<std::string>& entries) {
-  std::vector<AgentSource> out;
-  for (const std::string& f : sim::agent_files(entries)) out.push_back(read_agent_source(f));
-  return out;
-}
-
-/// A Fawkes-style agent's files in the order it loads them (docs/fawkes.md): the entry file,
-/// then each file a `(path-load FILE)` with a literal name loads (relative to the agent
-/// directory, inside it), at the place of that call, the files it path-loads after it; then the
-/// other .clp files of the entry file's directory in name order (a name computed at run time
-/// cannot be followed).
-std::vector<AgentSource> read_fawkes_sources(const std::string& agent_dir,
-                                             const std::string& entry) {
-  namespace fs = std::filesystem;
-  static const std::regex kPathLoad(R"re(\(path-load\s+(?:"([^"]*)"|([^\s()"]+)))re");
-  std::error_code ec;
-  const fs::path dir = fs::weakly_canonical(agent_dir, ec);
-  std::vector<AgentSource> out;
-  std::set<std::string> seen;
-  // Depth first, each file once: a file's own path-loads come right after it.
-  auto visit = [&](auto&& self, const fs::path& file) -> void {
-    std::error_code e;
-    const fs::path p = fs::weakly_canonical(file, e);
-    if (e || !fs::is_regular_file(p, e) || !seen.insert(p.string()).second) return;
-    const auto [d_end, p_it] = std::mismatch(dir.begin(), dir.end(), p.begin(), p.end());
-    if (d_end != dir.end()) return;  // outside the agent directory: the load refuses it
-    out.push_back(read_agent_source(file.string()));
-    const std::string code = out.back().code;
-    for (auto it = std::sregex_iterator(code.begin(), code.end(), kPathLoad);
-         it != std::sregex_iterator(); ++it) {
-      const std::string name = (*it)[1].matched ? (*it)[1].str() : (*it)[2].str();
-      const fs::path rel(name);
-      self(self, rel.is_absolute() ? rel : fs::path(agent_dir) / rel);
-    }
-  };
-  visit(visit, fs::path(entry));
-  for (const std::string& f : sim::agent_files({fs::path(entry).parent_path().string()})) {
-    std::error_code e;
-    const fs::path p = fs::weakly_canonical(f, e);
-    if (!e && !seen.contains(p.string())) out.push_back(read_agent_source(f));
-  }
-  return out;
-}
-
-/// The argument names a skill's documentation declares, one `@param NAME[, NAME...]` per line
-/// (docs/skills.md).
-std::vector<std::string> documented_params(const std::string& doc) {
-  std::vector<std::string> out;
-  for (std::size_t at = doc.find("@param"); at != std::string::npos;
-       at = doc.find("@param", at + 1)) {
-    std::size_t i = at + 6;
-    for (;;) {
-      while (i < doc.size() && (doc[i] == ' ' || doc[i] == '\t')) ++i;
-      std::size_t e = i;
-      while (e < doc.size() &&
-             (std::isalnum(static_cast<unsigned char>(doc[e])) != 0 || doc[e] == '_'))
-        ++e;
-      if (e == i) break;
-      out.push_back(doc.substr(i, e - i));
-      i = e;
-      if (i < doc.size() && doc[i] == ',') {
-        ++i;
-        continue;
-      }
-      break;
-    }
-  }
-  return out;
-}
-
-/// The literal argument names of a `(skill-call NAME key value key value ...)` whose name ends
-/// at `pos` of `code` (comments blanked): each key that is a plain symbol; stops at the call's
-/// `)` or at anything else (a variable or an expression in a key's place).
-std::vector<std::string> skill_call_arguments(const std::string& code, std::size_t pos) {
-  std::vector<std::string> out;
-  auto skip_space = [&] {
-    while (pos < code.size() && std::isspace(static_cast<unsigned char>(code[pos])) != 0) ++pos;
-  };
-  // Skips one value: a string, a parenthesised expression or a token.
-  auto skip_value = [&] {
-    if (pos >= code.size()) return;
-    if (code[pos] == '"') {
-      for (++pos; pos < code.size() && code[pos] != '"'; ++pos) {
-        if (code[pos] == '\\') ++pos;
-      }
-      ++pos;
-    } else if (code[pos] == '(') {
-      int depth = 0;
-      bool in_string = false;
-      for (; pos < code.size(); ++pos) {
-        const char c = code[pos];
-        if (in_string) {
-          if (c == '\\')
-            ++pos;
-          else if (c == '"')
-            in_string = false;
-        } else if (c == '"') {
-          in_string = true;
-        } else if (c == '(') {
-          ++depth;
-        } else if (c == ')' && --depth == 0) {
-          ++pos;
-          break;
-        }
-      }
-    } else {
-      while (pos < code.size() && std::isspace(static_cast<unsigned char>(code[pos])) == 0 &&
-             code[pos] != '(' && code[pos] != ')') {
-        ++pos;
-      }
-    }
-  };
-  for (;;) {
-    skip_space();
-    if (pos >= code.size() || code[pos] == ')') break;
-    const std::size_t b = pos;
-    while (pos < code.size() && (std::isalnum(static_cast<unsigned char>(code[pos])) != 0 ||
-                                 code[pos] == '_' || code[pos] == '-')) {
-      ++pos;
-    }
-    if (pos == b || (pos < code.size() && std::isspace(static_cast<unsigned char>(code[pos])) == 0))
-      break;  // not a plain symbol: a variable, an expression, a string
-    out.push_back(code.substr(b, pos - b));
-    skip_space();
-    skip_value();
-  }
-  return out;
-}
-
 /// One of `check`'s findings about an agent.
 struct AgentWarning {
   enum class Kind { kWarn, kNote };
@@ -589,149 +425,39 @@ struct AgentWarning {
   bool operator<(const AgentWarning& o) const { return text < o.text; }
 };
 
-/// `check`'s warnings about one robot's agent (docs/llsfsim.md, `check`): rule conditions that
-/// read the time where CLIPS does not evaluate them again (clips::TimeReadCheck); skill names in
-/// `(skill-call NAME ...)` the skill library does not have (with `brain` only); confval paths
-/// the scenario sets that no agent file names, and the reverse; the lock switch against the
-/// agent's use of lock facts; the sandbox switched off. Those marked in_run `run` prints too.
+/// `check`'s warnings about one robot's agent (docs/llsfsim.md, `check`): the static checks of
+/// its files (clips::check_agent: time reads, skill calls against the skill library with
+/// `brain` only, confvals against robots.config, the lock switch), then the sandbox switched
+/// off. Those marked in_run `run` prints too.
 std::vector<AgentWarning> agent_warnings(const study::RobotSpec& spec,
                                          const sim::AgentBrain* brain) {
-  std::vector<AgentWarning> warnings;
-  auto warn = [&warnings](std::string text, bool in_run = false) {
-    warnings.push_back({AgentWarning::Kind::kWarn, in_run, std::move(text)});
-  };
-  auto note = [&warnings](std::string text, bool in_run = false) {
-    warnings.push_back({AgentWarning::Kind::kNote, in_run, std::move(text)});
-  };
   // A Fawkes-style agent's files in the order its entry file path-loads them (a deffunction
   // that reads the time counts in the files loaded after its own).
-  const std::vector<AgentSource> sources =
-      spec.fawkes && !spec.agent.empty() ? read_fawkes_sources(spec.agent_dir, spec.agent.front())
-                                         : read_agent_sources(spec.agent);
-  std::vector<std::string> skills;
-  std::map<std::string, std::vector<std::string>> params;  // skill -> its @param names
+  const std::vector<clips::SourceFile> sources =
+      spec.fawkes && !spec.agent.empty()
+          ? clips::read_fawkes_sources(spec.agent_dir, spec.agent.front())
+          : clips::read_agent_sources(spec.agent);
+  clips::AgentCheckFacts facts;
   if (brain != nullptr) {
+    facts.skills.emplace();
     for (const lua::SkillInfo& s : brain->skills().engine().skills()) {
-      skills.push_back(s.name);
-      params[s.name] = documented_params(s.documentation);
+      facts.skills->push_back({s.name, lua::documented_params(s.documentation)});
     }
   }
-  static const std::regex kSkillCall(R"(\(skill-call\s+([A-Za-z_][A-Za-z0-9_]*))");
-  static const std::regex kConfval(R"re("(/clips-agent/[^"\s]*)")re");
-  std::vector<std::string> read_paths;  // literal paths in the agent (a trailing / is a prefix)
-  std::vector<std::string> read_where;  // each one's file:line
-  bool uses_locks = false;
-  clips::TimeReadCheck time_reads;  // the files in load order
-  for (const AgentSource& src : sources) {
-    for (const clips::SourceWarning& w : time_reads.scan(src.code)) {
-      warn(fmt::format("{}:{}: {}", src.file, w.line, w.message), /*in_run=*/true);
-    }
-    for (auto it = std::sregex_iterator(src.code.begin(), src.code.end(), kSkillCall);
-         it != std::sregex_iterator(); ++it) {
-      const std::string name = (*it)[1].str();
-      if (brain == nullptr) continue;
-      if (std::find(skills.begin(), skills.end(), name) != skills.end()) {
-        // Literal argument names the skill does not document (`plac` for `place`).
-        const std::vector<std::string>& known = params[name];
-        if (known.empty()) continue;  // a skill without @param lines: nothing to compare with
-        const std::size_t after = static_cast<std::size_t>(it->position() + it->length());
-        for (const std::string& arg : skill_call_arguments(src.code, after)) {
-          if (std::find(known.begin(), known.end(), arg) != known.end()) continue;
-          const auto meant = core::closest_match(arg, known);
-          std::string list;
-          for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
-          warn(
-              fmt::format("{}:{}: (skill-call {} {} ...): {} has no argument '{}' ({}its "
-                          "arguments: {})",
-                          src.file, src.line_of(static_cast<std::size_t>(it->position())), name,
-                          arg, name, arg, meant ? "did you mean '" + *meant + "'? " : "", list));
-        }
-        continue;
-      }
-      const auto hint = core::closest_match(name, skills);
-      warn(fmt::format(
-          "{}:{}: (skill-call {} ...): the skill library has no skill "
-          "'{}'{}",
-          src.file, src.line_of(static_cast<std::size_t>(it->position())), name, name,
-          hint ? " (did you mean '" + *hint + "'?)" : " (`llsfsim skill --list` lists them)"));
-    }
-    for (auto it = std::sregex_iterator(src.code.begin(), src.code.end(), kConfval);
-         it != std::sregex_iterator(); ++it) {
-      read_paths.push_back((*it)[1].str());
-      read_where.push_back(
-          fmt::format("{}:{}", src.file, src.line_of(static_cast<std::size_t>(it->position()))));
-    }
-    if (src.code.find("resource-request") != std::string::npos ||
-        src.code.find("(lock ") != std::string::npos ||
-        src.code.find("(lock-assert ") != std::string::npos) {
-      uses_locks = true;
-    }
-  }
-  auto read_by_agent = [&read_paths](const std::string& path) {
-    for (const std::string& p : read_paths) {
-      if (p == path || (p.ends_with('/') && path.starts_with(p))) return true;
-    }
-    return false;
-  };
-  // Paths are compared after the shared "/clips-agent/": on whole paths the long prefix made any
-  // two short keys "near" (speed and roles).
-  auto key_of = [](const std::string& p) {
-    constexpr std::string_view kPrefix = "/clips-agent/";
-    return p.starts_with(kPrefix) ? p.substr(kPrefix.size()) : p;
-  };
-  std::vector<std::string> read_keys;  // read_paths' keys, same order
-  for (const std::string& p : read_paths) read_keys.push_back(key_of(p));
-  std::vector<std::string> set_paths;
-  for (const clips::ConfigEntry& e : spec.config) {
-    if (e.path == "/clips-agent/use-locks") continue;             // the host's (robots.locks)
-    if (spec.fawkes && e.path == "/clips-agent/agent") continue;  // the host's (its entry)
-    set_paths.push_back(e.path);
-    if (read_by_agent(e.path)) continue;
-    // Either side may hold the typo: name the near path the agent reads and where, not a fix.
-    std::string near;
-    if (const auto hint = core::closest_match(key_of(e.path), read_keys)) {
-      const auto i = std::find(read_keys.begin(), read_keys.end(), *hint) - read_keys.begin();
-      near = fmt::format("; it reads {} ({}): one of the two is misspelt",
-                         read_paths[static_cast<std::size_t>(i)],
-                         read_where[static_cast<std::size_t>(i)]);
-    } else if (read_paths.empty()) {
-      near = "; its files name no /clips-agent/ path at all";
-    } else {
-      // No path near it: name what the agent reads, so the one meant can be found.
-      std::set<std::string> all(read_paths.begin(), read_paths.end());
-      std::string list;
-      int shown = 0;
-      for (const std::string& p : all) {
-        if (shown++ == 8) break;
-        list += (list.empty() ? "" : ", ") + p;
-      }
-      near = fmt::format("; it reads {}{}", list,
-                         all.size() > 8 ? fmt::format(", ... ({} paths)", all.size()) : "");
-    }
-    warn(fmt::format("robots.config: the agent reads no confval {}{}", e.path, near),
-         /*in_run=*/true);
-  }
-  std::sort(read_paths.begin(), read_paths.end());
-  read_paths.erase(std::unique(read_paths.begin(), read_paths.end()), read_paths.end());
-  std::string unset;
-  for (const std::string& p : read_paths) {
-    if (p.ends_with('/') || p == "/clips-agent/use-locks") continue;
-    if (std::find(set_paths.begin(), set_paths.end(), p) != set_paths.end()) continue;
-    unset += (unset.empty() ? "" : ", ") + p;
-  }
-  if (!unset.empty()) {
-    note("robots.config leaves these confvals of the agent at its defaults: " + unset);
-  }
-  if (spec.locks && !uses_locks) {
-    warn(
-        "robots.locks is on, but the agent uses no lock facts (no resource-request or lock "
-        "fact in its files): the lock protocol runs for nothing (set `robots.locks: false`?)");
+  facts.config = spec.config;
+  facts.locks = spec.locks;
+  facts.fawkes = spec.fawkes;
+  std::vector<AgentWarning> warnings;
+  for (clips::AgentFinding& f : clips::check_agent(sources, facts)) {
+    using Kind = clips::AgentFinding::Kind;
+    const bool in_run = f.kind == Kind::kTimeRead || f.kind == Kind::kConfvalNotRead;
+    warnings.push_back(
+        {f.note ? AgentWarning::Kind::kNote : AgentWarning::Kind::kWarn, in_run, f.text()});
   }
   if (!spec.sandbox) {
-    note(
-        "robots.sandbox is off: the agent may open, load and write files and run programs "
-        "(docs/security.md); only for a trusted local agent",
-        /*in_run=*/true);
+    warnings.push_back({AgentWarning::Kind::kNote, /*in_run=*/true,
+                        "robots.sandbox is off: the agent may open, load and write files and run "
+                        "programs (docs/security.md); only for a trusted local agent"});
   }
   return warnings;
 }

@@ -8,7 +8,7 @@
 #include <iterator>
 #include <utility>
 
-#include "llsf/clips/rule_test.h"
+#include "llsf/clips/agent_files.h"
 #include "llsf/core/input_file.h"
 
 namespace llsf::sim {

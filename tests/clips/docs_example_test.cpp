@@ -2,7 +2,7 @@
 // The C++ example of docs/clips.md, "Testing rules without the world", as written there: keep
 // the two equal.
 #include <doctest/doctest.h>
-#include "llsf/clips/rule_test.h"  // expand_agent_files: a directory -> its *.clp in name order
+#include "llsf/clips/agent_files.h"  // expand_agent_files: a directory -> its *.clp in name order
 #include "llsf/clips/testing.h"
 using namespace llsf;
 using clips::SkillStatus;

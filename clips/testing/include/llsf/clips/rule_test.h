@@ -64,8 +64,4 @@ class RuleTestFile {
 /// that does not exist and for a directory without test files.
 std::vector<std::string> find_rule_test_files(const std::vector<std::string>& paths);
 
-/// `entries` with every directory replaced by its *.clp files in name order (as a scenario's
-/// `agent` list is read).
-std::vector<std::string> expand_agent_files(const std::vector<std::string>& entries);
-
 }  // namespace llsf::clips

@@ -22,6 +22,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "llsf/clips/agent_files.h"
 #include "llsf/comm/registry.h"
 #include "llsf/core/config.h"
 #include "llsf/core/input_file.h"
@@ -635,23 +636,6 @@ ConfigEntries merge(ConfigEntries base, const ConfigEntries& over) {
 }  // namespace
 
 // ---- finding files ------------------------------------------------------------------------------
-
-std::vector<std::string> expand_agent_files(const std::vector<std::string>& entries) {
-  std::vector<std::string> out;
-  for (const std::string& e : entries) {
-    std::error_code ec;
-    if (!fs::is_directory(e, ec)) {
-      out.push_back(e);
-      continue;
-    }
-    std::vector<std::string> dir;
-    for (const auto& f : fs::directory_iterator(e, ec))
-      if (f.is_regular_file() && f.path().extension() == ".clp") dir.push_back(f.path().string());
-    std::sort(dir.begin(), dir.end());
-    out.insert(out.end(), dir.begin(), dir.end());
-  }
-  return out;
-}
 
 std::vector<std::string> find_rule_test_files(const std::vector<std::string>& paths) {
   std::vector<std::string> out;
