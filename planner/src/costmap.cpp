@@ -70,6 +70,9 @@ Costmap::Costmap(Vec2 origin, int nx, int ny, double resolution_m, const MoveBas
     for (const KernelCell& k : kernel) {
       if (k.dj == dj) row.costs[static_cast<std::size_t>(k.di - lo)] = k.cost;
     }
+    if (row.costs.size() <= row.wide.size()) {
+      std::copy(row.costs.begin(), row.costs.end(), row.wide.begin());
+    }
     rows_.push_back(std::move(row));
     kernel_r_ = std::max(kernel_r_, std::max(std::abs(dj), std::max(-lo, hi)));
   }
@@ -84,18 +87,21 @@ void Costmap::stamp(std::vector<std::uint8_t>& grid, int i, int j, int ci0, int 
     const int a0 = std::max(ci0, first);
     const int a1 = std::min(ci1, first + static_cast<int>(row.costs.size()) - 1);
     std::uint8_t* out = grid.data() + idx(0, b);
+    const int span = static_cast<int>(row.costs.size());
+    if (span <= 16 && a0 == first && a1 == first + span - 1 && first + 16 <= nx_) {
+      // The whole row of the kernel at once: 16 cells, maxed with its costs and zeros after
+      // them (which leave the cells beyond the span as they are).
+      using Bytes16 = std::uint8_t __attribute__((vector_size(16)));
+      Bytes16 o, k;
+      std::memcpy(&o, out + first, sizeof o);
+      std::memcpy(&k, row.wide.data(), sizeof k);
+      o = o > k ? o : k;
+      std::memcpy(out + first, &o, sizeof o);
+      continue;
+    }
     const std::uint8_t* k = row.costs.data() - first;
     for (int a = a0; a <= a1; ++a) out[a] = std::max(out[a], k[a]);
   }
-}
-
-bool Costmap::to_cell(const Vec2& p, int& i, int& j) const {
-  const double fx = (p.x() - origin_.x()) / res_;
-  const double fy = (p.y() - origin_.y()) / res_;
-  if (!(fx >= 0.0 && fy >= 0.0)) return false;
-  i = static_cast<int>(fx);
-  j = static_cast<int>(fy);
-  return i < nx_ && j < ny_;
 }
 
 Vec2 Costmap::cell_center(int i, int j) const {
@@ -281,20 +287,26 @@ void Costmap::mark_and_clear(const Vec2& origin, std::span<const Vec2> hits) {
         }
       }
     }
+    // (The grid's figures in locals: the obstacle cells' byte stores below could alias them.)
+    const double x_lo = origin_.x(), y_lo = origin_.y(), res = res_;
+    const double x_hi = origin_.x() + nx_ * res_ - 1e-9, y_hi = origin_.y() + ny_ * res_ - 1e-9;
+    const int nx = nx_, ny = ny_;
     for (const Vec2& h : any ? hits : std::span<const Vec2>{}) {
       // The end point, clipped to the grid along the beam.
       Vec2 e = h;
       const Vec2 d = e - origin;
       double t = 1.0;
-      const double x_lo = origin_.x(), y_lo = origin_.y();
-      const double x_hi = origin_.x() + nx_ * res_ - 1e-9, y_hi = origin_.y() + ny_ * res_ - 1e-9;
       if (e.x() < x_lo) t = std::min(t, (x_lo - origin.x()) / d.x());
       if (e.x() > x_hi) t = std::min(t, (x_hi - origin.x()) / d.x());
       if (e.y() < y_lo) t = std::min(t, (y_lo - origin.y()) / d.y());
       if (e.y() > y_hi) t = std::min(t, (y_hi - origin.y()) / d.y());
       e = origin + d * t;
-      int i1 = 0, j1 = 0;
-      if (!to_cell(e, i1, j1)) continue;
+      // to_cell(e, i1, j1)
+      const double fx = (e.x() - x_lo) / res;
+      const double fy = (e.y() - y_lo) / res;
+      if (!(fx >= 0.0 && fy >= 0.0)) continue;
+      const int i1 = static_cast<int>(fx), j1 = static_cast<int>(fy);
+      if (i1 >= nx || j1 >= ny) continue;
       const int da = i1 - i0, db = j1 - j0;
       const int dx = std::abs(da), dy = std::abs(db);
       const int steps = std::min(std::max(dx, dy), max_cells);
@@ -307,7 +319,9 @@ void Costmap::mark_and_clear(const Vec2& origin, std::span<const Vec2> hits) {
       const int last = slope_start_[static_cast<std::size_t>(bin) + 1];
       for (int c = first; c < last; ++c) {
         const OffsetCell& cell = slope_cells_[static_cast<std::size_t>(c)];
-        std::uint8_t& o = obstacle_[idx(i0 + cell.a, j0 + cell.b)];
+        std::uint8_t& o =
+            obstacle_[static_cast<std::size_t>(j0 + cell.b) * static_cast<std::size_t>(nx) +
+                      static_cast<std::size_t>(i0 + cell.a)];
         if (o == 0) continue;                        // cleared by an earlier beam
         const int a = cell.a * sx, b = cell.b * sy;  // both >= 0 in this octant
         const int k = x_major ? a : b;

@@ -994,25 +994,39 @@ void MoveBaseNavigator::generate(const Pose2D& pose, const VelocityCommand& vel,
   int path_d = 0, goal_d = 0;
   TrigRun& run = trig_run(pose, vel, vth_s, steps);
   double trig_th = th, cos_th = trig_cos0_, sin_th = trig_sin0_;
+  // (Figures in locals: the stores below could alias members.)
+  const double acc_x = c.acc_lim_x, acc_y = c.acc_lim_y, acc_th = c.acc_lim_th;
+  const double ox = m.origin().x(), oy = m.origin().y(), res = m.resolution();
+  const int nx = m.nx(), ny = m.ny(), w = grid_w_, unreachable = unreachable_;
+  const std::uint8_t* costs = m.cost_data();
+  const int* path_dist = path_dist_.data();
+  const int* goal_dist = goal_dist_.data();
+  double end_x = t.end_x, end_y = t.end_y, end_th = t.end_th;
   for (int s = 0; s < steps; ++s) {
-    int i = 0, j = 0;
-    if (!m.to_cell(Vec2(x, y), i, j)) return;  // off the known map
-    const std::uint8_t cost = m.cost(i, j);
-    if (cost >= Costmap::kInscribed) return;  // the footprint hits an obstacle
+    // m.to_cell(Vec2(x, y), i, j), m.cost(i, j), grid_index(i, j)
+    const double fx = (x - ox) / res;
+    const double fy = (y - oy) / res;
+    if (!(fx >= 0.0 && fy >= 0.0)) break;  // off the known map
+    const int i = static_cast<int>(fx), j = static_cast<int>(fy);
+    if (i >= nx || j >= ny) break;
+    const std::uint8_t cost = costs[static_cast<std::size_t>(j) * static_cast<std::size_t>(nx) +
+                                    static_cast<std::size_t>(i)];
+    if (cost >= Costmap::kInscribed) break;  // the footprint hits an obstacle
     occ = std::max(occ, static_cast<double>(cost));
-    const std::size_t k = grid_index(i, j);
-    path_d = path_dist_[k];
-    goal_d = goal_dist_[k];
-    if (path_d >= unreachable_ || goal_d >= unreachable_) {
+    const std::size_t k = static_cast<std::size_t>(j + 1) * static_cast<std::size_t>(w) +
+                          static_cast<std::size_t>(i + 1);
+    path_d = path_dist[k];
+    goal_d = goal_dist[k];
+    if (path_d >= unreachable || goal_d >= unreachable) {
       t.cost = -2.0;  // no clear way to the goal from here
-      return;
+      break;
     }
-    t.end_x = x;
-    t.end_y = y;
-    t.end_th = th;
-    vx = ramp(vx_s, vx, c.acc_lim_x, dt);
-    vy = ramp(vy_s, vy, c.acc_lim_y, dt);
-    vth = ramp(vth_s, vth, c.acc_lim_th, dt);
+    end_x = x;
+    end_y = y;
+    end_th = th;
+    vx = ramp(vx_s, vx, acc_x, dt);
+    vy = ramp(vy_s, vy, acc_y, dt);
+    vth = ramp(vth_s, vth, acc_th, dt);
     const auto step = static_cast<std::size_t>(s);
     if (step < run.cos_th.size()) {  // this heading's values, from an earlier sample
       cos_th = run.cos_th[step];
@@ -1030,8 +1044,18 @@ void MoveBaseNavigator::generate(const Pose2D& pose, const VelocityCommand& vel,
     x += (vx * cos_th - vy * sin_th) * dt;
     y += (vx * sin_th + vy * cos_th) * dt;
     th += vth * dt;
+    if (s + 1 == steps) {
+      t.end_x = end_x;
+      t.end_y = end_y;
+      t.end_th = end_th;
+      t.cost =
+          c.path_distance_bias * path_d + c.goal_distance_bias * goal_d + c.occdist_scale * occ;
+      return;
+    }
   }
-  t.cost = c.path_distance_bias * path_d + c.goal_distance_bias * goal_d + c.occdist_scale * occ;
+  t.end_x = end_x;  // stopped early: where the rollout got to
+  t.end_y = end_y;
+  t.end_th = end_th;
 }
 
 MoveBaseNavigator::Traj MoveBaseNavigator::create_trajectories(const Pose2D& pose,

@@ -146,9 +146,19 @@ class Costmap {
   int ny() const { return ny_; }
   double resolution() const { return res_; }
   Vec2 origin() const { return origin_; }
-  bool to_cell(const Vec2& p, int& i, int& j) const;
+  /// The cell holding `p`; false outside the grid.
+  bool to_cell(const Vec2& p, int& i, int& j) const {
+    const double fx = (p.x() - origin_.x()) / res_;
+    const double fy = (p.y() - origin_.y()) / res_;
+    if (!(fx >= 0.0 && fy >= 0.0)) return false;
+    i = static_cast<int>(fx);
+    j = static_cast<int>(fy);
+    return i < nx_ && j < ny_;
+  }
   Vec2 cell_center(int i, int j) const;
   std::uint8_t cost(int i, int j) const { return cost_[idx(i, j)]; }
+  /// The costs, row by row (cell (i, j) at j * nx() + i).
+  const std::uint8_t* cost_data() const { return cost_.data(); }
   /// Cost at a point; outside the grid: kLethal if `outside_lethal`, else kFree.
   std::uint8_t cost_at(const Vec2& p, bool outside_lethal = true) const;
   bool obstacle(int i, int j) const { return obstacle_[idx(i, j)] != 0; }
@@ -217,6 +227,7 @@ class Costmap {
     int dj;
     int di0;
     std::vector<std::uint8_t> costs;
+    std::array<std::uint8_t, 16> wide{};  // `costs` and zeros (when it has at most 16 cells)
   };
   std::vector<KernelRow> rows_;
   int kernel_r_ = 0;  // the largest |dj| (and |di|) of the kernel
