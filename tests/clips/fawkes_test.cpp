@@ -12,6 +12,7 @@
 
 #include "llsf/clips/testing.h"
 #include "llsf/comm/registry.h"
+#include "support/fawkes_agent.h"
 #include "support/temp_dir.h"
 
 using namespace llsf;
@@ -255,18 +256,11 @@ TEST_CASE("a nested message read from an unset field can be filled and set") {
 
 TEST_CASE("blackboard-open: interface facts from the pose and from written interfaces") {
   AgentDir d;
-  d.write("demo/demo.clp", R"clp(
-(defrule use-blackboard
-  (ff-feature blackboard)
-  =>
-  (ff-feature-request "blackboard")
-  (blackboard-enable-time-read)
-  (blackboard-open "Position3DInterface" "Pose")
-  (blackboard-open "RobotinoLightInterface" "Light_State")
-  (blackboard-open "NoSuchInterface" "x")
-  (path-load demo/sense.clp))  ; its rules match the interface templates just defined
-)clp");
-  d.write("demo/sense.clp", R"clp(
+  test::write_blackboard_agent(d.dir, "", "demo",
+                               {{"Position3DInterface", "Pose"},
+                                {"RobotinoLightInterface", "Light_State"},
+                                {"NoSuchInterface", "x"}},
+                               R"clp(
 (defrule seen-pose
   (Position3DInterface (id "Pose") (translation ?x ?y ?) (rotation $?q))
   =>
@@ -407,22 +401,15 @@ class FakeBlackboard final : public Blackboard {
 
 TEST_CASE("blackboard: every interface type the skills have, read from the robot's blackboard") {
   AgentDir d;
-  d.write("demo/demo.clp", R"clp(
-(defrule use-blackboard
-  (ff-feature blackboard)
-  =>
-  (ff-feature-request "blackboard")
-  (blackboard-enable-time-read)
-  (blackboard-open "NavigatorInterface" "Pathplan")
-  (blackboard-open "MotorInterface" "Robotino")
-  (blackboard-open "SwitchInterface" "ampel_red")
-  (blackboard-open "RobotinoAmpelInterface" "Ampel")
-  (blackboard-open "LaserClusterInterface" "laser-cluster")
-  (blackboard-open "SkillerInterface" "Skiller")
-  (blackboard-open "RobotinoSensorInterface" "Robotino")
-  (path-load demo/sense.clp))
-)clp");
-  d.write("demo/sense.clp", R"clp(
+  test::write_blackboard_agent(d.dir, "", "demo",
+                               {{"NavigatorInterface", "Pathplan"},
+                                {"MotorInterface", "Robotino"},
+                                {"SwitchInterface", "ampel_red"},
+                                {"RobotinoAmpelInterface", "Ampel"},
+                                {"LaserClusterInterface", "laser-cluster"},
+                                {"SkillerInterface", "Skiller"},
+                                {"RobotinoSensorInterface", "Robotino"}},
+                               R"clp(
 (defrule nav (NavigatorInterface (id "Pathplan") (msgid ?m) (final ?f) (dest_x ?x) (drive_mode ?dm))
   => (assert (nav ?m ?f ?x ?dm)))
 (defrule motor (MotorInterface (id "Robotino") (vx ?vx) (controller_thread_name ?n))
