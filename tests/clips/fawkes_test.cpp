@@ -192,6 +192,37 @@ TEST_CASE("an unbalanced entry file is a load error at the form's line") {
                        AgentLoadError);
 }
 
+TEST_CASE("an entry file's places count the lines in strings; what is not a form is an error") {
+  AgentDir d;
+  d.write("demo/demo.clp",
+          "; a comment (with a parenthesis\n"    // 1
+          "(printout t \"a ; no comment\n"       // 2
+          "b \\\"c\\\" \\\n"                     // 3: an escaped quote, an escaped newline
+          "\" crlf) ; a comment\n"               // 4
+          "(no-such-function 1)\n"               // 5
+          "(defrule r (a) => (assert (b)))\n"    // 6
+          "x (printout t \"not run\" crlf)\n");  // 7
+  AgentFixture f(fawkes_config(d));
+  try {
+    f.load_file(d.path("demo/demo.clp"));
+    FAIL("no load error");
+  } catch (const AgentLoadError& e) {
+    const std::string what = e.what();
+    INFO(what);
+    CHECK(what.find("demo.clp:5: [EXPRNPSR3] Missing function declaration for no-such-function") !=
+          std::string::npos);
+    CHECK(what.find("demo.clp:7: expected a command or construct in parentheses") !=
+          std::string::npos);
+  }
+  CHECK(f.logged("b \"c\""));
+  CHECK_FALSE(f.logged("not run"));
+  d.write("demo/stray.clp", "(deffacts none)\n\n) (printout t \"x\" crlf)\n");
+  AgentFixture g(fawkes_config(d));
+  CHECK_THROWS_WITH_AS(g.load_file(d.path("demo/stray.clp")),
+                       doctest::Contains("stray.clp:3: expected a command or construct"),
+                       AgentLoadError);
+}
+
 TEST_CASE("ff-feature-request: TRUE for what the host offers, FALSE otherwise") {
   AgentDir d;
   d.write("demo/demo.clp", "(defglobal ?*A* = (ff-feature-request \"motor-switch\"))\n");
