@@ -38,6 +38,16 @@ AgentConfig fawkes_config(const AgentDir& d) {
   return c;
 }
 
+// The AgentLoadError of loading the entry file `path` into `f`, or "" if it loads.
+std::string load_error(AgentFixture& f, const std::string& path) {
+  try {
+    f.load_file(path);
+  } catch (const AgentLoadError& e) {
+    return e.what();
+  }
+  return "";
+}
+
 // The entry file: top-level commands, path-load of the others (one from a rule), (reset).
 constexpr const char* kEntry = R"clp(
 ; demo.clp - a Fawkes-style entry file
@@ -153,20 +163,15 @@ TEST_CASE("path-load reads only the agent directory; load errors name file and l
                                "\")\n(path-load demo/missing.clp)\n(no-such-function 1)\n");
   d.write("demo/bad.clp", "(defrule ok => (assert (ok)))\n\n(defrule broken =>\n");
   AgentFixture f(fawkes_config(d));
-  try {
-    f.load_file(d.path("demo/demo.clp"));
-    FAIL("no load error");
-  } catch (const AgentLoadError& e) {
-    const std::string what = e.what();
-    INFO(what);
-    CHECK(what.find("demo/bad.clp:4: [PRNTUTIL2] Syntax Error") != std::string::npos);
-    CHECK(what.find("demo.clp:1: ") == std::string::npos);  // the file's own place only
-    CHECK(what.find("demo.clp:2: path-load: ") != std::string::npos);
-    CHECK(what.find("is outside the agent directory") != std::string::npos);
-    CHECK(what.find("demo.clp:3: path-load: no file demo/missing.clp") != std::string::npos);
-    CHECK(what.find("demo.clp:4: [EXPRNPSR3] Missing function declaration for no-such-function") !=
-          std::string::npos);
-  }
+  const std::string what = load_error(f, d.path("demo/demo.clp"));
+  INFO(what);
+  CHECK(what.find("demo/bad.clp:4: [PRNTUTIL2] Syntax Error") != std::string::npos);
+  CHECK(what.find("demo.clp:1: ") == std::string::npos);  // the file's own place only
+  CHECK(what.find("demo.clp:2: path-load: ") != std::string::npos);
+  CHECK(what.find("is outside the agent directory") != std::string::npos);
+  CHECK(what.find("demo.clp:3: path-load: no file demo/missing.clp") != std::string::npos);
+  CHECK(what.find("demo.clp:4: [EXPRNPSR3] Missing function declaration for no-such-function") !=
+        std::string::npos);
   CHECK_FALSE(f.has("(stolen)"));
   // Still no file access otherwise.
   CHECK_THROWS_AS(f.load("(defrule r => (open \"x\" f \"w\"))"), AgentLoadError);
@@ -203,17 +208,12 @@ TEST_CASE("an entry file's places count the lines in strings; what is not a form
           "(defrule r (a) => (assert (b)))\n"    // 6
           "x (printout t \"not run\" crlf)\n");  // 7
   AgentFixture f(fawkes_config(d));
-  try {
-    f.load_file(d.path("demo/demo.clp"));
-    FAIL("no load error");
-  } catch (const AgentLoadError& e) {
-    const std::string what = e.what();
-    INFO(what);
-    CHECK(what.find("demo.clp:5: [EXPRNPSR3] Missing function declaration for no-such-function") !=
-          std::string::npos);
-    CHECK(what.find("demo.clp:7: expected a command or construct in parentheses") !=
-          std::string::npos);
-  }
+  const std::string what = load_error(f, d.path("demo/demo.clp"));
+  INFO(what);
+  CHECK(what.find("demo.clp:5: [EXPRNPSR3] Missing function declaration for no-such-function") !=
+        std::string::npos);
+  CHECK(what.find("demo.clp:7: expected a command or construct in parentheses") !=
+        std::string::npos);
   CHECK(f.logged("b \"c\""));
   CHECK_FALSE(f.logged("not run"));
   d.write("demo/stray.clp", "(deffacts none)\n\n) (printout t \"x\" crlf)\n");
