@@ -17,6 +17,7 @@
 #include "llsf/core/input_file.h"
 #include "llsf/core/text.h"
 #include "sandbox.h"
+#include "source_text.h"
 #include "tracer.h"
 
 namespace llsf::clips {
@@ -398,7 +399,8 @@ struct AgentHost::Impl {
     for (auto& f : features) f->after_reset(env);
   }
 
-  // The top-level forms of a batch file: constructs and commands, with their first line.
+  // The top-level forms of a batch file: constructs and commands, with their first line (read
+  // with the one scanner of CLIPS source, source_text.h).
   struct Form {
     std::size_t begin = 0, end = 0;
     int line = 1;
@@ -409,65 +411,43 @@ struct AgentHost::Impl {
     static constexpr std::string_view kConstructs[] = {
         "defrule",    "deftemplate", "deffacts", "defglobal",    "deffunction",       "defmodule",
         "defgeneric", "defmethod",   "defclass", "definstances", "defmessage-handler"};
-    int line = 1;
-    std::size_t i = 0;
-    const std::size_t n = text.size();
-    while (i < n) {
-      const char c = text[i];
-      if (c == '\n') {
-        ++line;
-        ++i;
-      } else if (std::isspace(static_cast<unsigned char>(c)) != 0) {
-        ++i;
-      } else if (c == ';') {
-        while (i < n && text[i] != '\n') ++i;
-      } else if (c != '(') {
+    detail::SourceScanner scanner(text);
+    detail::SourceToken t;
+    while (scanner.next(t)) {
+      if (t.kind != detail::SourceToken::Kind::kOpen) {
         error = "expected a command or construct in parentheses";
-        error_line = line;
+        error_line = t.line;
         return false;
-      } else {
-        Form f;
-        f.begin = i;
-        f.line = line;
-        int depth = 0;
-        bool string = false;
-        for (; i < n; ++i) {
-          const char d = text[i];
-          if (d == '\n') ++line;
-          if (string) {
-            if (d == '\\' && i + 1 < n) {
-              if (text[i + 1] == '\n') ++line;
-              ++i;
-            } else if (d == '"') {
-              string = false;
-            }
-          } else if (d == '"') {
-            string = true;
-          } else if (d == ';') {
-            while (i + 1 < n && text[i + 1] != '\n') ++i;
-          } else if (d == '(') {
-            ++depth;
-          } else if (d == ')' && --depth == 0) {
-            break;
-          }
-        }
-        if (i >= n) {
-          error = "the form that starts here is not closed (a ')' is missing)";
-          error_line = f.line;
-          return false;
-        }
-        f.end = ++i;
-        std::size_t k = f.begin + 1;
-        while (k < f.end && std::isspace(static_cast<unsigned char>(text[k])) != 0) ++k;
-        std::size_t e = k;
-        while (e < f.end && std::isspace(static_cast<unsigned char>(text[e])) == 0 &&
-               text[e] != '(' && text[e] != ')')
-          ++e;
-        const std::string_view word(text.data() + k, e - k);
-        f.construct = std::find(std::begin(kConstructs), std::end(kConstructs), word) !=
-                      std::end(kConstructs);
-        out.push_back(f);
       }
+      Form f;
+      f.begin = t.begin;
+      f.line = t.line;
+      int depth = 1;
+      while (depth > 0 && scanner.next(t)) {
+        if (t.kind == detail::SourceToken::Kind::kOpen) {
+          ++depth;
+        } else if (t.kind == detail::SourceToken::Kind::kClose) {
+          --depth;
+        }
+      }
+      if (depth > 0) {
+        error = "the form that starts here is not closed (a ')' is missing)";
+        error_line = f.line;
+        return false;
+      }
+      f.end = t.end;
+      // A construct if the word right after its parenthesis (up to white space or a
+      // parenthesis) is a construct's keyword.
+      std::size_t k = f.begin + 1;
+      while (k < f.end && std::isspace(static_cast<unsigned char>(text[k])) != 0) ++k;
+      std::size_t e = k;
+      while (e < f.end && std::isspace(static_cast<unsigned char>(text[e])) == 0 &&
+             text[e] != '(' && text[e] != ')')
+        ++e;
+      const std::string_view word(text.data() + k, e - k);
+      f.construct =
+          std::find(std::begin(kConstructs), std::end(kConstructs), word) != std::end(kConstructs);
+      out.push_back(f);
     }
     return true;
   }
@@ -672,7 +652,9 @@ struct AgentHost::Impl {
   }
 
   // Where each defrule and deffunction (defgeneric, defmethod) of `text` starts ("file:line"),
-  // for messages that name one.
+  // for messages that name one. Not with the scanner of source_text.h, which skips strings: this
+  // reads them as code too, and so a rule built from a string at run time, (build "(defrule x
+  // ...)"), has the place of the string.
   void note_rule_places(const std::string& text, std::string_view source) {
     const auto token_end = [&](std::size_t b) {
       std::size_t e = b;

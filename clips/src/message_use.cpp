@@ -2,9 +2,10 @@
 #include "message_use.h"
 
 #include <array>
-#include <cctype>
 #include <string_view>
 #include <vector>
+
+#include "source_text.h"
 
 namespace llsf::clips::detail {
 
@@ -25,39 +26,31 @@ struct Node {
   bool is_list() const { return kind == Kind::kList; }
 };
 
-/// Reads the text's top-level forms; false on unbalanced parentheses or an open string.
+/// Reads the text's top-level forms (with the one scanner of CLIPS source, source_text.h);
+/// false on unbalanced parentheses or an open string.
 bool parse(std::string_view text, std::vector<Node>& out) {
   std::vector<std::vector<Node>*> stack = {&out};
-  std::size_t i = 0;
-  while (i < text.size()) {
-    const char c = text[i];
-    if (std::isspace(static_cast<unsigned char>(c)) != 0) {
-      ++i;
-    } else if (c == ';') {  // a comment, to the end of the line
-      while (i < text.size() && text[i] != '\n') ++i;
-    } else if (c == '(') {
-      stack.back()->push_back(Node{Node::Kind::kList, {}, {}});
-      stack.push_back(&stack.back()->back().items);
-      ++i;
-    } else if (c == ')') {
-      if (stack.size() == 1) return false;
-      stack.pop_back();
-      ++i;
-    } else if (c == '"') {
-      std::size_t j = i + 1;
-      while (j < text.size() && text[j] != '"') j += text[j] == '\\' ? 2 : 1;
-      if (j >= text.size()) return false;
-      stack.back()->push_back(
-          Node{Node::Kind::kString, std::string(text.substr(i + 1, j - i - 1)), {}});
-      i = j + 1;
-    } else {
-      std::size_t j = i;
-      while (j < text.size() && std::isspace(static_cast<unsigned char>(text[j])) == 0 &&
-             text[j] != '(' && text[j] != ')' && text[j] != '"' && text[j] != ';') {
-        ++j;
-      }
-      stack.back()->push_back(Node{Node::Kind::kToken, std::string(text.substr(i, j - i)), {}});
-      i = j;
+  SourceScanner scanner(text);
+  SourceToken t;
+  while (scanner.next(t)) {
+    switch (t.kind) {
+      case SourceToken::Kind::kOpen:
+        stack.back()->push_back(Node{Node::Kind::kList, {}, {}});
+        stack.push_back(&stack.back()->back().items);
+        break;
+      case SourceToken::Kind::kClose:
+        if (stack.size() == 1) return false;
+        stack.pop_back();
+        break;
+      case SourceToken::Kind::kString:
+        if (!t.closed) return false;
+        stack.back()->push_back(Node{
+            Node::Kind::kString, std::string(text.substr(t.begin + 1, t.end - t.begin - 2)), {}});
+        break;
+      case SourceToken::Kind::kAtom:
+        stack.back()->push_back(
+            Node{Node::Kind::kToken, std::string(text.substr(t.begin, t.end - t.begin)), {}});
+        break;
     }
   }
   return stack.size() == 1;

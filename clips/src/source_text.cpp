@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
-// The reader of CLIPS source text (source_text.h): iterative, bounded in depth.
+// The reader of CLIPS source text (source_text.h): its scanner, and the tree read from the
+// scanner's tokens, iteratively and bounded in depth.
 #include "source_text.h"
 
 #include <cctype>
@@ -11,63 +12,96 @@ std::string_view SourceNode::head() const {
   return items.front().text;
 }
 
+bool SourceScanner::next(SourceToken& out) {
+  const std::size_t n = text_.size();
+  while (i_ < n) {
+    const char c = text_[i_];
+    if (c == '\n') {
+      ++line_;
+      ++i_;
+    } else if (std::isspace(static_cast<unsigned char>(c)) != 0) {
+      ++i_;
+    } else if (c == ';') {
+      while (i_ < n && text_[i_] != '\n') ++i_;
+    } else {
+      out.begin = i_;
+      out.line = line_;
+      out.closed = true;
+      if (c == '(' || c == ')') {
+        out.kind = c == '(' ? SourceToken::Kind::kOpen : SourceToken::Kind::kClose;
+        ++i_;
+      } else if (c == '"') {
+        out.kind = SourceToken::Kind::kString;
+        for (++i_; i_ < n && text_[i_] != '"'; ++i_) {
+          if (text_[i_] == '\\' && i_ + 1 < n) ++i_;
+          if (text_[i_] == '\n') ++line_;
+        }
+        out.closed = i_ < n;
+        if (out.closed) ++i_;  // the closing quote
+      } else {
+        out.kind = SourceToken::Kind::kAtom;
+        while (i_ < n && std::isspace(static_cast<unsigned char>(text_[i_])) == 0 &&
+               text_[i_] != '(' && text_[i_] != ')' && text_[i_] != '"' && text_[i_] != ';')
+          ++i_;
+      }
+      out.end = i_;
+      return true;
+    }
+  }
+  return false;
+}
+
+std::string string_contents(std::string_view text, const SourceToken& token) {
+  std::string s;
+  const std::size_t n = token.end;
+  for (std::size_t i = token.begin + 1; i < n && text[i] != '"'; ++i) {
+    if (text[i] == '\\' && i + 1 < n) ++i;
+    s += text[i];
+  }
+  return s;
+}
+
 std::vector<SourceNode> read_source(std::string_view text) {
   SourceNode root;
   root.kind = SourceNode::Kind::kList;
   std::vector<SourceNode*> open = {&root};  // the lists being read, innermost last
   int skipped = 0;                          // depth inside a list deeper than kMaxSourceDepth
-  int line = 1;
-  const std::size_t n = text.size();
-  std::size_t i = 0;
-  while (i < n) {
-    const char c = text[i];
-    if (c == '\n') {
-      ++line;
-      ++i;
-    } else if (std::isspace(static_cast<unsigned char>(c)) != 0) {
-      ++i;
-    } else if (c == ';') {
-      while (i < n && text[i] != '\n') ++i;
-    } else if (c == '"') {
-      SourceNode s;
-      s.kind = SourceNode::Kind::kString;
-      s.line = line;
-      for (++i; i < n && text[i] != '"'; ++i) {
-        if (text[i] == '\\' && i + 1 < n) ++i;
-        if (text[i] == '\n') ++line;
-        s.text += text[i];
+  SourceScanner scanner(text);
+  SourceToken t;
+  while (scanner.next(t)) {
+    switch (t.kind) {
+      case SourceToken::Kind::kOpen: {
+        if (skipped > 0 || static_cast<int>(open.size()) > kMaxSourceDepth) {
+          ++skipped;
+          break;
+        }
+        SourceNode l;
+        l.kind = SourceNode::Kind::kList;
+        l.line = t.line;
+        open.back()->items.push_back(std::move(l));
+        open.push_back(&open.back()->items.back());
+        break;
       }
-      ++i;
-      if (skipped == 0) open.back()->items.push_back(std::move(s));
-    } else if (c == '(') {
-      ++i;
-      if (skipped > 0 || static_cast<int>(open.size()) > kMaxSourceDepth) {
-        ++skipped;
-        continue;
-      }
-      SourceNode l;
-      l.kind = SourceNode::Kind::kList;
-      l.line = line;
-      open.back()->items.push_back(std::move(l));
-      open.push_back(&open.back()->items.back());
-    } else if (c == ')') {
-      ++i;
-      if (skipped > 0) {
-        --skipped;
-      } else if (open.size() > 1) {
-        open.pop_back();
-      }
-    } else {
-      const std::size_t b = i;
-      while (i < n && std::isspace(static_cast<unsigned char>(text[i])) == 0 && text[i] != '(' &&
-             text[i] != ')' && text[i] != '"' && text[i] != ';')
-        ++i;
-      if (skipped == 0) {
-        SourceNode a;
-        a.text = std::string(text.substr(b, i - b));
-        a.line = line;
-        open.back()->items.push_back(std::move(a));
-      }
+      case SourceToken::Kind::kClose:
+        if (skipped > 0) {
+          --skipped;
+        } else if (open.size() > 1) {
+          open.pop_back();
+        }
+        break;
+      case SourceToken::Kind::kString:
+      case SourceToken::Kind::kAtom:
+        if (skipped == 0) {
+          SourceNode a;
+          a.kind = t.kind == SourceToken::Kind::kString ? SourceNode::Kind::kString
+                                                        : SourceNode::Kind::kAtom;
+          a.text = a.kind == SourceNode::Kind::kString
+                       ? string_contents(text, t)
+                       : std::string(text.substr(t.begin, t.end - t.begin));
+          a.line = t.line;
+          open.back()->items.push_back(std::move(a));
+        }
+        break;
     }
   }
   return std::move(root.items);

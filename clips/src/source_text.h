@@ -1,14 +1,49 @@
 // SPDX-License-Identifier: MIT
-// A small reader of CLIPS source text into lists, atoms and strings with their lines: enough to
-// find a rule's conditional elements (the line of CE #n in a CLIPS error) and to look at rule
-// conditions for `check`'s warnings. It parses no more than it must and never fails.
+// A small reader of CLIPS source text: its tokens (parentheses, atoms, strings) with their places
+// (`SourceScanner`, which the agent host's batch files are split with), and the tree of lists,
+// atoms and strings read from them (`read_source`): enough to find a rule's conditional elements
+// (the line of CE #n in a CLIPS error) and to look at rule conditions for `check`'s warnings. It
+// parses no more than it must and never fails.
 #pragma once
+
+#include <cstddef>
 
 #include <string>
 #include <string_view>
 #include <vector>
 
 namespace llsf::clips::detail {
+
+/// One token of the source: `(`, `)`, an atom (anything up to white space, a parenthesis, `"` or
+/// `;`) or a string (from `"` to the next `"` not escaped by a backslash).
+struct SourceToken {
+  enum class Kind { kOpen, kClose, kAtom, kString };
+  Kind kind = Kind::kAtom;
+  /// The offset of its first character (a string's: its opening quote).
+  std::size_t begin = 0;
+  /// The offset after its last character (a string's: its closing quote, else the text's end).
+  std::size_t end = 0;
+  int line = 1;        ///< the 1-based line where it starts
+  bool closed = true;  ///< false for a string that the text ends in (no closing quote)
+};
+
+/// The tokens of a text in order, white space and comments (`;` to the end of the line) skipped;
+/// lines count every newline, also those inside strings. Borrows the text.
+class SourceScanner {
+ public:
+  explicit SourceScanner(std::string_view text) : text_(text) {}
+  /// Reads the next token into `out`; false at the end of the text.
+  bool next(SourceToken& out);
+
+ private:
+  std::string_view text_;
+  std::size_t i_ = 0;
+  int line_ = 1;
+};
+
+/// A string token's contents without its quotes, each escaped character (`\"`) as it follows
+/// its backslash.
+std::string string_contents(std::string_view text, const SourceToken& token);
 
 /// One form of the source: a list `( ... )`, an atom (symbol, number, variable, `=>`, `<-`,
 /// `?x&:`) or a string.

@@ -44,6 +44,8 @@ with its S0 as the team's 2013 skill did (finish_puck_at.lua -> leave_area_recyc
 motor moves that, without stuck detection, push against whatever is in the way for good.
 ]==]
 
+local machine_front = require("machine_front")
+
 local PRE = 0.30          -- the approach stops this far before the input place
 local REACT_S = 6.0       -- processing must show within this time (vision adds a delay)
 local LIMIT_S = 90.0      -- T3/T4 take up to 60 s
@@ -244,10 +246,7 @@ fsm:add_transitions{
 }
 
 function APPROACH:init()
-   local v = self.fsm.vars
-   local px, py, pth = navigator:place(v.place .. "_input")
-   self.args["drive_to"] = {x = px - math.cos(pth) * PRE, y = py - math.sin(pth) * PRE,
-                            ori = pth, forward_only = true}
+   self.args["drive_to"] = machine_front.before_input(navigator, self.fsm.vars.place, PRE)
 end
 
 function LOST:init()

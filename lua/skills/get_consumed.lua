@@ -25,6 +25,8 @@ takes it turning to it first (fetch_puck), turns on the spot by 3.0 rad away fro
 push against whatever is in the way for good.
 ]==]
 
+local machine_front = require("machine_front")
+
 local function bad(self, vars)
    if type(vars.place) ~= "string" or navigator:place(vars.place .. "_left") == nil then
       self.fsm.error = string.format("get_consumed: unknown machine '%s'", tostring(vars.place))
@@ -87,10 +89,7 @@ function GOTO:init()
 end
 
 function FRONT:init()
-   local v = self.fsm.vars
-   local px, py, pth = navigator:place(v.place .. "_input")
-   self.args["drive_to"] = {x = px - math.cos(pth) * 0.3, y = py - math.sin(pth) * 0.3,
-                            ori = pth, forward_only = true}
+   self.args["drive_to"] = machine_front.before_input(navigator, self.fsm.vars.place, 0.3)
 end
 
 function SIDE:init()

@@ -252,8 +252,11 @@ RobotProfile named_or_fail(const core::ConfigNode& n) {
   try {
     return RobotProfile::named(n.as_string());
   } catch (const std::invalid_argument&) {
-    n.fail("unknown profile '" + n.as_string() +
-           "' (known: ideal, robotino-2013, robotino-2013-omniscient)");
+    std::string known;
+    for (const std::string& name : RobotProfile::names()) {
+      known += (known.empty() ? "" : ", ") + name;
+    }
+    n.fail("unknown profile '" + n.as_string() + "' (known: " + known + ")");
   }
 }
 

@@ -12,6 +12,7 @@
 
 #include "llsf/clips/testing.h"
 #include "llsf/comm/registry.h"
+#include "support/fawkes_agent.h"
 #include "support/temp_dir.h"
 
 using namespace llsf;
@@ -35,6 +36,16 @@ AgentConfig fawkes_config(const AgentDir& d) {
               ConfigEntry::of("/clips-agent/demo/peer-port", 4444),
               ConfigEntry::of("/other/value", 1)};
   return c;
+}
+
+// The AgentLoadError of loading the entry file `path` into `f`, or "" if it loads.
+std::string load_error(AgentFixture& f, const std::string& path) {
+  try {
+    f.load_file(path);
+  } catch (const AgentLoadError& e) {
+    return e.what();
+  }
+  return "";
 }
 
 // The entry file: top-level commands, path-load of the others (one from a rule), (reset).
@@ -152,20 +163,15 @@ TEST_CASE("path-load reads only the agent directory; load errors name file and l
                                "\")\n(path-load demo/missing.clp)\n(no-such-function 1)\n");
   d.write("demo/bad.clp", "(defrule ok => (assert (ok)))\n\n(defrule broken =>\n");
   AgentFixture f(fawkes_config(d));
-  try {
-    f.load_file(d.path("demo/demo.clp"));
-    FAIL("no load error");
-  } catch (const AgentLoadError& e) {
-    const std::string what = e.what();
-    INFO(what);
-    CHECK(what.find("demo/bad.clp:4: [PRNTUTIL2] Syntax Error") != std::string::npos);
-    CHECK(what.find("demo.clp:1: ") == std::string::npos);  // the file's own place only
-    CHECK(what.find("demo.clp:2: path-load: ") != std::string::npos);
-    CHECK(what.find("is outside the agent directory") != std::string::npos);
-    CHECK(what.find("demo.clp:3: path-load: no file demo/missing.clp") != std::string::npos);
-    CHECK(what.find("demo.clp:4: [EXPRNPSR3] Missing function declaration for no-such-function") !=
-          std::string::npos);
-  }
+  const std::string what = load_error(f, d.path("demo/demo.clp"));
+  INFO(what);
+  CHECK(what.find("demo/bad.clp:4: [PRNTUTIL2] Syntax Error") != std::string::npos);
+  CHECK(what.find("demo.clp:1: ") == std::string::npos);  // the file's own place only
+  CHECK(what.find("demo.clp:2: path-load: ") != std::string::npos);
+  CHECK(what.find("is outside the agent directory") != std::string::npos);
+  CHECK(what.find("demo.clp:3: path-load: no file demo/missing.clp") != std::string::npos);
+  CHECK(what.find("demo.clp:4: [EXPRNPSR3] Missing function declaration for no-such-function") !=
+        std::string::npos);
   CHECK_FALSE(f.has("(stolen)"));
   // Still no file access otherwise.
   CHECK_THROWS_AS(f.load("(defrule r => (open \"x\" f \"w\"))"), AgentLoadError);
@@ -188,6 +194,32 @@ TEST_CASE("an unbalanced entry file is a load error at the form's line") {
   AgentFixture f(fawkes_config(d));
   CHECK_THROWS_WITH_AS(f.load_file(d.path("demo/demo.clp")),
                        doctest::Contains("demo.clp:3: the form that starts here is not closed"),
+                       AgentLoadError);
+}
+
+TEST_CASE("an entry file's places count the lines in strings; what is not a form is an error") {
+  AgentDir d;
+  d.write("demo/demo.clp",
+          "; a comment (with a parenthesis\n"    // 1
+          "(printout t \"a ; no comment\n"       // 2
+          "b \\\"c\\\" \\\n"                     // 3: an escaped quote, an escaped newline
+          "\" crlf) ; a comment\n"               // 4
+          "(no-such-function 1)\n"               // 5
+          "(defrule r (a) => (assert (b)))\n"    // 6
+          "x (printout t \"not run\" crlf)\n");  // 7
+  AgentFixture f(fawkes_config(d));
+  const std::string what = load_error(f, d.path("demo/demo.clp"));
+  INFO(what);
+  CHECK(what.find("demo.clp:5: [EXPRNPSR3] Missing function declaration for no-such-function") !=
+        std::string::npos);
+  CHECK(what.find("demo.clp:7: expected a command or construct in parentheses") !=
+        std::string::npos);
+  CHECK(f.logged("b \"c\""));
+  CHECK_FALSE(f.logged("not run"));
+  d.write("demo/stray.clp", "(deffacts none)\n\n) (printout t \"x\" crlf)\n");
+  AgentFixture g(fawkes_config(d));
+  CHECK_THROWS_WITH_AS(g.load_file(d.path("demo/stray.clp")),
+                       doctest::Contains("stray.clp:3: expected a command or construct"),
                        AgentLoadError);
 }
 
@@ -255,18 +287,11 @@ TEST_CASE("a nested message read from an unset field can be filled and set") {
 
 TEST_CASE("blackboard-open: interface facts from the pose and from written interfaces") {
   AgentDir d;
-  d.write("demo/demo.clp", R"clp(
-(defrule use-blackboard
-  (ff-feature blackboard)
-  =>
-  (ff-feature-request "blackboard")
-  (blackboard-enable-time-read)
-  (blackboard-open "Position3DInterface" "Pose")
-  (blackboard-open "RobotinoLightInterface" "Light_State")
-  (blackboard-open "NoSuchInterface" "x")
-  (path-load demo/sense.clp))  ; its rules match the interface templates just defined
-)clp");
-  d.write("demo/sense.clp", R"clp(
+  test::write_blackboard_agent(d.dir, "", "demo",
+                               {{"Position3DInterface", "Pose"},
+                                {"RobotinoLightInterface", "Light_State"},
+                                {"NoSuchInterface", "x"}},
+                               R"clp(
 (defrule seen-pose
   (Position3DInterface (id "Pose") (translation ?x ?y ?) (rotation $?q))
   =>
@@ -407,22 +432,15 @@ class FakeBlackboard final : public Blackboard {
 
 TEST_CASE("blackboard: every interface type the skills have, read from the robot's blackboard") {
   AgentDir d;
-  d.write("demo/demo.clp", R"clp(
-(defrule use-blackboard
-  (ff-feature blackboard)
-  =>
-  (ff-feature-request "blackboard")
-  (blackboard-enable-time-read)
-  (blackboard-open "NavigatorInterface" "Pathplan")
-  (blackboard-open "MotorInterface" "Robotino")
-  (blackboard-open "SwitchInterface" "ampel_red")
-  (blackboard-open "RobotinoAmpelInterface" "Ampel")
-  (blackboard-open "LaserClusterInterface" "laser-cluster")
-  (blackboard-open "SkillerInterface" "Skiller")
-  (blackboard-open "RobotinoSensorInterface" "Robotino")
-  (path-load demo/sense.clp))
-)clp");
-  d.write("demo/sense.clp", R"clp(
+  test::write_blackboard_agent(d.dir, "", "demo",
+                               {{"NavigatorInterface", "Pathplan"},
+                                {"MotorInterface", "Robotino"},
+                                {"SwitchInterface", "ampel_red"},
+                                {"RobotinoAmpelInterface", "Ampel"},
+                                {"LaserClusterInterface", "laser-cluster"},
+                                {"SkillerInterface", "Skiller"},
+                                {"RobotinoSensorInterface", "Robotino"}},
+                               R"clp(
 (defrule nav (NavigatorInterface (id "Pathplan") (msgid ?m) (final ?f) (dest_x ?x) (drive_mode ?dm))
   => (assert (nav ?m ?f ?x ?dm)))
 (defrule motor (MotorInterface (id "Robotino") (vx ?vx) (controller_thread_name ?n))

@@ -14,6 +14,7 @@
 #include "llsf/study/player.h"
 #include "llsf/study/runner.h"
 #include "llsf/study/scenario.h"
+#include "support/fawkes_agent.h"
 #include "support/temp_dir.h"
 
 using namespace llsf;
@@ -143,6 +144,15 @@ robots:
   }
 };
 
+// Plays robot 0 of `s` (its agent as the scenario configures it) to `seconds` and returns its
+// agent, checked to have had no runtime error.
+const clips::AgentHost& play_robot_0(sim::GameDriver& driver, const Scenario& s, double seconds) {
+  sim::AgentBrain& brain = driver.plug_agent(0, agent_config(s, s.robots.at(0)));
+  driver.run_until(core::SimTime::from_seconds(seconds));
+  CHECK(brain.agent().runtime_errors() == 0);
+  return brain.agent();
+}
+
 }  // namespace
 
 TEST_CASE("a Fawkes-style agent's own messages travel between the robots") {
@@ -209,17 +219,8 @@ message LockMessage {
 
 TEST_CASE("a Fawkes-style agent reads the light detection as RobotinoLightInterface Light_State") {
   test::TempDir dir{"llsf_fawkes_light"};
-  std::filesystem::create_directories(dir.path / "agents/light");
-  dir.write("agents/light/light.clp", R"clp(
-(defrule use-blackboard
-  (ff-feature blackboard)
-  =>
-  (ff-feature-request "blackboard")
-  (blackboard-enable-time-read)
-  (blackboard-open "RobotinoLightInterface" "Light_State")
-  (path-load light/sense.clp))
-)clp");
-  dir.write("agents/light/sense.clp", R"clp(
+  test::write_blackboard_agent(dir, "agents", "light", {{"RobotinoLightInterface", "Light_State"}},
+                               R"clp(
 (defrule seen-light
   (RobotinoLightInterface (id "Light_State") (red ?r) (ready ?ready) (visibility_history ?v))
   =>
@@ -233,12 +234,8 @@ robots:
   agent: {fawkes: agents, entry: light/light}
 )yaml");
   const ScenarioFile f = load_scenario(dir.file("s.yaml"));
-  const Scenario& s = f.variants.at(0);
-  sim::GameDriver driver(s.game);
-  sim::AgentBrain& brain = driver.plug_agent(0, agent_config(s, s.robots.at(0)));
-  driver.run_until(core::SimTime::from_seconds(2.0));
-  const clips::AgentHost& agent = brain.agent();
-  CHECK(agent.runtime_errors() == 0);
+  sim::GameDriver driver(f.variants.at(0).game);
+  const clips::AgentHost& agent = play_robot_0(driver, f.variants.at(0), 2.0);
   // At its start pose the robot sees no signal: UNKNOWN, not ready, and a visibility history
   // that counts down from -1 in frames of the skill rate (30 Hz), one fact per agent cycle.
   const auto seen = agent.facts("seen-light");
@@ -257,18 +254,9 @@ robots:
 
 TEST_CASE("what a skill writes with Fawkes' API reaches a Fawkes-style agent's blackboard") {
   test::TempDir dir{"llsf_fawkes_written"};
-  std::filesystem::create_directories(dir.path / "agents/mark");
   std::filesystem::create_directories(dir.path / "skills");
-  dir.write("agents/mark/mark.clp", R"clp(
-(defrule use-blackboard
-  (ff-feature blackboard)
-  =>
-  (ff-feature-request "blackboard")
-  (blackboard-enable-time-read)
-  (blackboard-open "RobotinoLightInterface" "Light determined")
-  (path-load mark/sense.clp))
-)clp");
-  dir.write("agents/mark/sense.clp", R"clp(
+  test::write_blackboard_agent(dir, "agents", "mark",
+                               {{"RobotinoLightInterface", "Light determined"}}, R"clp(
 (defrule call-mark (time $?) (not (called)) => (assert (called)) (skill-call mark))
 (defrule determined
   (RobotinoLightInterface (id "Light determined") (green ?g) (ready ?r))
@@ -300,12 +288,8 @@ robots:
 skills: {skill_dirs: [skills]}
 )yaml");
   const ScenarioFile f = load_scenario(dir.file("s.yaml"));
-  const Scenario& s = f.variants.at(0);
-  sim::GameDriver driver(s.game);
-  sim::AgentBrain& brain = driver.plug_agent(0, agent_config(s, s.robots.at(0)));
-  driver.run_until(core::SimTime::from_seconds(2.0));
-  const clips::AgentHost& agent = brain.agent();
-  CHECK(agent.runtime_errors() == 0);
+  sim::GameDriver driver(f.variants.at(0).game);
+  const clips::AgentHost& agent = play_robot_0(driver, f.variants.at(0), 2.0);
   const auto facts = agent.facts("determined");
   REQUIRE(facts.size() == 1);
   CHECK(facts[0].fields().at(0).text == "ON");
@@ -314,19 +298,11 @@ skills: {skill_dirs: [skills]}
 
 TEST_CASE("a Fawkes-style agent drives by NavigatorInterface messages and reads the navigator") {
   test::TempDir dir{"llsf_fawkes_nav"};
-  std::filesystem::create_directories(dir.path / "agents/nav");
-  dir.write("agents/nav/nav.clp", R"clp(
-(defrule use-blackboard
-  (ff-feature blackboard)
-  =>
-  (ff-feature-request "blackboard")
-  (blackboard-enable-time-read)
-  (blackboard-open "Position3DInterface" "Pose")
-  (blackboard-open "NavigatorInterface" "Pathplan")
-  (blackboard-open "MotorInterface" "Robotino")
-  (path-load nav/drive.clp))
-)clp");
-  dir.write("agents/nav/drive.clp", R"clp(
+  test::write_blackboard_agent(dir, "agents", "nav",
+                               {{"Position3DInterface", "Pose"},
+                                {"NavigatorInterface", "Pathplan"},
+                                {"MotorInterface", "Robotino"}},
+                               R"clp(
 (defrule go
   (Position3DInterface (id "Pose") (translation ?x ?y ?))
   (not (goal $?))

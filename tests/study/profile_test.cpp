@@ -144,7 +144,12 @@ TEST_CASE("profiles: the scenario key, overrides, and keys that win over the pro
   // Errors name the file, line and key.
   std::string e = error_of(dir, head + "profile: robotino-2099\n");
   CHECK(e.find("s.yaml:4:") != std::string::npos);
-  CHECK(e.find("unknown profile 'robotino-2099'") != std::string::npos);
+  CHECK(e.find("unknown profile 'robotino-2099' (known: ideal, robotino-2013, "
+               "robotino-2013-omniscient)") != std::string::npos);
+  for (const std::string& name : study::RobotProfile::names()) {
+    CAPTURE(name);
+    CHECK(study::RobotProfile::named(name).name == name);  // the list is the names named() knows
+  }
   e = error_of(dir, head + "profile: {name: ideal, max_speed_mps: -1}\n");
   CHECK(e.find("s.yaml:4:") != std::string::npos);
   CHECK(e.find("max_speed_mps") != std::string::npos);
