@@ -209,6 +209,28 @@ namespace {
 int octant_of(int a, int b) {
   return (a < 0 ? 1 : 0) | (b < 0 ? 2 : 0) | (std::abs(b) > std::abs(a) ? 4 : 0);
 }
+// Calls f(i, j) for every non-zero cell of `grid` (rows of `nx`) in columns [i0, i1] and rows
+// [j0, j1], row by row; eight zero cells are skipped at a time.
+template <class F>
+void for_each_set(const std::vector<std::uint8_t>& grid, int nx, int i0, int j0, int i1, int j1,
+                  F&& f) {
+  for (int j = j0; j <= j1; ++j) {
+    const std::uint8_t* row =
+        grid.data() + static_cast<std::size_t>(j) * static_cast<std::size_t>(nx);
+    for (int i = i0; i <= i1; ++i) {
+      if (i + 8 <= i1 + 1) {
+        std::uint64_t block = 0;
+        std::memcpy(&block, row + i, sizeof block);
+        if (block == 0) {
+          i += 7;
+          continue;
+        }
+      }
+      if (row[i] != 0) f(i, j);
+    }
+  }
+}
+
 bool in_closed_octant(int o, int a, int b) {
   return ((o & 1) != 0 ? a <= 0 : a >= 0) && ((o & 2) != 0 ? b <= 0 : b >= 0) &&
          ((o & 4) != 0 ? std::abs(b) >= std::abs(a) : std::abs(a) >= std::abs(b));
@@ -231,25 +253,13 @@ void Costmap::mark_and_clear(const Vec2& origin, std::span<const Vec2> hits) {
     const int bi0 = std::max(0, i0 - max_cells), bi1 = std::min(nx_ - 1, i0 + max_cells);
     const int bj0 = std::max(0, j0 - max_cells), bj1 = std::min(ny_ - 1, j0 + max_cells);
     bool any = false;
-    for (int j = bj0; j <= bj1; ++j) {
-      const std::uint8_t* row = obstacle_.data() + idx(0, j);
-      for (int i = bi0; i <= bi1; ++i) {
-        if (i + 8 <= bi1 + 1) {  // eight free cells at a time
-          std::uint64_t block = 0;
-          std::memcpy(&block, row + i, sizeof block);
-          if (block == 0) {
-            i += 7;
-            continue;
-          }
-        }
-        if (row[i] == 0) continue;
-        const int a = i - i0, b = j - j0;
-        for (int o = 0; o < 8; ++o) {
-          if (in_closed_octant(o, a, b)) octant_cells_[o].push_back({a, b});
-        }
-        any = true;
+    for_each_set(obstacle_, nx_, bi0, bj0, bi1, bj1, [&](int i, int j) {
+      const int a = i - i0, b = j - j0;
+      for (int o = 0; o < 8; ++o) {
+        if (in_closed_octant(o, a, b)) octant_cells_[o].push_back({a, b});
       }
-    }
+      any = true;
+    });
     // Each cell by slope bins: a cell k cells along the major axis and m along the minor one is
     // on the lines of slopes in ((2m - 1) / 2k, (2m + 1) / 2k] (the closed form below), so a
     // line needs to test only the cells of its slope's bin.
@@ -381,20 +391,8 @@ void Costmap::inflate() {
   for (int j = rj0; j <= rj1; ++j) {
     std::memcpy(cost_.data() + idx(ri0, j), static_cost_.data() + idx(ri0, j), n);
   }
-  for (int j = oj0; j <= oj1; ++j) {
-    const std::uint8_t* row = obstacle_.data() + idx(0, j);
-    for (int i = oi0; i <= oi1; ++i) {
-      if (i + 8 <= oi1 + 1) {  // eight free cells at a time
-        std::uint64_t block = 0;
-        std::memcpy(&block, row + i, sizeof block);
-        if (block == 0) {
-          i += 7;
-          continue;
-        }
-      }
-      if (row[i] != 0) stamp(cost_, i, j, ri0, rj0, ri1, rj1);
-    }
-  }
+  for_each_set(obstacle_, nx_, oi0, oj0, oi1, oj1,
+               [&](int i, int j) { stamp(cost_, i, j, ri0, rj0, ri1, rj1); });
   dirty_i0_ = dirty_j0_ = std::numeric_limits<int>::max();
   dirty_i1_ = dirty_j1_ = -1;
 }
