@@ -396,7 +396,7 @@ def("Position3DInterface", {
         local list = pucks_by_distance(now)
         local p = list[n]
         pose_fields(d, p and p[1] or 0.0, p and p[2] or 0.0, 0.0, "/base_link", p ~= nil, now)
-      end, function() return V.count(V) >= n end
+      end, function() return V.count(V) >= n end, n
     end
     if id == "Euclidean Laser Cluster" then
       local L, N = llsf.RobotinoLightInterface, llsf.NavigatorInterface
@@ -761,10 +761,10 @@ common.msgq_enqueue = common.msgq_enqueue_copy
 local function make_object(type_name, id, t)
   local d = {}
   for f, spec in pairs(t.fields) do d[f] = default_value(spec[1], spec[2]) end
-  local w, visible = t.writer(id)
+  local w, visible, puck_n = t.writer(id)
   local obj = {}
   meta_of[obj] = {type = type_name, id = id, t = t, write = w ~= "store" and w or nil,
-                  visible = visible, store = w == "store", msgid = 0}
+                  visible = visible, puck_n = puck_n, store = w == "store", msgid = 0}
   if w == "store" then meta_of[obj].written = true end
   data_of[obj] = d
   -- llsfsim's own methods answer at every id of its types; before the fields of the same name
@@ -1000,12 +1000,25 @@ end
 -- asked for): it is all that a history counts.
 function F.poll()
   local now
+  local count_ok, count  -- the puck detection's count, read once for every OmniPuck<n>
   for i = 1, #polled do
     local obj = polled[i]
-    local visible = meta_of[obj].visible
+    local m = meta_of[obj]
+    local visible = m.visible
     if visible then
       now = now or now_ns()
-      local ok, v = pcall(visible)  -- (a failing read fails at the skill's)
+      local ok, v
+      local n = m.puck_n
+      if n then  -- (as its visible(): V.count(V) >= n)
+        if count_ok == nil then
+          local V = llsf.PuckVisionInterface
+          count_ok, count = pcall(V.count, V)
+        end
+        ok = count_ok
+        if ok then v = count >= n end
+      else
+        ok, v = pcall(visible)  -- (a failing read fails at the skill's)
+      end
       local d = data_of[obj]
       if ok and d.vis_state ~= v then d.vis_state, d.vis_since = v, now end
     else
