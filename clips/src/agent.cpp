@@ -127,6 +127,7 @@ LogLevel level_of(std::string_view logical_name) {
 
 struct AgentHost::Impl {
   detail::HostState state;
+  std::pair<std::string, std::string> interface_key;  // write_interface's look-up
   detail::Environment env;  // before the features: they hold handles into it
   std::vector<std::unique_ptr<detail::Feature>> features;
   bool started = false;
@@ -851,7 +852,13 @@ void AgentHost::set_pose(const core::Pose2D& pose) {
 
 void AgentHost::write_interface(std::string_view type, std::string_view id,
                                 InterfaceFields fields) {
-  auto& d = impl_->state.blackboard[{std::string(type), std::string(id)}];
+  // (the key's strings reused: no allocation per write of an interface already there)
+  auto& key = impl_->interface_key;
+  key.first.assign(type);
+  key.second.assign(id);
+  auto it = impl_->state.blackboard.find(key);
+  if (it == impl_->state.blackboard.end()) it = impl_->state.blackboard.try_emplace(key).first;
+  auto& d = it->second;
   d.time = impl_->state.now;
   d.fields = std::move(fields);
   ++d.serial;

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Small features: logging functions, seeded random, robot identity and pose, confval facts.
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -176,9 +177,35 @@ class RobotFeature final : public Feature {
   // at every cycle as the 2013 localization wrote it at its rate (the map frame; the yaw as the
   // quaternion (0 0 sin(a/2) cos(a/2)); visibility_history counts the updates).
   void write_pose_interface() {
-    auto& d = s_.blackboard[{"Position3DInterface", "Pose"}];
+    // (the map's entries are never erased: looked up once)
+    if (pose_data_ == nullptr) pose_data_ = &s_.blackboard[{"Position3DInterface", "Pose"}];
+    HostState::InterfaceData& d = *pose_data_;
     d.time = s_.now;
     const double h = s_.pose->theta / 2.0;
+    auto& f = d.fields;
+    const auto floats = [](const Value& v, std::size_t n) {
+      return v.type == Value::Type::kMultifield && v.items.size() == n &&
+             std::all_of(v.items.begin(), v.items.end(),
+                         [](const Value& e) { return e.type == Value::Type::kFloat; });
+    };
+    if (f.size() == 4 && f[0].first == "frame" && f[0].second.is_string("/map") &&
+        f[1].first == "visibility_history" && f[1].second.type == Value::Type::kInteger &&
+        f[2].first == "rotation" && floats(f[2].second, 4) && f[3].first == "translation" &&
+        floats(f[3].second, 3)) {
+      // As this function wrote them last time: the numbers updated in place.
+      f[1].second.integer = static_cast<std::int64_t>(d.serial) + 1;
+      std::vector<Value>& r = f[2].second.items;
+      std::vector<Value>& t = f[3].second.items;
+      r[0].real = 0.0;
+      r[1].real = 0.0;
+      r[2].real = std::sin(h);
+      r[3].real = std::cos(h);
+      t[0].real = s_.pose->x;
+      t[1].real = s_.pose->y;
+      t[2].real = 0.0;
+      ++d.serial;
+      return;
+    }
     d.fields = {
         {"frame", Value::string("/map")},
         {"visibility_history", Value::integer_value(static_cast<std::int64_t>(d.serial) + 1)},
@@ -209,6 +236,7 @@ class RobotFeature final : public Feature {
   HostState& s_;
   Template info_, pose_;
   FactHandle pose_fact_;
+  HostState::InterfaceData* pose_data_ = nullptr;  // Position3DInterface "Pose"
 };
 
 // ---- config: confval facts after each (reset), or on (config-load PREFIX) -------------------

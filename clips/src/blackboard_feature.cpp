@@ -22,6 +22,7 @@
 // (blackboard-list-msg-fields ?m), (blackboard-send-msg ?m) (its id; handled at once).
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <map>
 #include <set>
 #include <stdexcept>
@@ -462,10 +463,12 @@ class BlackboardFeature final : public Feature {
 
  private:
   struct Opened {
-    std::uint64_t read_serial = 0;           // the host's data: their serial when last asserted
-    std::optional<core::SimTime> read_time;  // the robot's data: their time when last asserted
-    bool robot_writer = true;                // as last read (else: read again on a new version)
-    std::int64_t version = 0;                // Blackboard::version() when last read
+    std::uint64_t read_serial = 0;             // the host's data: their serial when last asserted
+    std::optional<core::SimTime> read_time;    // the robot's data: their time when last asserted
+    bool robot_writer = true;                  // as last read (else: read again on a new version)
+    std::int64_t version = 0;                  // Blackboard::version() when last read
+    const InterfaceDef* def = nullptr;         // its type (looked up once)
+    HostState::InterfaceData* host = nullptr;  // the host's data, once there are any
   };
 
   const InterfaceDef* known(const std::string& type, std::string_view function) {
@@ -636,12 +639,16 @@ class BlackboardFeature final : public Feature {
 
   void read(Environment& env) {
     for (auto& [key, o] : opened_) {
-      const InterfaceDef& def = *find_def(key.first);
-      const auto it = s_.blackboard.find(key);
-      if (it != s_.blackboard.end()) {  // the host's own data
-        if (it->second.serial == o.read_serial) continue;
-        o.read_serial = it->second.serial;
-        assert_fact(env, def, key.second, it->second.time, it->second.fields);
+      if (o.def == nullptr) o.def = find_def(key.first);
+      const InterfaceDef& def = *o.def;
+      if (o.host == nullptr) {  // (the host's entries are never erased: found once)
+        const auto it = s_.blackboard.find(key);
+        if (it != s_.blackboard.end()) o.host = &it->second;
+      }
+      if (o.host != nullptr) {  // the host's own data
+        if (o.host->serial == o.read_serial) continue;
+        o.read_serial = o.host->serial;
+        assert_fact(env, def, key.second, o.host->time, o.host->fields);
         continue;
       }
       if (s_.io.blackboard == nullptr) continue;
@@ -661,33 +668,63 @@ class BlackboardFeature final : public Feature {
 
   // The fact built from values, without printing and parsing it (the agent reads its
   // interfaces at every cycle): every field of the definition, as its type holds it (a field
-  // the data lack, or cannot be held, its default).
+  // the data lack, or cannot be held, its default). The values are passed by pointer: a field
+  // the data hold as its type does is not copied.
   void assert_fact(Environment& env, const InterfaceDef& def, const std::string& id,
                    core::SimTime time, const InterfaceFields& fields) {
-    auto found = templates_.find(std::string_view(def.type));
-    if (found == templates_.end())
-      found = templates_.emplace(def.type, env.find_template(def.type)).first;
-    const Template& t = found->second;
-    values_.assign(t.slots.size(), Value{});
+    const Plan& plan = plan_of(env, def);
+    slot_values_.assign(plan.t.slots.size(), nullptr);
+    converted_.resize(def.fields.size());
     const std::int64_t ns = time.ns();
-    values_[static_cast<std::size_t>(t.slot_index("id"))] = Value::string(id);
-    values_[static_cast<std::size_t>(t.slot_index("time"))] =
-        Value::multifield({Value::integer_value(ns / 1'000'000'000),
-                           Value::integer_value((ns % 1'000'000'000) / 1000)});
-    for (const FieldDef& f : def.fields) {
-      const auto given = std::find_if(fields.begin(), fields.end(),
-                                      [&](const auto& v) { return v.first == f.name; });
-      Value& slot = values_[static_cast<std::size_t>(t.slot_index(f.name))];
+    id_value_.text = id;
+    time_value_.items[0].integer = ns / 1'000'000'000;
+    time_value_.items[1].integer = (ns % 1'000'000'000) / 1000;
+    slot_values_[plan.id_slot] = &id_value_;
+    slot_values_[plan.time_slot] = &time_value_;
+    for (std::size_t i = 0; i < def.fields.size(); ++i) {
+      const FieldDef& f = def.fields[i];
+      const std::string_view name = plan.names[i];
+      const auto given = std::find_if(fields.begin(), fields.end(), [&](const auto& v) {
+        return v.first.size() == name.size() && std::string_view(v.first) == name;
+      });
       if (given != fields.end() && fits(f, given->second)) {
-        slot = given->second;  // (the usual case: no conversion)
+        slot_values_[plan.field_slots[i]] = &given->second;  // (the usual case: no conversion)
         continue;
       }
       std::optional<Value> v;
       if (given != fields.end()) v = coerce(f, given->second, kNoBase);
-      slot = v ? std::move(*v) : default_value(f);
+      converted_[i] = v ? std::move(*v) : default_value(f);
+      slot_values_[plan.field_slots[i]] = &converted_[i];
     }
-    FactHandle h = env.assert_fact(t, values_);
+    FactHandle h = env.assert_fact(plan.t, std::span<const Value* const>(slot_values_));
     env.release(h);
+  }
+
+  // A type's template and the slot of each of its fields, looked up once.
+  struct Plan {
+    const InterfaceDef* def = nullptr;
+    Template t;
+    std::size_t id_slot = 0, time_slot = 0;
+    std::vector<std::size_t> field_slots;  // by the definition's fields
+    std::vector<std::string_view> names;   // the fields' names
+  };
+  const Plan& plan_of(Environment& env, const InterfaceDef& def) {
+    for (const Plan& p : plans_)
+      if (p.def == &def) return p;
+    Plan p;
+    p.def = &def;
+    auto found = templates_.find(std::string_view(def.type));
+    if (found == templates_.end())
+      found = templates_.emplace(def.type, env.find_template(def.type)).first;
+    p.t = found->second;
+    p.id_slot = static_cast<std::size_t>(p.t.slot_index("id"));
+    p.time_slot = static_cast<std::size_t>(p.t.slot_index("time"));
+    for (const FieldDef& f : def.fields) {
+      p.field_slots.push_back(static_cast<std::size_t>(p.t.slot_index(f.name)));
+      p.names.emplace_back(f.name);
+    }
+    plans_.push_back(std::move(p));
+    return plans_.back();
   }
 
   void cleanup(Environment& env) {
@@ -712,7 +749,11 @@ class BlackboardFeature final : public Feature {
   std::map<std::pair<std::string, std::string>, InterfaceFields> writing_;
   std::map<InterfaceMessage*, std::unique_ptr<InterfaceMessage>> messages_;  // not yet sent
   static constexpr std::size_t kMaxUnsentMessages = 1000;
-  std::vector<Value> values_;                               // assert_fact's slot values
+  std::vector<const Value*> slot_values_;  // assert_fact's slot values
+  std::vector<Value> converted_;           // assert_fact's fields converted or defaulted
+  Value id_value_ = Value::string("");
+  Value time_value_ = Value::multifield({Value::integer_value(0), Value::integer_value(0)});
+  std::deque<Plan> plans_;                                  // by type (stable addresses)
   std::map<std::string, Template, std::less<>> templates_;  // by type, looked up once
   std::vector<std::string> defined_;                        // the types with a template
   std::vector<Template> cleanup_;                           // their templates

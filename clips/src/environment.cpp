@@ -98,9 +98,9 @@ void atom(void* env, const Value& v, int& type, void*& value) {
     case Value::Type::kSymbol:
       type = SYMBOL;
       // TRUE and FALSE (every predicate's result) without hashing them into the symbol table.
-      if (v.text == "TRUE")
+      if (v.text.size() == 4 && std::memcmp(v.text.data(), "TRUE", 4) == 0)
         value = EnvTrueSymbol(env);
-      else if (v.text == "FALSE")
+      else if (v.text.size() == 5 && std::memcmp(v.text.data(), "FALSE", 5) == 0)
         value = EnvFalseSymbol(env);
       else
         value = EnvAddSymbol(env, v.text.c_str());
@@ -1295,42 +1295,42 @@ Template Environment::implied_template(const std::string& name) {
   return t;
 }
 
-FactHandle Environment::assert_fact(const Template& t, std::span<const Value> values) {
+namespace {
+// The value of slot i: values hold them (assert_fact) or point at them (nullptr: unset).
+const Value* slot_value(std::span<const Value> values, std::size_t i) { return &values[i]; }
+const Value* slot_value(std::span<const Value* const> values, std::size_t i) { return values[i]; }
+}  // namespace
+
+template <class Values>
+FactHandle Environment::assert_slots(const Template& t, Values values) {
   auto* fact = static_cast<struct fact*>(EnvCreateFact(env_, t.ptr));
   if (fact == nullptr) throw std::logic_error("CLIPS: cannot create a fact of " + t.name);
   // The slots are written in place, as EnvPutFactSlot does, without its per-call look-up of the
   // slot by name (a symbol hash each) and without the temporary multifield of a DATA_OBJECT;
   // EnvAssignFactSlotDefaults then fills only the slots left unset. Same fact, fewer steps.
   struct field* fields = fact->theProposition.theFields;
-  if (t.implied) {
-    if (fields[0].type == MULTIFIELD)
-      ReturnMultifield(env_, static_cast<struct multifield*>(fields[0].value));
-    fields[0].type = MULTIFIELD;
-    fields[0].value = make_multifield(env_, values);
-  } else {
-    const std::size_t n = std::min(values.size(), t.slots.size());
-    struct templateSlot* slot = static_cast<struct deftemplate*>(t.ptr)->slotList;
-    for (std::size_t i = 0; i < n; ++i, slot = slot->next) {
-      const Value& v = values[i];
-      if (v.type == Value::Type::kVoid) continue;
-      const bool multi = v.type == Value::Type::kMultifield;
-      if (multi != (slot->multislot != 0))
-        throw std::logic_error("CLIPS: cannot set slot " + t.slots[i] + " of " + t.name);
-      if (fields[i].type == MULTIFIELD)
-        ReturnMultifield(env_, static_cast<struct multifield*>(fields[i].value));
-      if (multi) {
-        fields[i].type = MULTIFIELD;
-        fields[i].value = make_multifield(env_, v.items);
-      } else {
-        int type = 0;
-        void* value = nullptr;
-        atom(env_, v, type, value);
-        fields[i].type = static_cast<unsigned short>(type);
-        fields[i].value = value;
-      }
+  const std::size_t n = std::min(values.size(), t.slots.size());
+  struct templateSlot* slot = static_cast<struct deftemplate*>(t.ptr)->slotList;
+  for (std::size_t i = 0; i < n; ++i, slot = slot->next) {
+    const Value* v = slot_value(values, i);
+    if (v == nullptr || v->type == Value::Type::kVoid) continue;
+    const bool multi = v->type == Value::Type::kMultifield;
+    if (multi != (slot->multislot != 0))
+      throw std::logic_error("CLIPS: cannot set slot " + t.slots[i] + " of " + t.name);
+    if (fields[i].type == MULTIFIELD)
+      ReturnMultifield(env_, static_cast<struct multifield*>(fields[i].value));
+    if (multi) {
+      fields[i].type = MULTIFIELD;
+      fields[i].value = make_multifield(env_, v->items);
+    } else {
+      int type = 0;
+      void* value = nullptr;
+      atom(env_, *v, type, value);
+      fields[i].type = static_cast<unsigned short>(type);
+      fields[i].value = value;
     }
-    EnvAssignFactSlotDefaults(env_, fact);
   }
+  EnvAssignFactSlotDefaults(env_, fact);
   FactHandle h;
   void* asserted = EnvAssert(env_, fact);
   if (asserted != nullptr) {
@@ -1338,6 +1338,29 @@ FactHandle Environment::assert_fact(const Template& t, std::span<const Value> va
     h.fact_ = asserted;
   }
   return h;
+}
+
+FactHandle Environment::assert_fact(const Template& t, std::span<const Value> values) {
+  if (!t.implied) return assert_slots(t, values);
+  auto* fact = static_cast<struct fact*>(EnvCreateFact(env_, t.ptr));
+  if (fact == nullptr) throw std::logic_error("CLIPS: cannot create a fact of " + t.name);
+  struct field* fields = fact->theProposition.theFields;
+  if (fields[0].type == MULTIFIELD)
+    ReturnMultifield(env_, static_cast<struct multifield*>(fields[0].value));
+  fields[0].type = MULTIFIELD;
+  fields[0].value = make_multifield(env_, values);
+  FactHandle h;
+  void* asserted = EnvAssert(env_, fact);
+  if (asserted != nullptr) {
+    EnvIncrementFactCount(env_, asserted);
+    h.fact_ = asserted;
+  }
+  return h;
+}
+
+FactHandle Environment::assert_fact(const Template& t, std::span<const Value* const> values) {
+  if (t.implied) throw std::logic_error("CLIPS: assert_fact by slot of ordered " + t.name);
+  return assert_slots(t, values);
 }
 
 bool Environment::exists(const FactHandle& h) const {

@@ -189,6 +189,9 @@ class Environment {
   /// Asserts a fact of `t` with `values` in slot order (kVoid keeps the slot's default); for an
   /// ordered template, `values` are the fields. The handle keeps the fact for retract().
   FactHandle assert_fact(const Template& t, std::span<const Value> values);
+  /// The same for a deftemplate's fact, the values by pointer (nullptr keeps the slot's default):
+  /// nothing copied.
+  FactHandle assert_fact(const Template& t, std::span<const Value* const> values);
   /// True if the handle's fact is still in the fact list.
   bool exists(const FactHandle& h) const;
   /// Retracts the fact if it still exists and releases the handle.
@@ -281,6 +284,8 @@ class Environment {
   friend struct RouterAccess;
   friend struct TraceHooks;
   void on_print(std::string_view logical_name, std::string_view text);
+  template <class Values>
+  FactHandle assert_slots(const Template& t, Values values);
   static void periodic(void* clips_env);
   void print_fact(void* fact, std::string& out) const;
   // The call guard: CLIPS' evaluators of deffunction (PCALL) and generic function (GCALL) calls,

@@ -55,13 +55,15 @@ class TimeFeature final : public Feature {
         a.env().error(a.function(), "the third argument must be a number of seconds");
         return Value::boolean(false);
       }
-      return Value::boolean(now - since > secs);
+      a.return_boolean(now - since > secs);  // (no Value made: a test in many rules' LHS)
+      return Value{};
     });
     // (time> ?t1 ?t2): t1 later than t2.
     env.define_function("time>", "22", [](Args& a) {
       double t1 = 0, t2 = 0;
       if (!read_times(a, t1, t2)) return Value::boolean(false);
-      return Value::boolean(t1 > t2);
+      a.return_boolean(t1 > t2);
+      return Value{};
     });
   }
 

@@ -103,6 +103,10 @@ struct SkillEngine::Impl {
   /// (shortened, whole) shown path of every skill file whose path Lua shortens.
   std::vector<std::pair<std::string, std::string>> long_paths;
   int loads = 0;
+  // SkillEngine::written_interfaces: the interpreter (loads) and blackboard version at its last
+  // call (-1: none yet).
+  int written_loads = -1;
+  std::int64_t written_version = -1;
 
   SkillStatus status = SkillStatus::kInactive;
   std::string error;

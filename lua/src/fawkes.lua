@@ -123,12 +123,12 @@ local tf = {Vector3 = Vector3, Quaternion = Quaternion, Pose = Pose, StampedPose
 
 -- The robot's frames: /map (the pose estimate's frame), /odom (the same frame here: llsfsim has
 -- no odometry apart from localization) and /base_link (the robot: x forward, y left).
+-- (by name, with or without the leading slash: a look-up, no pattern matched per transform)
+local frame_kinds = {map = "world", ["/map"] = "world", odom = "world", ["/odom"] = "world",
+                     base_link = "robot", ["/base_link"] = "robot"}
 local function frame_kind(name)
   if type(name) ~= "string" then return nil end
-  local n = name:gsub("^/", "")
-  if n == "map" or n == "odom" then return "world" end
-  if n == "base_link" then return "robot" end
-  return nil
+  return frame_kinds[name]
 end
 local function robot_pose()
   return llsf.Position3DInterface.get(llsf.Position3DInterface)
@@ -159,7 +159,9 @@ function transformer.transform_pose(_, target, stamped_in, stamped_out)
   if not stamped(stamped_in) or not stamped(stamped_out) then
     fail(2, "tf:transform_pose(target_frame, stamped_in, stamped_out): expected StampedPoses")
   end
-  for _, f in ipairs{target, stamped_in.frame_id} do
+  for i = 1, 2 do  -- the target, then the pose's frame
+    local f = stamped_in.frame_id
+    if i == 1 then f = target end
     if not frame_kind(f) then
       fail(2, "tf:transform_pose: unknown frame '%s' (llsfsim has /map, /odom and /base_link)",
            tostring(f))
@@ -394,7 +396,7 @@ def("Position3DInterface", {
         local list = pucks_by_distance(now)
         local p = list[n]
         pose_fields(d, p and p[1] or 0.0, p and p[2] or 0.0, 0.0, "/base_link", p ~= nil, now)
-      end, function() return V.count(V) >= n end
+      end, function() return V.count(V) >= n end, n
     end
     if id == "Euclidean Laser Cluster" then
       local L, N = llsf.RobotinoLightInterface, llsf.NavigatorInterface
@@ -759,10 +761,10 @@ common.msgq_enqueue = common.msgq_enqueue_copy
 local function make_object(type_name, id, t)
   local d = {}
   for f, spec in pairs(t.fields) do d[f] = default_value(spec[1], spec[2]) end
-  local w, visible = t.writer(id)
+  local w, visible, puck_n = t.writer(id)
   local obj = {}
   meta_of[obj] = {type = type_name, id = id, t = t, write = w ~= "store" and w or nil,
-                  visible = visible, store = w == "store", msgid = 0}
+                  visible = visible, puck_n = puck_n, store = w == "store", msgid = 0}
   if w == "store" then meta_of[obj].written = true end
   data_of[obj] = d
   -- llsfsim's own methods answer at every id of its types; before the fields of the same name
@@ -774,14 +776,13 @@ local function make_object(type_name, id, t)
   local lookup
   -- What a key means is fixed per object: looked up once (no closure made per call).
   -- llsfsim's own methods may command the robot: looking one up counts as a command (epoch).
+  -- The cache is the object's __index table (a hit costs no call); a miss asks its own __index.
   local cache, commands = {}, {}
-  mt.__index = function(o, k)
-    local v = cache[k]
-    if v ~= nil then return v end
-    v = commands[k]
+  setmetatable(cache, {__index = function(_, k)
+    local v = commands[k]
     if v == nil then
       local command
-      v, command = lookup(o, k)
+      v, command = lookup(obj, k)
       if v == nil then return nil end
       if not command then
         cache[k] = v
@@ -791,7 +792,8 @@ local function make_object(type_name, id, t)
     end
     epoch = epoch + 1
     return v
-  end
+  end})
+  mt.__index = cache
   lookup = function(_, k)
     local c = common[k]
     if c then return c end
@@ -998,12 +1000,25 @@ end
 -- asked for): it is all that a history counts.
 function F.poll()
   local now
+  local count_ok, count  -- the puck detection's count, read once for every OmniPuck<n>
   for i = 1, #polled do
     local obj = polled[i]
-    local visible = meta_of[obj].visible
+    local m = meta_of[obj]
+    local visible = m.visible
     if visible then
       now = now or now_ns()
-      local ok, v = pcall(visible)  -- (a failing read fails at the skill's)
+      local ok, v
+      local n = m.puck_n
+      if n then  -- (as its visible(): V.count(V) >= n)
+        if count_ok == nil then
+          local V = llsf.PuckVisionInterface
+          count_ok, count = pcall(V.count, V)
+        end
+        ok = count_ok
+        if ok then v = count >= n end
+      else
+        ok, v = pcall(visible)  -- (a failing read fails at the skill's)
+      end
       local d = data_of[obj]
       if ok and d.vis_state ~= v then d.vis_state, d.vis_since = v, now end
     else

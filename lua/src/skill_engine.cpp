@@ -1038,10 +1038,17 @@ void push_field_values(lua_State* L, const std::vector<InterfaceField>& fields) 
 std::vector<WrittenInterface> SkillEngine::written_interfaces() {
   Impl& e = *impl_;
   std::vector<WrittenInterface> out;
-  if (e.L == nullptr || e.call_entry("written_interfaces", 0, 1) != LUA_OK) {
+  if (e.L == nullptr) return out;
+  // Every write counts in the blackboard's version (fawkes.lua, mark_written): the same
+  // version of the same interpreter as at the last call, and nothing was written since.
+  const std::int64_t version = blackboard_version();
+  if (e.written_loads == e.loads && e.written_version == version) return out;
+  if (e.call_entry("written_interfaces", 0, 1) != LUA_OK) {
     lua_settop(e.L, 0);
     return out;
   }
+  e.written_loads = e.loads;
+  e.written_version = blackboard_version();
   // {{type=, id=, serial=, fields={{name, kind, value}, ...}}, ...} (fawkes.lua, F.written)
   lua_State* L = e.L;
   const lua_Integer n = static_cast<lua_Integer>(lua_rawlen(L, -1));

@@ -294,13 +294,20 @@ void AgentBrain::on_agent_cycle(lua::RobotApi& robot, RobotRadio& radio) {
     const std::int64_t frames =
         (frame_ns > 0 ? std::max<std::int64_t>(since_ns, 0) / frame_ns : 0) + 1;
     using clips::Value;
-    agent_->write_interface(
-        "RobotinoLightInterface", "Light_State",
-        {{"red", Value::symbol(light.visible ? lamp_symbol(light.red) : "UNKNOWN")},
-         {"yellow", Value::symbol(light.visible ? lamp_symbol(light.yellow) : "UNKNOWN")},
-         {"green", Value::symbol(light.visible ? lamp_symbol(light.green) : "UNKNOWN")},
-         {"visibility_history", Value::integer_value(light.visible ? frames : -frames)},
-         {"ready", Value::boolean(light.visible)}});
+    if (light_fields_.empty()) {
+      light_fields_ = {{"red", Value::symbol("")},
+                       {"yellow", Value::symbol("")},
+                       {"green", Value::symbol("")},
+                       {"visibility_history", Value::integer_value(0)},
+                       {"ready", Value::boolean(false)}};
+    }
+    // (the same values as made afresh: only the symbols' texts and the integer change)
+    light_fields_[0].second.text = light.visible ? lamp_symbol(light.red) : "UNKNOWN";
+    light_fields_[1].second.text = light.visible ? lamp_symbol(light.yellow) : "UNKNOWN";
+    light_fields_[2].second.text = light.visible ? lamp_symbol(light.green) : "UNKNOWN";
+    light_fields_[3].second.integer = light.visible ? frames : -frames;
+    light_fields_[4].second.text = light.visible ? "TRUE" : "FALSE";
+    agent_->write_interface("RobotinoLightInterface", "Light_State", light_fields_);
     // What the skills wrote with Fawkes' API (the team's "Light determined"): one blackboard.
     for (const lua::WrittenInterface& w : skills_->engine().written_interfaces()) {
       std::vector<std::pair<std::string, Value>> fields;

@@ -206,6 +206,26 @@ TEST_CASE("Fawkes' MotorInterface and RobotinoSensorInterface, tf and config in 
   CHECK(robot.vx == 0.0);  // DRIVE:exit() sent TransRot(0, 0, 0)
 }
 
+// written_interfaces asks the interpreter only when the blackboard's version changed: a write
+// after an empty answer is still reported, once.
+TEST_CASE("Fawkes' blackboard: every write is reported once, also after an empty answer") {
+  FakeRobot robot;
+  robot.light_reading.visible = true;
+  robot.light_reading.device = "M1";
+  robot.light_reading.green = lua::Lamp::kOn;
+  lua::SkillEngine engine(fawkes_config(), robot);
+  for (int round = 0; round < 3; ++round) {
+    CAPTURE(round);
+    REQUIRE(engine.exec("read_light{}"));
+    CHECK(test::run_until_done(engine, robot) == SkillStatus::kFinal);
+    const std::vector<lua::WrittenInterface> written = engine.written_interfaces();
+    REQUIRE(written.size() == 1);
+    CHECK(written[0].id == "Light determined");
+    CHECK(engine.written_interfaces().empty());
+    CHECK(engine.written_interfaces().empty());
+  }
+}
+
 TEST_CASE("Fawkes' light, switch and sensor interfaces; a skill writes Light determined") {
   FakeRobot robot;
   robot.light_reading.visible = true;

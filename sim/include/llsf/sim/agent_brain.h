@@ -155,6 +155,8 @@ class AgentBrain final : public RobotBrain, private clips::SkillRunner {
   // A Fawkes-style agent's RobotinoLightInterface "Light_State": since when no device is seen.
   bool light_seen_ = false;
   core::SimTime light_lost_since_;
+  /// RobotinoLightInterface "Light_State" as last written (its values replaced at each cycle).
+  std::vector<std::pair<std::string, clips::Value>> light_fields_;
   clips::TraceOptions trace_options_;  // set_trace(), for reloaded agents
   clips::TraceSink trace_sink_;
   std::unique_ptr<clips::AgentHost> agent_;
