@@ -1331,6 +1331,10 @@ FactHandle Environment::assert_slots(const Template& t, Values values) {
     }
   }
   EnvAssignFactSlotDefaults(env_, fact);
+  return assert_created(fact);
+}
+
+FactHandle Environment::assert_created(void* fact) {
   FactHandle h;
   void* asserted = EnvAssert(env_, fact);
   if (asserted != nullptr) {
@@ -1349,13 +1353,7 @@ FactHandle Environment::assert_fact(const Template& t, std::span<const Value> va
     ReturnMultifield(env_, static_cast<struct multifield*>(fields[0].value));
   fields[0].type = MULTIFIELD;
   fields[0].value = make_multifield(env_, values);
-  FactHandle h;
-  void* asserted = EnvAssert(env_, fact);
-  if (asserted != nullptr) {
-    EnvIncrementFactCount(env_, asserted);
-    h.fact_ = asserted;
-  }
-  return h;
+  return assert_created(fact);
 }
 
 FactHandle Environment::assert_fact(const Template& t, std::span<const Value* const> values) {

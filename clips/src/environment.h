@@ -286,6 +286,8 @@ class Environment {
   void on_print(std::string_view logical_name, std::string_view text);
   template <class Values>
   FactHandle assert_slots(const Template& t, Values values);
+  // Asserts a fact made by EnvCreateFact and holds it (a handle to nothing if CLIPS refused it).
+  FactHandle assert_created(void* fact);
   static void periodic(void* clips_env);
   void print_fact(void* fact, std::string& out) const;
   // The call guard: CLIPS' evaluators of deffunction (PCALL) and generic function (GCALL) calls,

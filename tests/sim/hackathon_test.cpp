@@ -155,7 +155,6 @@ TEST_CASE("hackathon camera: miss and false-colour rates over many frames") {
   rig.colours = {0, 2};
   int frames = 0, sightings = 0, wrong = 0;
   double err = 0.0;
-  SimTime last;
   for (int t = 0; t < 40000; ++t) {  // 400 s at 10 Hz: 4,000 frames
     rig.tick();
     const auto seen = rig.stack.colour_pucks();
