@@ -683,10 +683,8 @@ class BlackboardFeature final : public Feature {
     slot_values_[plan.time_slot] = &time_value_;
     for (std::size_t i = 0; i < def.fields.size(); ++i) {
       const FieldDef& f = def.fields[i];
-      const std::string_view name = plan.names[i];
-      const auto given = std::find_if(fields.begin(), fields.end(), [&](const auto& v) {
-        return v.first.size() == name.size() && std::string_view(v.first) == name;
-      });
+      const auto given = std::find_if(fields.begin(), fields.end(),
+                                      [&](const auto& v) { return v.first == f.name; });
       if (given != fields.end() && fits(f, given->second)) {
         slot_values_[plan.field_slots[i]] = &given->second;  // (the usual case: no conversion)
         continue;
@@ -706,7 +704,6 @@ class BlackboardFeature final : public Feature {
     Template t;
     std::size_t id_slot = 0, time_slot = 0;
     std::vector<std::size_t> field_slots;  // by the definition's fields
-    std::vector<std::string_view> names;   // the fields' names
   };
   const Plan& plan_of(Environment& env, const InterfaceDef& def) {
     for (const Plan& p : plans_)
@@ -721,7 +718,6 @@ class BlackboardFeature final : public Feature {
     p.time_slot = static_cast<std::size_t>(p.t.slot_index("time"));
     for (const FieldDef& f : def.fields) {
       p.field_slots.push_back(static_cast<std::size_t>(p.t.slot_index(f.name)));
-      p.names.emplace_back(f.name);
     }
     plans_.push_back(std::move(p));
     return plans_.back();
