@@ -291,8 +291,13 @@ void Costmap::mark_and_clear(const Vec2& origin, std::span<const Vec2> hits) {
         for (const OffsetCell& cell : octant_cells_[o]) {
           int lo = 0, hi = 0;
           slope_bins(cell, o, lo, hi);
-          for (int b = lo; b <= hi; ++b) {
-            slope_cells_[static_cast<std::size_t>(fill[o * kB + b]++)] = cell;
+          const int a = (o & 1) != 0 ? -cell.a : cell.a, b = (o & 2) != 0 ? -cell.b : cell.b;
+          const BinCell bc{static_cast<std::int16_t>(cell.a), static_cast<std::int16_t>(cell.b),
+                           static_cast<std::int16_t>((o & 4) != 0 ? b : a),
+                           static_cast<std::int16_t>((o & 4) != 0 ? a : b),
+                           static_cast<std::ptrdiff_t>(cell.b) * nx_ + cell.a};
+          for (int bin = lo; bin <= hi; ++bin) {
+            slope_cells_[static_cast<std::size_t>(fill[o * kB + bin]++)] = bc;
           }
         }
       }
@@ -301,6 +306,9 @@ void Costmap::mark_and_clear(const Vec2& origin, std::span<const Vec2> hits) {
     const double x_lo = origin_.x(), y_lo = origin_.y(), res = res_;
     const double x_hi = origin_.x() + nx_ * res_ - 1e-9, y_hi = origin_.y() + ny_ * res_ - 1e-9;
     const int nx = nx_, ny = ny_;
+    std::uint8_t* const base = obstacle_.data() + idx(i0, j0);
+    constexpr int kNone = std::numeric_limits<int>::max();
+    int di0 = kNone, dj0 = kNone, di1 = -1, dj1 = -1;  // the cells cleared
     for (const Vec2& h : any ? hits : std::span<const Vec2>{}) {
       // The end point, clipped to the grid along the beam.
       Vec2 e = h;
@@ -321,31 +329,34 @@ void Costmap::mark_and_clear(const Vec2& origin, std::span<const Vec2> hits) {
       const int dx = std::abs(da), dy = std::abs(db);
       const int steps = std::min(std::max(dx, dy), max_cells);
       if (steps == 0) continue;
-      const int sx = da >= 0 ? 1 : -1, sy = db >= 0 ? 1 : -1;
       const bool x_major = dx >= dy;
       const int major = x_major ? dx : dy, minor = x_major ? dy : dx;
       const int bin = octant_of(da, db) * kB + std::min(kB - 1, (minor * kB) / major);
       const int first = slope_start_[static_cast<std::size_t>(bin)];
       const int last = slope_start_[static_cast<std::size_t>(bin) + 1];
+      // (No branch per cell: whether a cell is cleared is as good as random.)
+      const int den = 2 * major;
       for (int c = first; c < last; ++c) {
-        const OffsetCell& cell = slope_cells_[static_cast<std::size_t>(c)];
-        std::uint8_t& o =
-            obstacle_[static_cast<std::size_t>(j0 + cell.b) * static_cast<std::size_t>(nx) +
-                      static_cast<std::size_t>(i0 + cell.a)];
-        if (o == 0) continue;                        // cleared by an earlier beam
-        const int a = cell.a * sx, b = cell.b * sy;  // both >= 0 in this octant
-        const int k = x_major ? a : b;
-        const int m = x_major ? b : a;
+        const BinCell& cell = slope_cells_[static_cast<std::size_t>(c)];
+        std::uint8_t* o = base + cell.at;
         // The textbook Bresenham's minor offset at major step k is ceil(num / den) with
         // num = 2 k minor - major and den = 2 major (checked against the walk for every line
         // up to 90 cells): m is it iff (m - 1) den < num <= m den.
-        const int num = 2 * k * minor - major, den = 2 * major;
-        if (k < steps && num <= m * den && num > (m - 1) * den) {
-          o = 0;
-          mark_dirty(i0 + cell.a, j0 + cell.b);
-        }
+        const int num = 2 * cell.k * minor - major;
+        const bool hit =
+            (*o != 0) & (cell.k < steps) & (num <= cell.m * den) & (num > (cell.m - 1) * den);
+        *o = hit ? 0 : *o;
+        const int ci = i0 + cell.a, cj = j0 + cell.b;
+        di0 = std::min(di0, hit ? ci : kNone);
+        dj0 = std::min(dj0, hit ? cj : kNone);
+        di1 = std::max(di1, hit ? ci : -1);
+        dj1 = std::max(dj1, hit ? cj : -1);
       }
     }
+    dirty_i0_ = std::min(dirty_i0_, di0);
+    dirty_j0_ = std::min(dirty_j0_, dj0);
+    dirty_i1_ = std::max(dirty_i1_, di1);
+    dirty_j1_ = std::max(dirty_j1_, dj1);
   }
   // 2. Mark the hits within the obstacle range.
   const double r2 = obstacle_range_ * obstacle_range_;

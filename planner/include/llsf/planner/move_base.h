@@ -221,7 +221,14 @@ class Costmap {
   // lines' slopes (minor / major) reach [b / kSlopeBins, (b + 1) / kSlopeBins] (a flat list,
   // bin o * kSlopeBins + b starting at slope_start_[o * kSlopeBins + b]).
   static constexpr int kSlopeBins = 64;
-  std::vector<OffsetCell> slope_cells_;
+  // (Each as its octant sees it: k cells along the major axis, m along the minor one, and its
+  // index relative to the origin cell's.)
+  struct BinCell {
+    std::int16_t a, b;  // the offset (for the changed region)
+    std::int16_t k, m;
+    std::ptrdiff_t at;  // b * nx + a
+  };
+  std::vector<BinCell> slope_cells_;
   std::array<int, 8 * kSlopeBins + 1> slope_start_{};
   struct KernelRow {  // the inflation kernel by rows: costs of cells di0, di0 + 1, ... of row dj
     int dj;
