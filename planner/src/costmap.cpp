@@ -309,8 +309,15 @@ void Costmap::mark_and_clear(const Vec2& origin, std::span<const Vec2> hits) {
     std::uint8_t* const base = obstacle_.data() + idx(i0, j0);
     constexpr int kNone = std::numeric_limits<int>::max();
     int di0 = kNone, dj0 = kNone, di1 = -1, dj1 = -1;  // the cells cleared
+    // Two passes: first each beam's line and the cells of its bin, without a branch that
+    // depends on the beam (most bins are empty, and which ones is as good as random: a
+    // mispredicted branch there cost more than the rest of the beam); then the beams whose bin
+    // holds cells.
+    beam_lines_.resize(any ? hits.size() : 0);
+    std::size_t lines = 0;
     for (const Vec2& h : any ? hits : std::span<const Vec2>{}) {
-      // The end point, clipped to the grid along the beam.
+      // The end point, clipped to the grid along the beam (these branches follow the beams'
+      // directions, which change slowly).
       Vec2 e = h;
       const Vec2 d = e - origin;
       double t = 1.0;
@@ -319,24 +326,31 @@ void Costmap::mark_and_clear(const Vec2& origin, std::span<const Vec2> hits) {
       if (e.y() < y_lo) t = std::min(t, (y_lo - origin.y()) / d.y());
       if (e.y() > y_hi) t = std::min(t, (y_hi - origin.y()) / d.y());
       e = origin + d * t;
-      // to_cell(e, i1, j1)
+      // to_cell(e, i1, j1); a beam whose end is outside (by rounding) clears nothing.
       const double fx = (e.x() - x_lo) / res;
       const double fy = (e.y() - y_lo) / res;
-      if (!(fx >= 0.0 && fy >= 0.0)) continue;
-      const int i1 = static_cast<int>(fx), j1 = static_cast<int>(fy);
-      if (i1 >= nx || j1 >= ny) continue;
+      bool valid = (fx >= 0.0) & (fy >= 0.0);
+      const int i1 = static_cast<int>(valid ? std::min(fx, double(nx)) : 0.0);
+      const int j1 = static_cast<int>(valid ? std::min(fy, double(ny)) : 0.0);
+      valid = valid & (i1 < nx) & (j1 < ny);
       const int da = i1 - i0, db = j1 - j0;
       const int dx = std::abs(da), dy = std::abs(db);
       const int steps = std::min(std::max(dx, dy), max_cells);
-      if (steps == 0) continue;
+      valid = valid & (steps != 0);
       const bool x_major = dx >= dy;
-      const int major = x_major ? dx : dy, minor = x_major ? dy : dx;
+      const int major = std::max(1, x_major ? dx : dy), minor = x_major ? dy : dx;
       const int bin = octant_of(da, db) * kB + std::min(kB - 1, (minor * kB) / major);
       const int first = slope_start_[static_cast<std::size_t>(bin)];
-      const int last = slope_start_[static_cast<std::size_t>(bin) + 1];
+      const int last = valid ? slope_start_[static_cast<std::size_t>(bin) + 1] : first;
+      beam_lines_[lines] = {first, last, steps, major, minor};
+      lines += last > first ? 1 : 0;
+    }
+    for (std::size_t n = 0; n < lines; ++n) {
+      const BeamLine& line = beam_lines_[n];
+      const int steps = line.steps, major = line.major, minor = line.minor;
       // (No branch per cell: whether a cell is cleared is as good as random.)
       const int den = 2 * major;
-      for (int c = first; c < last; ++c) {
+      for (int c = line.first; c < line.last; ++c) {
         const BinCell& cell = slope_cells_[static_cast<std::size_t>(c)];
         std::uint8_t* o = base + cell.at;
         // The textbook Bresenham's minor offset at major step k is ceil(num / den) with

@@ -230,6 +230,13 @@ class Costmap {
   };
   std::vector<BinCell> slope_cells_;
   std::array<int, 8 * kSlopeBins + 1> slope_start_{};
+  // The beams whose bin holds cells: the bin's range in slope_cells_ and the beam's line.
+  struct BeamLine {
+    int first, last;   // slope_cells_[first, last)
+    int steps;         // cells of the line that are cleared (its end cell is not)
+    int major, minor;  // the line's extent along its major and minor axis
+  };
+  std::vector<BeamLine> beam_lines_;
   struct KernelRow {  // the inflation kernel by rows: costs of cells di0, di0 + 1, ... of row dj
     int dj;
     int di0;
