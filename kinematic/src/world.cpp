@@ -21,6 +21,20 @@
 #include "llsf/core/error.h"
 #include "raycast.h"
 
+// Box2D 2.4.1 times the phases of every b2World::Step (collide, solve, each island's init,
+// velocity and position passes, TOI) with gettimeofday() for b2World::GetProfile(), which
+// llsfsim never reads: about 20 wall-clock reads per step, 3 % of the CPU time of a
+// move_base-2013 game (docs/benchmarks.md, "game_move_base"). Debian's libbox2d calls b2Timer's
+// members through its procedure linkage table, so these definitions in the program take the
+// place of the library's: the timer reads no clock and shows 0 ms. (A wall-clock read has no
+// place in a deterministic step anyway; nothing else of Box2D changes.)
+b2Timer::b2Timer() { Reset(); }
+void b2Timer::Reset() {
+  m_start_sec = 0;
+  m_start_usec = 0;
+}
+float b2Timer::GetMilliseconds() const { return 0.0f; }
+
 namespace llsf::kinematic {
 
 using core::SimTime;

@@ -1028,18 +1028,30 @@ void MoveBaseNavigator::generate(const Pose2D& pose, const VelocityCommand& vel,
     vy = ramp(vy_s, vy, acc_y, dt);
     vth = ramp(vth_s, vth, acc_th, dt);
     const auto step = static_cast<std::size_t>(s);
-    if (step < run.cos_th.size()) {  // this heading's values, from an earlier sample
-      cos_th = run.cos_th[step];
+    if (step < run.cos_th.size() && !std::isnan(run.cos_th[step])) {
+      cos_th = run.cos_th[step];  // this heading's values, from an earlier sample
       sin_th = run.sin_th[step];
       trig_th = th;
+    } else if (vx == 0.0 && vy == 0.0) {
+      // Standing (an in-place rotation once the ramp reached 0): x and y do not move, whatever
+      // the heading's values; none are computed (NaN: unknown, for a later sample).
+      if (step == run.cos_th.size()) {
+        run.cos_th.push_back(std::numeric_limits<double>::quiet_NaN());
+        run.sin_th.push_back(std::numeric_limits<double>::quiet_NaN());
+      }
     } else {
       if (th != trig_th) {  // the same values, computed once per heading
         cos_th = std::cos(th);
         sin_th = std::sin(th);
         trig_th = th;
       }
-      run.cos_th.push_back(cos_th);
-      run.sin_th.push_back(sin_th);
+      if (step < run.cos_th.size()) {
+        run.cos_th[step] = cos_th;
+        run.sin_th[step] = sin_th;
+      } else {
+        run.cos_th.push_back(cos_th);
+        run.sin_th.push_back(sin_th);
+      }
     }
     x += (vx * cos_th - vy * sin_th) * dt;
     y += (vx * sin_th + vy * cos_th) * dt;
