@@ -67,6 +67,10 @@ double RandomStream::normal(double mean, double stddev) {
   return mean + stddev * u * f;
 }
 
+void RandomStream::normals(double mean, double stddev, std::span<double> out) {
+  for (double& v : out) v = normal(mean, stddev);
+}
+
 bool RandomStream::bernoulli(double p) {
   if (p <= 0.0) return false;
   if (p >= 1.0) return true;

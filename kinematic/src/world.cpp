@@ -161,6 +161,7 @@ struct World::Impl : public b2ContactListener {
   WorldEvents events;
   RayCaster raycaster;
   RayCaster::ScanScratch scan_scratch;
+  std::vector<double> noise_scratch;  // one scan's range noise
   std::vector<Circle> robot_circles;  // scratch, no per-step allocation
   std::vector<Circle> puck_circles;
   std::vector<Circle> other_circles;
@@ -670,9 +671,15 @@ struct World::Impl : public b2ContactListener {
       raycaster.scan(origin, pose.theta + scan.angle_min_rad, scan.angle_increment_rad, n,
                      lc.max_range_m, others(r), out, scan_scratch);
       const float lo = static_cast<float>(lc.min_range_m), hi = static_cast<float>(lc.max_range_m);
+      // The noise of each beam that hit, drawn in beam order.
+      int hits = 0;
+      for (int i = 0; i < n; ++i) hits += std::isfinite(out[i]) ? 1 : 0;
+      noise_scratch.resize(static_cast<std::size_t>(hits));
+      r.laser_rng.normals(0.0, lc.noise_std_m, noise_scratch);
+      const double* noise = noise_scratch.data();
       for (int i = 0; i < n; ++i) {
         if (!std::isfinite(out[i])) continue;
-        const float v = out[i] + static_cast<float>(r.laser_rng.normal(0.0, lc.noise_std_m));
+        const float v = out[i] + static_cast<float>(*noise++);
         out[i] = v > hi ? std::numeric_limits<float>::infinity() : std::max(v, lo);
       }
       scan.stamp = now;

@@ -1016,8 +1016,11 @@ local function fsm_step(fsm)
     path[#path + 1] = st.name
   end
   if trs or fsm.spin ~= nil then watch_spin(fsm, now, path, trs, progress) end
-  fsm.passed = path  -- the states this step went through (nil: it stayed), for skill_state
-  fsm.passed_by = trs  -- what took it from each to the next (a transition or "final_to", ...)
+  -- The states this step went through (nil: it stayed), for skill_state, and what took it from
+  -- each to the next (a transition or "final_to", ...). (Nil is written only over a value:
+  -- written to an absent key it would still call SkillHSM.__newindex, twice in most steps.)
+  if path or fsm.passed ~= nil then fsm.passed = path end
+  if trs or fsm.passed_by ~= nil then fsm.passed_by = trs end
   if not path and fsm.misses and not st.waited and now - st.entered_ns >= kWaitNs then
     st.waited = true
     watch_misses(fsm, st, now)

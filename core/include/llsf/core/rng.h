@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string_view>
 
 namespace llsf::core {
@@ -44,6 +45,9 @@ class RandomStream {
   std::int64_t uniform_int(std::int64_t lo, std::int64_t hi);
   /// Gaussian with the given mean and standard deviation (Marsaglia polar method).
   double normal(double mean, double stddev);
+  /// out.size() draws of normal(mean, stddev), in order (the same values as that many calls,
+  /// for less per draw).
+  void normals(double mean, double stddev, std::span<double> out);
   /// True with probability p (clamped to [0, 1]).
   bool bernoulli(double p);
   /// Exponential with the given mean (> 0).
