@@ -111,7 +111,7 @@ Vec2 Costmap::cell_center(int i, int j) const {
 std::uint8_t Costmap::cost_at(const Vec2& p, bool outside_lethal) const {
   int i = 0, j = 0;
   if (!to_cell(p, i, j)) return outside_lethal ? kLethal : kFree;
-  return cost_[idx(i, j)];
+  return cost(i, j);
 }
 
 std::uint8_t Costmap::static_cost_at(const Vec2& p) const {
@@ -139,7 +139,6 @@ void Costmap::set_static(const Planner& planner) {
     if (static_lethal_[n] != 0) obstacle_[n] = 0;
   }
   mark_all_dirty();
-  inflate();
 }
 
 void Costmap::recenter(const Vec2& center) {
@@ -168,13 +167,10 @@ void Costmap::update(const Vec2& origin, std::span<const Vec2> hits, const Vec2&
                      double radius_m) {
   mark_and_clear(origin, hits);
   erase_within(robot, radius_m);
-  inflate();
 }
 
 bool Costmap::clear_footprint(const Vec2& center, double radius_m) {
-  if (!erase_within(center, radius_m)) return false;
-  inflate();
-  return true;
+  return erase_within(center, radius_m);
 }
 
 bool Costmap::erase_within(const Vec2& center, double radius_m) {
@@ -401,10 +397,9 @@ void Costmap::reset_outside(const Vec2& center, double size_m) {
       }
     }
   }
-  inflate();
 }
 
-void Costmap::inflate() {
+void Costmap::inflate() const {
   if (dirty_i0_ > dirty_i1_) return;  // no laser obstacle changed: nor did a cost
   // The cells a changed obstacle cell reaches, and the obstacle cells that reach them.
   const int r = kernel_r_;

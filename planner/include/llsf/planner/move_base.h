@@ -156,9 +156,15 @@ class Costmap {
     return i < nx_ && j < ny_;
   }
   Vec2 cell_center(int i, int j) const;
-  std::uint8_t cost(int i, int j) const { return cost_[idx(i, j)]; }
+  std::uint8_t cost(int i, int j) const {
+    settle();
+    return cost_[idx(i, j)];
+  }
   /// The costs, row by row (cell (i, j) at j * nx() + i).
-  const std::uint8_t* cost_data() const { return cost_.data(); }
+  const std::uint8_t* cost_data() const {
+    settle();
+    return cost_.data();
+  }
   /// Cost at a point; outside the grid: kLethal if `outside_lethal`, else kFree.
   std::uint8_t cost_at(const Vec2& p, bool outside_lethal = true) const;
   bool obstacle(int i, int j) const { return obstacle_[idx(i, j)] != 0; }
@@ -172,12 +178,12 @@ class Costmap {
   void recenter(const Vec2& center);
   /// One sensor update: clear the cells along every beam from `origin` to its hit (within
   /// raytrace range), mark the hits within obstacle range, then, as costmap_2d's
-  /// clearRobotFootprint(), forget the laser obstacles within `radius_m` of `robot`; then
-  /// inflate.
+  /// clearRobotFootprint(), forget the laser obstacles within `radius_m` of `robot`; the costs
+  /// are inflated again when next read.
   void update(const Vec2& origin, std::span<const Vec2> hits, const Vec2& robot, double radius_m);
   /// costmap_2d's clearRobotFootprint(), after every update and before every controller cycle:
   /// laser obstacle cells within `radius_m` of `center` (the robot's inscribed circle) are
-  /// forgotten, then the map is inflated again. Returns whether a cell was cleared.
+  /// forgotten (the costs inflated again when next read). Returns whether a cell was cleared.
   bool clear_footprint(const Vec2& center, double radius_m);
   /// ClearCostmapRecovery: laser obstacles outside the square of side `size_m` around `center`
   /// are forgotten (the static map remains).
@@ -190,7 +196,13 @@ class Costmap {
   }
   // Inflates the cells the laser obstacles changed since the last call could reach (all of them
   // after set_static or recenter): only those cells' costs can differ.
-  void inflate();
+  void inflate() const;
+  // The costs are inflated when they are read after a change, not at every change (the global
+  // costmap changes at 2 Hz and is read by each global plan): the same costs, as inflation
+  // depends only on the obstacles, not on when it ran.
+  void settle() const {
+    if (dirty_i0_ <= dirty_i1_) inflate();
+  }
   void mark_dirty(int i, int j) {
     dirty_i0_ = std::min(dirty_i0_, i);
     dirty_j0_ = std::min(dirty_j0_, j);
@@ -208,7 +220,7 @@ class Costmap {
   std::vector<std::uint8_t> static_lethal_;  // 1 = static obstacle
   std::vector<std::uint8_t> static_cost_;    // inflated static layer
   std::vector<std::uint8_t> obstacle_;       // 1 = laser obstacle
-  std::vector<std::uint8_t> cost_;           // combined, inflated
+  mutable std::vector<std::uint8_t> cost_;   // combined, inflated (settle())
   std::vector<std::uint8_t> scratch_;        // recenter()'s moved obstacles (kept to reuse)
   // mark_and_clear(): the laser obstacle cells within reach, as offsets from the scan's origin
   // cell, by the closed octants around it that hold them.
@@ -246,8 +258,9 @@ class Costmap {
   std::vector<KernelRow> rows_;
   int kernel_r_ = 0;  // the largest |dj| (and |di|) of the kernel
   // The cells whose laser obstacle changed since the last inflate() (none: i0 > i1).
-  int dirty_i0_ = std::numeric_limits<int>::max(), dirty_j0_ = std::numeric_limits<int>::max();
-  int dirty_i1_ = -1, dirty_j1_ = -1;
+  mutable int dirty_i0_ = std::numeric_limits<int>::max();
+  mutable int dirty_j0_ = std::numeric_limits<int>::max();
+  mutable int dirty_i1_ = -1, dirty_j1_ = -1;
   // Raises `grid`'s cells within columns [ci0, ci1] and rows [cj0, cj1] to the kernel around
   // (i, j).
   void stamp(std::vector<std::uint8_t>& grid, int i, int j, int ci0, int cj0, int ci1,
