@@ -26,6 +26,7 @@ Costmap::Costmap(Vec2 origin, int nx, int ny, double resolution_m, const MoveBas
   static_lethal_.assign(n, 0);
   static_cost_.assign(n, kFree);
   obstacle_.assign(n, 0);
+  listed_.assign(n, 0);
   cost_.assign(n, kFree);
   // costmap_2d's cost of a cell at distance d (in cells, exact) from an obstacle cell: lethal on
   // it, inscribed within ceil(robot radius / resolution) cells, then
@@ -159,6 +160,7 @@ void Costmap::recenter(const Vec2& center) {
     }
   }
   obstacle_.swap(moved);
+  relist();
   origin_ = Vec2(origin_.x() + si * res_, origin_.y() + sj * res_);
   mark_all_dirty();
 }
@@ -205,34 +207,48 @@ namespace {
 int octant_of(int a, int b) {
   return (a < 0 ? 1 : 0) | (b < 0 ? 2 : 0) | (std::abs(b) > std::abs(a) ? 4 : 0);
 }
-// Calls f(i, j) for every non-zero cell of `grid` (rows of `nx`) in columns [i0, i1] and rows
-// [j0, j1], row by row; eight zero cells are skipped at a time.
-template <class F>
-void for_each_set(const std::vector<std::uint8_t>& grid, int nx, int i0, int j0, int i1, int j1,
-                  F&& f) {
-  for (int j = j0; j <= j1; ++j) {
-    const std::uint8_t* row =
-        grid.data() + static_cast<std::size_t>(j) * static_cast<std::size_t>(nx);
-    for (int i = i0; i <= i1; ++i) {
-      if (i + 8 <= i1 + 1) {
-        std::uint64_t block = 0;
-        std::memcpy(&block, row + i, sizeof block);
-        if (block == 0) {
-          i += 7;
-          continue;
-        }
-      }
-      if (row[i] != 0) f(i, j);
-    }
-  }
-}
-
 bool in_closed_octant(int o, int a, int b) {
   return ((o & 1) != 0 ? a <= 0 : a >= 0) && ((o & 2) != 0 ? b <= 0 : b >= 0) &&
          ((o & 4) != 0 ? std::abs(b) >= std::abs(a) : std::abs(a) >= std::abs(b));
 }
 
 }  // namespace
+
+void Costmap::set_obstacle(std::size_t k) {
+  if (obstacle_[k] != 0) return;
+  obstacle_[k] = 1;
+  if (listed_[k] == 0) {
+    listed_[k] = 1;
+    obstacle_list_.push_back(static_cast<int>(k));
+  }
+}
+
+void Costmap::relist() const {
+  obstacle_list_.clear();
+  std::fill(listed_.begin(), listed_.end(), 0);
+  for (std::size_t k = 0; k < obstacle_.size(); ++k) {
+    if (obstacle_[k] != 0) {
+      listed_[k] = 1;
+      obstacle_list_.push_back(static_cast<int>(k));
+    }
+  }
+}
+
+template <class F>
+void Costmap::for_each_obstacle(int i0, int j0, int i1, int j1, F&& f) const {
+  std::size_t kept = 0;
+  for (std::size_t n = 0; n < obstacle_list_.size(); ++n) {
+    const int k = obstacle_list_[n];
+    if (obstacle_[static_cast<std::size_t>(k)] == 0) {  // cleared since it was listed
+      listed_[static_cast<std::size_t>(k)] = 0;
+      continue;
+    }
+    obstacle_list_[kept++] = k;
+    const int j = k / nx_, i = k - j * nx_;
+    if (i >= i0 && i <= i1 && j >= j0 && j <= j1) f(i, j);
+  }
+  obstacle_list_.resize(kept);
+}
 
 void Costmap::mark_and_clear(const Vec2& origin, std::span<const Vec2> hits) {
   int i0 = 0, j0 = 0;
@@ -249,7 +265,7 @@ void Costmap::mark_and_clear(const Vec2& origin, std::span<const Vec2> hits) {
     const int bi0 = std::max(0, i0 - max_cells), bi1 = std::min(nx_ - 1, i0 + max_cells);
     const int bj0 = std::max(0, j0 - max_cells), bj1 = std::min(ny_ - 1, j0 + max_cells);
     bool any = false;
-    for_each_set(obstacle_, nx_, bi0, bj0, bi1, bj1, [&](int i, int j) {
+    for_each_obstacle(bi0, bj0, bi1, bj1, [&](int i, int j) {
       const int a = i - i0, b = j - j0;
       for (int o = 0; o < 8; ++o) {
         if (in_closed_octant(o, a, b)) octant_cells_[o].push_back({a, b});
@@ -375,9 +391,8 @@ void Costmap::mark_and_clear(const Vec2& origin, std::span<const Vec2> hits) {
     int i = 0, j = 0;
     if (!to_cell(h, i, j)) continue;
     if (static_lethal_[idx(i, j)] != 0) continue;  // already an obstacle for good
-    std::uint8_t& o = obstacle_[idx(i, j)];
-    if (o == 0) {
-      o = 1;
+    if (obstacle_[idx(i, j)] == 0) {
+      set_obstacle(idx(i, j));
       mark_dirty(i, j);
     }
   }
@@ -411,8 +426,8 @@ void Costmap::inflate() const {
   for (int j = rj0; j <= rj1; ++j) {
     std::memcpy(cost_.data() + idx(ri0, j), static_cost_.data() + idx(ri0, j), n);
   }
-  for_each_set(obstacle_, nx_, oi0, oj0, oi1, oj1,
-               [&](int i, int j) { stamp(cost_, i, j, ri0, rj0, ri1, rj1); });
+  for_each_obstacle(oi0, oj0, oi1, oj1,
+                    [&](int i, int j) { stamp(cost_, i, j, ri0, rj0, ri1, rj1); });
   dirty_i0_ = dirty_j0_ = std::numeric_limits<int>::max();
   dirty_i1_ = dirty_j1_ = -1;
 }

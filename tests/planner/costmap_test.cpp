@@ -41,6 +41,25 @@ struct Reference {
   }
   std::uint8_t& at(int i, int j) { return obstacle[static_cast<std::size_t>(j * nx + i)]; }
 
+  // A rolling window's move: the origin by whole cells so that `center` is in the middle, the
+  // cells that stay kept, the others free.
+  void recenter(const Vec2& center) {
+    const Vec2 wanted(center.x() - 0.5 * nx * res, center.y() - 0.5 * ny * res);
+    const int si = static_cast<int>(std::floor((wanted.x() - origin.x()) / res));
+    const int sj = static_cast<int>(std::floor((wanted.y() - origin.y()) / res));
+    std::vector<std::uint8_t> moved(obstacle.size(), 0);
+    for (int j = 0; j < ny; ++j) {
+      for (int i = 0; i < nx; ++i) {
+        const int oi = i + si, oj = j + sj;
+        if (oi >= 0 && oj >= 0 && oi < nx && oj < ny) {
+          moved[static_cast<std::size_t>(j * nx + i)] = at(oi, oj);
+        }
+      }
+    }
+    obstacle = moved;
+    origin = Vec2(origin.x() + si * res, origin.y() + sj * res);
+  }
+
   void update(const Vec2& from, const std::vector<Vec2>& hits, const Vec2& robot, double r) {
     int i0 = 0, j0 = 0;
     const int max_cells = static_cast<int>(range / res);
@@ -119,8 +138,11 @@ struct Reference {
   }
 };
 
-// `scans` random scans of `beams` beams from random origins, some reaching past the grid.
-void compare(double res, int nx, int ny, int scans, int beams, std::uint32_t seed) {
+// `scans` random scans of `beams` beams from random origins, some reaching past the grid; with
+// `rolling`, the window first moves by up to two cells to have the scan's origin in its middle
+// (as the local costmap rolls with the robot).
+void compare(double res, int nx, int ny, int scans, int beams, std::uint32_t seed,
+             bool rolling = false) {
   const MoveBaseConfig config;
   const Vec2 origin(0.37, -0.21);
   Costmap costmap(origin, nx, ny, res, config);
@@ -136,8 +158,16 @@ void compare(double res, int nx, int ny, int scans, int beams, std::uint32_t see
   int cleared = 0, marked = 0, costs_changed = 0;
   std::vector<std::uint8_t> costs_before(static_cast<std::size_t>(nx * ny), Costmap::kFree);
   for (int scan = 0; scan < scans; ++scan) {
-    // Origins mostly inside, now and then outside the grid.
-    const Vec2 from(origin.x() + (u(rng) * 1.2 - 0.1) * w, origin.y() + (u(rng) * 1.2 - 0.1) * h);
+    // Origins mostly inside, now and then outside the grid; a rolling window's near its middle.
+    Vec2 from(origin.x() + (u(rng) * 1.2 - 0.1) * w, origin.y() + (u(rng) * 1.2 - 0.1) * h);
+    if (rolling) {
+      from = ref.origin +
+             Vec2(0.5 * w + (u(rng) * 4.0 - 2.0) * res, 0.5 * h + (u(rng) * 4.0 - 2.0) * res);
+      costmap.recenter(from);
+      ref.recenter(from);
+      REQUIRE(costmap.origin().x() == ref.origin.x());
+      REQUIRE(costmap.origin().y() == ref.origin.y());
+    }
     std::vector<Vec2> hits;
     const double turn = u(rng) * 6.283;
     for (int b = 0; b < beams; ++b) {
@@ -146,7 +176,7 @@ void compare(double res, int nx, int ny, int scans, int beams, std::uint32_t see
       const double range = u(rng) < 0.3 ? 0.2 + u(rng) * 1.0 : 0.5 + u(rng) * 5.0;
       hits.emplace_back(from.x() + range * std::cos(a), from.y() + range * std::sin(a));
     }
-    const std::vector<std::uint8_t> before = ref.obstacle;
+    const std::vector<std::uint8_t> before = ref.obstacle;  // (after the move)
     costmap.update(from, hits, from, 0.1);
     ref.update(from, hits, from, 0.1);
     for (int j = 0; j < ny; ++j) {
@@ -189,4 +219,7 @@ TEST_CASE(
   SUBCASE("the global costmap's resolution") { compare(0.05, 112, 96, 60, 360, 7); }
   SUBCASE("the local rolling window's") { compare(0.1, 30, 30, 200, 360, 11); }
   SUBCASE("few beams, coarse cells") { compare(0.25, 23, 17, 300, 17, 13); }
+  SUBCASE("the local window rolling with its scans' origin") {
+    compare(0.1, 30, 30, 200, 360, 17, true);
+  }
 }

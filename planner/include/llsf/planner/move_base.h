@@ -222,6 +222,19 @@ class Costmap {
   std::vector<std::uint8_t> obstacle_;       // 1 = laser obstacle
   mutable std::vector<std::uint8_t> cost_;   // combined, inflated (settle())
   std::vector<std::uint8_t> scratch_;        // recenter()'s moved obstacles (kept to reuse)
+  // The laser obstacle cells (indices), so that a search for them need not scan the grid (a
+  // map holds a few dozen); a cell cleared since it was listed is dropped by the next search.
+  // listed_[k]: whether k is in the list.
+  mutable std::vector<int> obstacle_list_;
+  mutable std::vector<std::uint8_t> listed_;
+  // Sets cell k's laser obstacle (and lists it).
+  void set_obstacle(std::size_t k);
+  // The list made again from the grid (after the grid moved).
+  void relist() const;
+  // Calls f(i, j) for every laser obstacle cell in columns [i0, i1] and rows [j0, j1], in no
+  // particular order (what the callers do with them does not depend on it).
+  template <class F>
+  void for_each_obstacle(int i0, int j0, int i1, int j1, F&& f) const;
   // mark_and_clear(): the laser obstacle cells within reach, as offsets from the scan's origin
   // cell, by the closed octants around it that hold them.
   struct OffsetCell {
