@@ -247,6 +247,9 @@ VelocityCommand MoveBaseNavigator::update(SimTime now, const Pose2D& pose,
   has_last_update_ = true;
   if (scan != nullptr) {
     scan_hits_.assign(scan->hits.begin(), scan->hits.end());
+    scan_beam_of_hit_.assign(scan->beams.of_hit.begin(), scan->beams.of_hit.end());
+    scan_beams_ = scan->beams;
+    scan_beams_.of_hit = {};
     scan_origin_ = scan->origin;
     scan_for_local_ = scan_for_global_ = true;
   }
@@ -257,7 +260,8 @@ VelocityCommand MoveBaseNavigator::update(SimTime now, const Pose2D& pose,
       next_local_ = now + SimTime::period_of_hz(config_.local_update_hz);
       local_.recenter(pose.position());
       if (scan_for_local_) {
-        local_.update(scan_origin_, scan_hits_, pose.position(), config_.robot_radius_m);
+        local_.update(scan_origin_, scan_hits_, scan_beams(), pose.position(),
+                      config_.robot_radius_m);
       } else {
         local_.clear_footprint(pose.position(), config_.robot_radius_m);
       }
@@ -266,7 +270,8 @@ VelocityCommand MoveBaseNavigator::update(SimTime now, const Pose2D& pose,
     if (now >= next_global_) {
       next_global_ = now + SimTime::period_of_hz(config_.global_update_hz);
       if (scan_for_global_) {
-        global_.update(scan_origin_, scan_hits_, pose.position(), config_.robot_radius_m);
+        global_.update(scan_origin_, scan_hits_, scan_beams(), pose.position(),
+                       config_.robot_radius_m);
       } else {
         global_.clear_footprint(pose.position(), config_.robot_radius_m);
       }

@@ -75,7 +75,8 @@ kinematic::MotorCommand RobotStack::actuate(SimTime now,
     case Drive::kNavigator: {
       if (move_base_) {
         const bool was_running = move_base_->status().outcome == planner::NavOutcome::kRunning;
-        planner::MoveBaseNavigator::Scan scan{scan_origin_, scan_hits_};
+        planner::MoveBaseNavigator::Scan scan{scan_origin_, scan_hits_, scan_beams_};
+        scan.beams.of_hit = scan_beam_of_hit_;
         const planner::VelocityCommand c = move_base_->update(
             now, localization_.estimate().pose, odom_velocity_, scan_new_ ? &scan : nullptr);
         scan_new_ = false;
@@ -347,6 +348,7 @@ void RobotStack::sense(const RobotPercept& p) {
       const core::Pose2D est = localization_.estimate().pose;
       scan_origin_ = est.to_parent(laser_mount_);
       scan_hits_.clear();
+      scan_beam_of_hit_.clear();
       const std::size_t n = s.laser.ranges.size();
       if (beam_dirs_.size() != n) {
         // The beams' directions in the robot frame, once (the scan's geometry is fixed).
@@ -364,7 +366,10 @@ void RobotStack::sense(const RobotPercept& p) {
         const core::Vec2& d = beam_dirs_[i];
         scan_hits_.emplace_back(scan_origin_.x() + r * (c * d.x() - sn * d.y()),
                                 scan_origin_.y() + r * (sn * d.x() + c * d.y()));
+        scan_beam_of_hit_.push_back(static_cast<int>(i));
       }
+      scan_beams_ = {
+          est.theta + s.laser.angle_min_rad, s.laser.angle_increment_rad, static_cast<int>(n), {}};
       scan_new_ = true;
     }
   }

@@ -2,8 +2,9 @@
 // The move_base-2013 costmap's laser update against a plain reference: every beam walked cell
 // by cell with the textbook Bresenham line (costmap_2d's raytraceLine), the hits marked, the
 // robot's circle cleared. Costmap::update tests beams against the obstacle cells instead of
-// walking them (planner/src/costmap.cpp: only the obstacle cells in a line's octant and slope bin);
-// the cells it leaves must be the same. Costs: every
+// walking them (planner/src/costmap.cpp: only the obstacle cells in a line's octant and slope bin),
+// and, when it knows the beams' directions, only the beams that pass near an obstacle cell; the
+// cells it leaves must be the same. Costs: every
 // obstacle cell's inflation kernel (costmap_2d's cost of a distance) maxed over the whole grid;
 // Costmap::inflate recomputes only the cells a changed obstacle reaches.
 #include <doctest/doctest.h>
@@ -138,11 +139,26 @@ struct Reference {
   }
 };
 
+// How the scans tell the costmap their beams' directions.
+enum class Directions {
+  kUnknown,  // hits only: every beam is tested
+  kFull,     // a 360 degree scanner, some beams without a hit
+  kPartial,  // a 240 degree scanner (as the Hokuyo URG-04LX), some beams without a hit
+};
+
+// What the beams hit.
+enum class Scene {
+  kScattered,  // random ranges: obstacle cells in every direction
+  kDiscs,      // four discs (robots) that move a little between scans, elsewhere far ranges:
+               // obstacle cells in a few directions, as in a game
+};
+
 // `scans` random scans of `beams` beams from random origins, some reaching past the grid; with
 // `rolling`, the window first moves by up to two cells to have the scan's origin in its middle
 // (as the local costmap rolls with the robot).
 void compare(double res, int nx, int ny, int scans, int beams, std::uint32_t seed,
-             bool rolling = false) {
+             bool rolling = false, Directions directions = Directions::kFull,
+             Scene scene = Scene::kScattered) {
   const MoveBaseConfig config;
   const Vec2 origin(0.37, -0.21);
   Costmap costmap(origin, nx, ny, res, config);
@@ -155,7 +171,16 @@ void compare(double res, int nx, int ny, int scans, int beams, std::uint32_t see
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const double w = nx * res, h = ny * res;
+  struct Disc {
+    Vec2 c;
+    double r;
+  };
+  std::vector<Disc> discs;
+  for (int k = 0; k < 4; ++k) {
+    discs.push_back({origin + Vec2(u(rng) * w, u(rng) * h), 0.15 + 0.2 * u(rng)});
+  }
   int cleared = 0, marked = 0, costs_changed = 0;
+  std::size_t tested = 0, offered = 0;
   std::vector<std::uint8_t> costs_before(static_cast<std::size_t>(nx * ny), Costmap::kFree);
   for (int scan = 0; scan < scans; ++scan) {
     // Origins mostly inside, now and then outside the grid; a rolling window's near its middle.
@@ -169,15 +194,41 @@ void compare(double res, int nx, int ny, int scans, int beams, std::uint32_t see
       REQUIRE(costmap.origin().y() == ref.origin.y());
     }
     std::vector<Vec2> hits;
-    const double turn = u(rng) * 6.283;
+    std::vector<int> of_hit;
+    // The first beam's direction anywhere, also beyond +-pi (an unnormalised heading).
+    const double first = (u(rng) * 2.0 - 1.0) * 7.0;
+    const double fan = directions == Directions::kPartial ? 4.18879020478639 : 6.283185307179586;
+    const double increment = fan / beams;
+    for (Disc& d : discs) d.c += Vec2(u(rng) * 0.2 - 0.1, u(rng) * 0.2 - 0.1);
     for (int b = 0; b < beams; ++b) {
-      const double a = turn + 6.283185307179586 * b / beams;
-      // Ranges: some short (marks near the robot), some past the raytrace range or the grid.
-      const double range = u(rng) < 0.3 ? 0.2 + u(rng) * 1.0 : 0.5 + u(rng) * 5.0;
+      const double a = first + increment * b;
+      // Ranges: some short (marks near the robot), some past the raytrace range or the grid;
+      // with known directions some beams see nothing (no hit).
+      double range = u(rng) < 0.3 ? 0.2 + u(rng) * 1.0 : 0.5 + u(rng) * 5.0;
+      if (scene == Scene::kDiscs) {
+        range = 2.5 + u(rng) * 3.5;  // far, unless a disc is nearer
+        const Vec2 dir(std::cos(a), std::sin(a));
+        for (const Disc& d : discs) {
+          const Vec2 m = d.c - from;
+          const double p = dir.dot(m), q = m.squaredNorm() - d.r * d.r;
+          if (q <= 0.0 || p * p < q) continue;  // inside it, or missed
+          const double t = p - std::sqrt(p * p - q);
+          if (t > 0.0) range = std::min(range, t);
+        }
+      }
+      if (directions != Directions::kUnknown && u(rng) < 0.1) continue;
       hits.emplace_back(from.x() + range * std::cos(a), from.y() + range * std::sin(a));
+      of_hit.push_back(b);
     }
+    Costmap::Beams known;
+    if (directions != Directions::kUnknown) known = {first, increment, beams, of_hit};
     const std::vector<std::uint8_t> before = ref.obstacle;  // (after the move)
-    costmap.update(from, hits, from, 0.1);
+    costmap.update(from, hits, known, from, 0.1);
+    if (costmap.beams_tested() > 0) {  // (0: no obstacle cell in reach, or from outside)
+      if (directions == Directions::kUnknown) REQUIRE(costmap.beams_tested() == hits.size());
+      tested += costmap.beams_tested();
+      offered += hits.size();
+    }
     ref.update(from, hits, from, 0.1);
     for (int j = 0; j < ny; ++j) {
       for (int i = 0; i < nx; ++i) {
@@ -206,9 +257,15 @@ void compare(double res, int nx, int ny, int scans, int beams, std::uint32_t see
     costs_before = costs;
   }
   // The comparison saw both kinds of change.
-  CHECK(cleared > 100);
+  // (Discs change fewer cells: a few surfaces, not every direction.)
+  const bool in_scene = scene == Scene::kDiscs;
+  CHECK(cleared > (in_scene ? 20 : 100));
   CHECK(marked > 100);
-  CHECK(costs_changed > scans / 2);
+  CHECK(costs_changed > scans / (in_scene ? 20 : 2));
+  // Known directions spare beams that pass no obstacle cell (unknown ones, none: above); in a
+  // game's scene, many.
+  if (in_scene) CHECK(4 * tested < 3 * offered);
+  MESSAGE("beams tested: " << tested << " of " << offered);
 }
 
 }  // namespace
@@ -221,5 +278,19 @@ TEST_CASE(
   SUBCASE("few beams, coarse cells") { compare(0.25, 23, 17, 300, 17, 13); }
   SUBCASE("the local window rolling with its scans' origin") {
     compare(0.1, 30, 30, 200, 360, 17, true);
+  }
+  SUBCASE("moving discs: the global costmap's resolution") {
+    compare(0.05, 112, 96, 80, 360, 37, false, Directions::kFull, Scene::kDiscs);
+  }
+  SUBCASE("moving discs: the local rolling window") {
+    compare(0.1, 30, 30, 300, 360, 41, true, Directions::kFull, Scene::kDiscs);
+  }
+  SUBCASE("moving discs, a 240 degree scanner") {
+    compare(0.05, 112, 96, 80, 682, 19, false, Directions::kPartial, Scene::kDiscs);
+    compare(0.1, 30, 30, 300, 682, 23, true, Directions::kPartial, Scene::kDiscs);
+  }
+  SUBCASE("the beams' directions unknown: every beam tested") {
+    compare(0.05, 112, 96, 40, 360, 29, false, Directions::kUnknown);
+    compare(0.1, 30, 30, 100, 360, 31, true, Directions::kUnknown);
   }
 }

@@ -138,6 +138,16 @@ class Costmap {
   static constexpr std::uint8_t kInscribed = 253;
   static constexpr std::uint8_t kLethal = 254;
 
+  /// Where a scan's beams point: hit k came from beam of_hit[k] (increasing), in the direction
+  /// first_rad + of_hit[k] * increment_rad (field frame), of `count` beams in all. Empty
+  /// of_hit: not known.
+  struct Beams {
+    double first_rad = 0.0;
+    double increment_rad = 0.0;
+    int count = 0;
+    std::span<const int> of_hit;
+  };
+
   Costmap() = default;
   /// A grid of `nx` x `ny` cells of `resolution_m`, its lower-left corner at `origin`.
   Costmap(Vec2 origin, int nx, int ny, double resolution_m, const MoveBaseConfig& config);
@@ -179,8 +189,13 @@ class Costmap {
   /// One sensor update: clear the cells along every beam from `origin` to its hit (within
   /// raytrace range), mark the hits within obstacle range, then, as costmap_2d's
   /// clearRobotFootprint(), forget the laser obstacles within `radius_m` of `robot`; the costs
-  /// are inflated again when next read.
-  void update(const Vec2& origin, std::span<const Vec2> hits, const Vec2& robot, double radius_m);
+  /// are inflated again when next read. With `beams` known, only the beams that pass near a
+  /// laser obstacle cell are looked at (the same cells result).
+  void update(const Vec2& origin, std::span<const Vec2> hits, const Beams& beams, const Vec2& robot,
+              double radius_m);
+  /// The beams the last update() tested against its laser obstacle cells (all its hits when
+  /// their directions are unknown; none when no obstacle cell was in reach).
+  std::size_t beams_tested() const { return beams_tested_; }
   /// costmap_2d's clearRobotFootprint(), after every update and before every controller cycle:
   /// laser obstacle cells within `radius_m` of `center` (the robot's inscribed circle) are
   /// forgotten (the costs inflated again when next read). Returns whether a cell was cleared.
@@ -210,7 +225,10 @@ class Costmap {
     dirty_j1_ = std::max(dirty_j1_, j);
   }
   void mark_all_dirty() { dirty_i0_ = 0, dirty_j0_ = 0, dirty_i1_ = nx_ - 1, dirty_j1_ = ny_ - 1; }
-  void mark_and_clear(const Vec2& origin, std::span<const Vec2> hits);
+  void mark_and_clear(const Vec2& origin, std::span<const Vec2> hits, const Beams& beams);
+  // The beams (indices into the hits) that may clear one of the obstacle cells reach_cells_
+  // (offsets from the origin's cell (i0, j0)): into beam_todo_.
+  void beams_near(const Vec2& origin, std::size_t hits, const Beams& beams, int i0, int j0);
   bool erase_within(const Vec2& center, double radius_m);
 
   Vec2 origin_{0.0, 0.0};
@@ -262,6 +280,11 @@ class Costmap {
     int major, minor;  // the line's extent along its major and minor axis
   };
   std::vector<BeamLine> beam_lines_;
+  std::vector<OffsetCell> reach_cells_;  // the obstacle cells within reach of a scan
+  std::vector<int> beam_marks_;          // beams_near(): +1 where a window starts, -1 after it
+  std::vector<std::uint8_t> beam_wanted_;
+  std::vector<int> beam_todo_;  // the beams to look at
+  std::size_t beams_tested_ = 0;
   struct KernelRow {  // the inflation kernel by rows: costs of cells di0, di0 + 1, ... of row dj
     int dj;
     int di0;
@@ -322,10 +345,12 @@ class MoveBaseNavigator {
   void go_to_place(std::string_view name, bool forward = false);
   void abort();
 
-  /// A laser scan in field coordinates: the sensor's position and the points it hit.
+  /// A laser scan in field coordinates: the sensor's position, the points it hit and where
+  /// their beams point (may be unknown: Costmap::Beams).
   struct Scan {
     Vec2 origin{0.0, 0.0};
     std::span<const Vec2> hits;
+    Costmap::Beams beams;
   };
   /// One step at `now` for the robot at `pose` (the localization's estimate) moving at
   /// `velocity` (robot frame, odometry); `scan` is a new laser scan or nullptr. Returns the
@@ -424,6 +449,13 @@ class MoveBaseNavigator {
   VelocityCommand command_;
   // Latest scan, kept until the costmaps have used it.
   std::vector<Vec2> scan_hits_;
+  std::vector<int> scan_beam_of_hit_;
+  Costmap::Beams scan_beams_;  // (of_hit empty: scan_beam_of_hit_ holds it)
+  Costmap::Beams scan_beams() const {
+    Costmap::Beams b = scan_beams_;
+    b.of_hit = scan_beam_of_hit_;
+    return b;
+  }
   Vec2 scan_origin_{0.0, 0.0};
   bool scan_for_local_ = false;
   bool scan_for_global_ = false;

@@ -228,7 +228,10 @@ class RobotStack final : public lua::RobotApi {
   core::Vec2 scan_origin_{0.0, 0.0};
   core::Vec2 laser_mount_{0.0, 0.0};
   std::vector<core::Vec2> scan_hits_;
-  std::vector<core::Vec2> beam_dirs_;  // unit vectors of the laser's beams, robot frame
+  std::vector<int> scan_beam_of_hit_;
+  planner::Costmap::Beams scan_beams_;  // their directions (field frame, as estimated; of_hit:
+                                        // scan_beam_of_hit_)
+  std::vector<core::Vec2> beam_dirs_;   // unit vectors of the laser's beams, robot frame
   planner::VelocityCommand odom_velocity_;
   void nav_abort();
   RobotRadio radio_;
