@@ -17,6 +17,17 @@ double normalize_angle(double rad) {
 
 double angle_diff(double to, double from) { return normalize_angle(to - from); }
 
+double rough_atan2(double y, double x) {
+  // atan(t) ~ (pi / 4) t + 0.273 t (1 - t) on [0, 1], folded onto the other octants.
+  const double ax = std::abs(x), ay = std::abs(y);
+  const bool steep = ay > ax;
+  const double t = steep ? ax / ay : (ax > 0.0 ? ay / ax : 0.0);
+  double a = (0.25 * kPi + 0.273 * (1.0 - t)) * t;
+  a = steep ? 0.5 * kPi - a : a;
+  a = x < 0.0 ? kPi - a : a;
+  return y < 0.0 ? -a : a;
+}
+
 Pose2D Pose2D::compose(const Pose2D& other) const {
   const Vec2 p = to_parent(other.position());
   return {p.x(), p.y(), normalize_angle(theta + other.theta)};

@@ -10,6 +10,7 @@
 #include <limits>
 
 #include "llsf/core/assert.h"
+#include "llsf/core/geometry.h"
 #include "llsf/planner/move_base.h"
 
 namespace llsf::planner {
@@ -234,24 +235,6 @@ void Costmap::relist() const {
   }
 }
 
-namespace {
-
-// atan2(y, x) within 0.0038 rad: atan(t) ~ (pi / 4) t + 0.273 t (1 - t) on [0, 1] (Rajan, Wang,
-// Inkol and Joyal, "Efficient approximations for the arctangent function", IEEE Signal
-// Processing Magazine 23(3), 2006: maximum error 0.0038 rad; 0.00376 checked on a 1e-6 grid).
-double rough_atan2(double y, double x) {
-  constexpr double kPi = 3.14159265358979323846;
-  const double ax = std::abs(x), ay = std::abs(y);
-  const bool steep = ay > ax;
-  const double t = steep ? ax / ay : (ax > 0.0 ? ay / ax : 0.0);
-  double a = (0.25 * kPi + 0.273 * (1.0 - t)) * t;
-  a = steep ? 0.5 * kPi - a : a;
-  a = x < 0.0 ? kPi - a : a;
-  return y < 0.0 ? -a : a;
-}
-
-}  // namespace
-
 void Costmap::beams_near(const Vec2& origin, std::size_t hits, const Beams& beams, int i0, int j0) {
   beam_todo_.clear();
   auto all = [&] {
@@ -267,8 +250,8 @@ void Costmap::beams_near(const Vec2& origin, std::size_t hits, const Beams& beam
   // cells). So a cell the beam clears has its centre within 0.5 + 0.7072 cells of the beam: at
   // a distance D (cells) from the origin, in a direction less than asin(1.2072 / D) from the
   // beam's. Looked at: the beams within 1.155 x >= asin(x) (x = 1.25 / D <= 0.5) and 0.01 rad
-  // (rough_atan2's error) of some obstacle cell's direction; every beam when a cell is nearer
-  // than 2.5 cells.
+  // (more than core::rough_atan2's error) of some obstacle cell's direction; every beam when a
+  // cell is nearer than 2.5 cells.
   constexpr double kTwoPi = 2.0 * 3.14159265358979323846;
   constexpr double kReach = 1.25;
   beam_marks_.assign(static_cast<std::size_t>(count) + 1, 0);
@@ -279,8 +262,9 @@ void Costmap::beams_near(const Vec2& origin, std::size_t hits, const Beams& beam
     const double qy = origin_.y() + (j0 + cell.b + 0.5) * res_ - origin.y();
     const double x = kReach * res_ / std::sqrt(qx * qx + qy * qy);
     if (!(x <= 0.5)) return all();
+    static_assert(core::kRoughAtan2Error < 0.01);
     const double w = 1.155 * x + 0.01;
-    const double phi = rough_atan2(qy, qx);
+    const double phi = core::rough_atan2(qy, qx);
     double lo = (phi - w - beams.first_rad) * inv_inc, hi = (phi + w - beams.first_rad) * inv_inc;
     const double turns = std::floor(lo / per_turn);  // lo into [0, per_turn)
     lo -= turns * per_turn;

@@ -2,6 +2,7 @@
 // Tests of core: SimTime, typed ids, geometry, random streams, config nodes, checks.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <vector>
@@ -53,6 +54,22 @@ TEST_CASE("angles and poses") {
   CHECK(id.x == doctest::Approx(0.0).epsilon(1e-12));
   CHECK(id.y == doctest::Approx(0.0).epsilon(1e-12));
   CHECK(id.theta == doctest::Approx(0.0).epsilon(1e-12));
+}
+
+TEST_CASE("rough_atan2 stays within its stated error, all around and at the axes") {
+  double worst = 0.0;
+  for (int k = 0; k <= 2'000'000; ++k) {
+    const double a = -kPi + 2.0 * kPi * k / 2'000'000;
+    for (const double r : {1e-6, 0.3, 7.0}) {
+      const double y = r * std::sin(a), x = r * std::cos(a);
+      worst = std::max(worst, std::abs(angle_diff(rough_atan2(y, x), std::atan2(y, x))));
+    }
+  }
+  CHECK(worst <= kRoughAtan2Error);
+  CHECK(worst > 0.9 * kRoughAtan2Error);  // (the bound is the approximation's, not loose)
+  CHECK(rough_atan2(0.0, 0.0) == 0.0);
+  CHECK(rough_atan2(0.0, -1.0) == doctest::Approx(kPi));
+  CHECK(rough_atan2(-1.0, 0.0) == doctest::Approx(-kPi / 2));
 }
 
 TEST_CASE("oriented boxes") {

@@ -18,6 +18,13 @@ inline constexpr double kPi = std::numbers::pi;
 double normalize_angle(double rad);
 /// The signed smallest rotation from `from` to `to`, in (-pi, pi].
 double angle_diff(double to, double from);
+/// atan2(y, x) within kRoughAtan2Error, for what only needs a range of directions (widened by
+/// that much) and decides exactly afterwards; a fraction of std::atan2's instructions.
+double rough_atan2(double y, double x);
+/// rough_atan2's largest error, radians (0.0038: Rajan, Wang, Inkol and Joyal, "Efficient
+/// approximations for the arctangent function", IEEE Signal Processing Magazine 23(3), 2006;
+/// tests/core/core_test.cpp checks it).
+inline constexpr double kRoughAtan2Error = 0.0038;
 inline constexpr double deg_to_rad(double deg) { return deg * kPi / 180.0; }
 inline constexpr double rad_to_deg(double rad) { return rad * 180.0 / kPi; }
 
