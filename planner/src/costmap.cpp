@@ -252,7 +252,7 @@ void Costmap::beams_near(const Vec2& origin, std::size_t hits, const Beams& beam
   // beam's. Looked at: the beams within 1.155 x >= asin(x) (x = 1.25 / D <= 0.5) and 0.01 rad
   // (more than core::rough_atan2's error) of some obstacle cell's direction; every beam when a
   // cell is nearer than 2.5 cells.
-  constexpr double kTwoPi = 2.0 * 3.14159265358979323846;
+  constexpr double kTwoPi = 2.0 * core::kPi;
   constexpr double kReach = 1.25;
   beam_marks_.assign(static_cast<std::size_t>(count) + 1, 0);
   const double inv_inc = 1.0 / beams.increment_rad;
