@@ -20,7 +20,11 @@ local E = {}
 -- hands on from a sub-skill (fail_to, or self.fsm.reason = self.fsm.states.X.reason).
 local kDeclaredReasons = {["aborted"] = true, ["not-found"] = true, ["failed"] = true,
                           ["unknown-skill"] = true, ["error"] = true, ["budget"] = true}
-local fsms = setmetatable({}, {__mode = "k"})  -- every SkillHSM made by SkillHSM:new
+-- The engine's links from a skill's own tables to real handles, kept out of those tables: a
+-- skill gets its state machine as `fsm` and its states as `self`, and could otherwise walk from
+-- them to its own handle and on (children, child_of) to any other skill's state machine.
+local fsms = setmetatable({}, {__mode = "k"})  -- every SkillHSM made by SkillHSM:new -> its skill
+local subskills_of = setmetatable({}, {__mode = "k"})  -- a SkillJumpState -> its sub-skills
 local kMaxStatesPerStep = 32
 
 -- What every skill module and skill string sees (read through __index; never written).
@@ -541,9 +545,9 @@ local function args_watch(st)
     rawset(t, k, v)
     if warned[k] then return end
     local names = {}
-    for i, sk in ipairs(st.subskills or {}) do
-      if sk.handle.name == k then return end
-      names[i] = sk.handle.name
+    for i, h in ipairs(subskills_of[st] or {}) do
+      if h.name == k then return end
+      names[i] = h.name
     end
     warned[k] = true
     local what = fmt("%s: state '%s' sets self.args[\"%s\"]", st.fsm.name, st.name, tostring(k))
@@ -576,9 +580,9 @@ function SkillHSM:new(o)
   if not loading then error("SkillHSM:new can only be called while a skill file loads", 2) end
   local fsm = setmetatable({name = o.name or loading.name, start = o.start, debug = o.debug,
                             states = {}, state_list = {}, defaults = {}, vars = {},
-                            closure = {}, skill = loading, where = where(2), step_id = 0},
+                            closure = {}, where = where(2), step_id = 0},
                            SkillHSM)
-  fsms[fsm] = true
+  fsms[fsm] = loading
   fsm.cond_env = setmetatable(fsm.closure, {__index = loading.env})
   fsm.final = new_state(fsm, "FINAL", "final")
   fsm.failed = new_state(fsm, "FAILED", "failed")
@@ -589,18 +593,15 @@ local function resolve_subskill(fsm, spec, lvl)
   local s = spec[1]
   local h = type(s) == "string" and handles[s] or real_of[s]
   if not h then error(fmt("skills: entry %s is not a skill", tostring(s)), lvl) end
-  if fsm.skill.bindings[h.name] ~= proxies[h.name] then
+  if fsms[fsm].bindings[h.name] ~= proxies[h.name] then
     error(fmt("skill '%s' is used but not declared in depends_skills", h.name), lvl)
   end
-  local static = nil
-  for k, v in pairs(spec) do
-    if k ~= 1 then static = static or {}; static[k] = v end
-  end
-  return {handle = h, static = static}
+  return h
 end
 
 function SkillHSM:define_states(spec)
-  local export = spec.export_to or self.skill.env
+  local skill = fsms[self]
+  local export = spec.export_to or skill.env
   for _, st in ipairs{self.final, self.failed} do
     if rawget(export, st.name) == nil then rawset(export, st.name, st) end
   end
@@ -619,18 +620,23 @@ function SkillHSM:define_states(spec)
       if type(e.skills) ~= "table" or #e.skills == 0 then
         error(fmt("SkillJumpState '%s' needs skills={{skill}, ...}", name), 2)
       end
-      -- st.subskills: the engine's; st.skills: Fawkes' self.skills[i], one table per sub-skill
-      -- holding it at [1] and its arguments (the static ones of the definition, and what init()
-      -- sets: self.skills[1].place = ...). They stay set from one entry of the state to the next,
-      -- as in Fawkes, where they were the definition's own table.
-      st.subskills, st.skills, st.call_args = {}, {}, {}
+      -- subskills_of[st]: the engine's, the real handles; st.skills: Fawkes' self.skills[i], one
+      -- table per sub-skill holding its proxy at [1] and its arguments (the static ones of the
+      -- definition, and what init() sets: self.skills[1].place = ...). They stay set from one
+      -- entry of the state to the next, as in Fawkes, where they were the definition's own table.
+      local subskills = {}
+      st.skills, st.call_args = {}, {}
       for i, s in ipairs(e.skills) do
-        local sub = resolve_subskill(self, type(s) == "table" and not s.is_skill and s or {s}, 3)
-        st.subskills[i] = sub
-        local spec = {proxies[sub.handle.name]}
-        for k, v in pairs(sub.static or {}) do spec[k] = v end
-        st.skills[i] = spec
+        local def = type(s) == "table" and not s.is_skill and s or {s}
+        local h = resolve_subskill(self, def, 3)
+        subskills[i] = h
+        local entry = {proxies[h.name]}
+        for k, v in pairs(def) do
+          if k ~= 1 then entry[k] = v end
+        end
+        st.skills[i] = entry
       end
+      subskills_of[st] = subskills
       st.final_to, st.fail_to = e.final_to, e.fail_to or "FAILED"
       if type(st.final_to) ~= "string" then
         error(fmt("SkillJumpState '%s' needs final_to=\"STATE\"", name), 2)
@@ -638,7 +644,7 @@ function SkillHSM:define_states(spec)
     end
     -- timeout= of a state definition is llsfsim's; Fawkes' skiller (2013) ignored it, and so
     -- does a file written for Fawkes (module(..., skillenv.module_init)).
-    if e.timeout ~= nil and not self.skill.fawkes_style then pending[#pending + 1] = {st, e.timeout} end
+    if e.timeout ~= nil and not skill.fawkes_style then pending[#pending + 1] = {st, e.timeout} end
     rawset(export, name, st)
   end
   for _, st in ipairs(self.state_list) do
@@ -708,7 +714,7 @@ function SkillHSM:add_transitions(spec)
     end
     local tr = {from = from, to = self.states[to], desc = t.desc, error = t.error, where = loc}
     local text
-    if self.skill.fawkes_style and from then
+    if fsms[self].fawkes_style and from then
       -- As Fawkes' add_transitions: the condition is t[3] or cond=; precond=COND is the
       -- condition of a transition and a precondition both, precond=true makes cond one too,
       -- precond_only=COND a precondition only.
@@ -783,7 +789,9 @@ local spec_args
 -- the keys conditions missed are kept per state machine (key -> transition), for the check of a
 -- state that waits long (fsm_step) and the report of a skill still running at the end.
 local cond_fsm, cond_tr = nil, nil  -- the state machine and transition whose condition runs
-local vars_mt = {__index = function(_, k)
+-- (One table for every skill of the interpreter: __metatable hides it, or one skill could change
+-- how every other's conditions read vars.)
+local vars_mt = {__metatable = false, __index = function(_, k)
   local fsm = cond_fsm
   if fsm and type(k) == "string" then
     local m = fsm.misses
@@ -804,10 +812,9 @@ end
 -- Sub-skills of a SkillJumpState: next state and error text once they are done.
 local function run_subskills(fsm, st)
   local all_final = true
-  local skills = st.subskills
+  local skills = subskills_of[st]
   for i = 1, #skills do
-    local sk = skills[i]
-    local h = sk.handle
+    local h = skills[i]
     local status = call_skill(h, st.call_args[i] or st.args[h.name] or fsm.vars)
     if status == S_FAILED then
       return fsm.states[st.fail_to], fmt("%s()/%s failed: %s", st.name, h.name,
@@ -824,7 +831,7 @@ end
 -- keys of self.skills[i] other than [1], merged with self.args[name] (its keys win); neither:
 -- the sub-skill gets the skill's own fsm.vars (st.call_args[i] nil, self.args read per call).
 spec_args = function(st)
-  for i, sk in ipairs(st.subskills) do
+  for i, h in ipairs(subskills_of[st]) do
     local spec, args = st.skills[i], nil
     for k, v in pairs(spec) do
       if k ~= 1 then
@@ -832,7 +839,7 @@ spec_args = function(st)
         args[k] = v
       end
     end
-    local a = args and st.args[sk.handle.name]
+    local a = args and st.args[h.name]
     if type(a) == "table" then
       for k, v in pairs(a) do args[k] = v end
     end
@@ -865,11 +872,12 @@ local function enter(fsm, st, now)
   st.error, st.reason = nil, nil
   fsm.current = st
   fsm.running = st
-  if st.subskills then
-    for _, sk in ipairs(st.subskills) do reset_skill(sk.handle) end
+  local subskills = subskills_of[st]
+  if subskills then
+    for _, h in ipairs(subskills) do reset_skill(h) end
   end
   if st.init then st:init() end
-  if st.subskills then spec_args(st) end
+  if subskills then spec_args(st) end
   return st
 end
 
@@ -977,7 +985,9 @@ local function fsm_step(fsm)
     if st.loop then st:loop() end
     local to, tr, err, sub_reason = nil, nil, nil, nil
     if fsm.error == nil then
-      if st.subskills then
+      -- (A SkillJumpState; its kind, one field read, and not subskills_of[st]: no lookup more
+      -- in every step than when the handles were a field of the state.)
+      if st.kind == "skill" then
         progress = true
         to, err, sub_reason = run_subskills(fsm, st)
       end
@@ -1008,7 +1018,7 @@ local function fsm_step(fsm)
       trs[#trs + 1] = tr
       if tr.timeout_ns then progress = true end
     else  -- what took it there, for skill_state's `via`
-      trs[#trs + 1] = err and "fail_to" or (st.subskills and fsm.error == nil and "final_to") or
+      trs[#trs + 1] = err and "fail_to" or (st.kind == "skill" and fsm.error == nil and "final_to") or
                       "error"
     end
     leave(fsm, st, to, tr, err, sub_reason)
@@ -1272,7 +1282,7 @@ function E.finish_module(name)
     -- of every state) would only show as "still running" at the end: warn at load.
     if #fsm.defaults == 0 then
       for _, st in ipairs(fsm.state_list) do
-        if st.kind ~= "final" and st.kind ~= "failed" and not st.subskills and
+        if st.kind ~= "final" and st.kind ~= "failed" and not subskills_of[st] and
            #st.transitions == 0 and #st.preconds == 0 then
           log(2, fmt("%s: %s: state '%s' has no way out: no transition, timeout or sub-skill " ..
                      "leaves it, so the skill would stay there; add one (fsm:add_transitions" ..
@@ -1372,9 +1382,9 @@ function E.skill_wait(name)
   local st = fsm and fsm.current
   if not st or st.kind == "final" or st.kind == "failed" or h.status ~= S_RUNNING then return nil end
   local out = fmt("in state %s since %.2f s", st.name, st.entered_ns / 1e9)
-  if st.subskills then
+  if subskills_of[st] then
     local names = {}
-    for i, sk in ipairs(st.subskills) do names[i] = sk.handle.name end
+    for i, h in ipairs(subskills_of[st]) do names[i] = h.name end
     return out .. fmt(", its sub-skill(s) %s still running", concat(names, ", "))
   end
   local waits = {}

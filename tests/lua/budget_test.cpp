@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Budgets for work the instruction count hook cannot see (it never fires inside a C function):
 // string.rep, table.move and friends, the pattern functions, the allocation budget; the shared
-// library tables are read-only. Each hostile call must fail the skill at its line, quickly.
+// library tables are read-only, and a skill meets another only as its read-only handle. Each
+// hostile call must fail the skill at its line, quickly.
 #include <doctest/doctest.h>
 #include <lua.hpp>
 
@@ -248,6 +249,146 @@ TEST_CASE("a skill sees other skills read-only: it can call them, not reach thei
             ": skill 'target' is read-only: cannot set target.execute");
   REQUIRE(engine.exec("target{}"));
   CHECK(engine.cycle() == SkillStatus::kFinal);
+}
+
+namespace {
+
+// Lua for the two skills below: where in the tables a skill can walk (next, rawget) from its
+// own state and globals lies a real skill handle (is_skill set; another skill as skills see it
+// is an empty proxy). Sorted paths, or "nothing".
+constexpr const char* kHandleFinder = R"(
+local function handles_from(...)
+  local found, seen, queue, i = {}, {}, {}, 1
+  for _, root in ipairs{...} do
+    seen[root[1]] = true
+    queue[#queue + 1] = root
+  end
+  while queue[i] do
+    local t, path = queue[i][1], queue[i][2]
+    i = i + 1
+    if rawget(t, 'is_skill') then found[#found + 1] = path end
+    for k, v in next, t do
+      if type(v) == 'table' and not seen[v] then
+        seen[v] = true
+        queue[#queue + 1] = {v, path .. '.' .. tostring(k)}
+      end
+    end
+  end
+  table.sort(found)
+  return #found == 0 and 'nothing' or table.concat(found, ', ')
+end
+)";
+
+// `meddler` runs `worker` (three steps) from a SkillJumpState; each reports the real handles it
+// can reach, and with vars.tamper = "down" (meddler) or "up" (worker) uses them: meddler makes
+// worker end at once, worker makes meddler fail.
+void write_meddler_and_worker(const TempDir& dir) {
+  dir.write("meddler.lua", std::string(R"(name = 'meddler'
+documentation = 'runs worker and reaches for its state machine'
+depends_skills = {'worker'}
+fsm = SkillHSM:new{name=name, start='RUN'}
+fsm:define_states{{'RUN', SkillJumpState, skills={{worker}}, final_to='FINAL'}}
+)") + kHandleFinder + R"(
+function RUN:init()
+  assert(self.skills[1][1] == worker and self.skills[1][1].name == 'worker')
+  print('meddler reaches ' .. handles_from({self, 'self'}, {_M, '_M'}))
+end
+function RUN:loop()
+  local subskills = rawget(self, 'subskills')
+  if self.fsm.vars.tamper == 'down' and subskills then
+    local w = subskills[1].handle.fsm
+    w.current = w.final
+  end
+end
+)");
+  dir.write("worker.lua", std::string(R"(name = 'worker'
+documentation = 'works for three steps and reaches for its caller'
+fsm = SkillHSM:new{name=name, start='WORK'}
+fsm:define_states{{'WORK'}}
+fsm:add_transitions{{'WORK', 'FINAL', cond='vars.n == 3'}}
+)") + kHandleFinder + R"(
+function WORK:init()
+  self.fsm.vars.n = 0
+  print('worker reaches ' .. handles_from({self, 'self'}, {_M, '_M'}))
+end
+function WORK:loop()
+  self.fsm.vars.n = self.fsm.vars.n + 1
+  local me = rawget(self.fsm, 'skill')
+  if self.fsm.vars.tamper == 'up' and me and me.child_of then
+    me.child_of.fsm.error = 'stopped by worker'
+  end
+end
+)");
+}
+
+// The first line of `log` that starts with `prefix` ("" if none).
+std::string line_starting(const std::vector<std::string>& log, const std::string& prefix) {
+  for (const std::string& line : log) {
+    if (line.rfind(prefix, 0) == 0) return line;
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST_CASE("a SkillJumpState's state holds no real handle: a skill cannot end its sub-skill") {
+  TempDir dir("llsf_budget");
+  write_meddler_and_worker(dir);
+  FakeRobot robot;
+  lua::SkillEngine engine(budget_config(dir), robot);
+  std::vector<std::string> log;
+  engine.set_log_sink([&](lua::LogLevel, std::string_view text) { log.emplace_back(text); });
+  REQUIRE(engine.exec("meddler{tamper='down'}"));
+  CHECK(test::run_cycles(engine, robot, 2) == SkillStatus::kRunning);
+  CHECK(engine.skill_state("worker") == "WORK");
+  CHECK(test::run_cycles(engine, robot, 1) == SkillStatus::kFinal);
+  CHECK(engine.error() == "");
+  CHECK(line_starting(log, "meddler reaches") == "meddler reaches nothing");
+}
+
+TEST_CASE("a sub-skill's state machine holds no real handle: it cannot fail its caller") {
+  TempDir dir("llsf_budget");
+  write_meddler_and_worker(dir);
+  FakeRobot robot;
+  lua::SkillEngine engine(budget_config(dir), robot);
+  std::vector<std::string> log;
+  engine.set_log_sink([&](lua::LogLevel, std::string_view text) { log.emplace_back(text); });
+  REQUIRE(engine.exec("meddler{tamper='up'}"));
+  CHECK(test::run_cycles(engine, robot, 2) == SkillStatus::kRunning);
+  CHECK(test::run_cycles(engine, robot, 1) == SkillStatus::kFinal);
+  CHECK(engine.error() == "");
+  CHECK(line_starting(log, "worker reaches") == "worker reaches nothing");
+}
+
+TEST_CASE("fsm.vars' metatable is not shared: a skill cannot change how others read vars") {
+  TempDir dir("llsf_budget");
+  dir.write("tamper.lua", R"(name = 'tamper'
+documentation = 'makes every unset key of vars read true, for every skill'
+fsm = SkillHSM:new{name=name, start='GO'}
+fsm:define_states{{'GO'}}
+fsm:add_transitions{{'GO', 'FINAL', cond=true}}
+function GO:init()
+  local mt = getmetatable(self.fsm.vars)
+  print('getmetatable(vars): ' .. (type(mt) == 'table' and 'a table' or tostring(mt)))
+  if type(mt) == 'table' then mt.__index = function() return true end end
+end
+)");
+  dir.write("waiter.lua", R"(name = 'waiter'
+documentation = 'waits for vars.done, which nothing sets'
+fsm = SkillHSM:new{name=name, start='WAIT'}
+fsm:define_states{{'WAIT'}}
+fsm:add_transitions{{'WAIT', 'FINAL', cond='vars.done'}}
+)");
+  FakeRobot robot;
+  lua::SkillEngine engine(budget_config(dir), robot);
+  std::vector<std::string> log;
+  engine.set_log_sink([&](lua::LogLevel, std::string_view text) { log.emplace_back(text); });
+  REQUIRE(engine.exec("tamper{}"));
+  CHECK(engine.cycle() == SkillStatus::kFinal);
+  CHECK(line_starting(log, "getmetatable(vars)") == "getmetatable(vars): false");
+  REQUIRE(engine.exec("waiter{}"));
+  CHECK(test::run_cycles(engine, robot, 3) == SkillStatus::kRunning);
+  CHECK(engine.skill_state("waiter") == "WAIT");
 }
 
 TEST_CASE("string positions count for the charges; error objects never show an address") {
