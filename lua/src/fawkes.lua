@@ -677,11 +677,16 @@ local function refresh(obj)
 end
 
 
+-- A message class (iface.SomeMessage) is one table for every skill of the robot: skills get it
+-- read-only (F.readonly, the prelude's, which also refuses rawset), and neither the messages'
+-- metatable nor the interface definition's field list is a field of it.
+F.readonly = nil  -- set by the prelude: function(t, what) -> a read-only proxy of t
 local function message_class(type_name, name, fields)
   local by_type = message_classes[type_name]
   if not by_type then by_type = {}; message_classes[type_name] = by_type end
   if by_type[name] then return by_type[name] end
-  local class = {type_name = type_name, name = name, fields = fields}
+  local class = {type_name = type_name, name = name}
+  local shown  -- what skills get (below)
   local mmt = {__metatable = false}
   mmt.__index = function(msg, k)
     if type(k) ~= "string" then return nil end
@@ -692,10 +697,9 @@ local function message_class(type_name, name, fields)
     end
     return nil
   end
-  class.mt = mmt
   -- Class:new(field values in the definition's order).
   class.new = function(cls, ...)
-    if cls ~= class then fail(2, "%s.%s:new(...): call it with a colon", type_name, name) end
+    if cls ~= shown then fail(2, "%s.%s:new(...): call it with a colon", type_name, name) end
     local msg = setmetatable({}, mmt)
     for i = 1, select("#", ...) do
       local f = fields[i]
@@ -706,8 +710,9 @@ local function message_class(type_name, name, fields)
     message_of[msg] = class
     return msg
   end
-  by_type[name] = class
-  return class
+  shown = F.readonly and F.readonly(class, type_name .. "." .. name) or class
+  by_type[name] = shown
+  return shown
 end
 
 -- Methods every interface object has.

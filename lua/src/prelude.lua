@@ -182,6 +182,7 @@ base.module = function() if loading then loading.fawkes_style = true end end
 -- What skills written for Fawkes find besides (fawkes.lua): fawkes.Time, fawkes.tf, fawkes.modinit,
 -- fawkes.load_yaml_navgraph, the tf transformer, the config, require's built-in modules.
 local fawkes = native.fawkes
+fawkes.readonly = readonly  -- for the message classes it makes on demand
 local fawkes_tf
 do
   local tf_classes = {}

@@ -336,6 +336,54 @@ TEST_CASE("bad Fawkes-style input: navgraph files, messages, config, interface i
                  "depends_interfaces[1]: unknown interface type 'WorldModel' (known: "));
 }
 
+TEST_CASE("message classes are read-only: one skill cannot break another's nav.StopMessage") {
+  test::TempDir dir;
+  const std::string skills = dir.path.string() + "/skills";
+  std::filesystem::create_directories(skills);
+  const std::string nav = "{v='nav', type='NavigatorInterface', id='Pathplan'}";
+  // Every skill of the robot gets the same class table for nav.StopMessage.
+  write(skills + "/tamper_msg.lua",
+        skill_running(
+            "tamper_msg",
+            "local stop, go = nav.StopMessage, nav.CartesianGotoMessage\n"
+            "local tries = {\n"
+            "  function() stop.new = function() end end,\n"
+            "  function() rawset(stop, 'new', function() end) end,\n"
+            "  function() go.fields[1] = 'y' end,\n"
+            "  function() rawget(go, 'mt').__index = function() end end,\n"
+            "}\n"
+            "local refused = 0\n"
+            "for _, f in ipairs(tries) do if not pcall(f) then refused = refused + 1 end end\n"
+            "print('refused ' .. refused .. ', getmetatable ' .. tostring(getmetatable(stop)))\n"
+            "stop.new = nil  -- MARK",
+            nav));
+  write(skills + "/send_msgs.lua",
+        skill_running("send_msgs",
+                      "nav:msgq_enqueue_copy(nav.StopMessage:new())\n"
+                      "nav:msgq_enqueue_copy(nav.CartesianGotoMessage:new(1, 2, 0))",
+                      nav));
+  lua::SkillEngineConfig cfg = fawkes_config();
+  cfg.skill_dirs = {skills};
+  FakeRobot robot;
+  lua::SkillEngine engine(cfg, robot);
+  std::vector<std::string> log;
+  engine.set_log_sink([&](lua::LogLevel, std::string_view text) { log.emplace_back(text); });
+  REQUIRE(engine.exec("tamper_msg{}"));
+  CHECK(test::run_cycles(engine, robot, 1) == SkillStatus::kFailed);
+  CHECK(
+      contains(engine.error(), test::marked_line(skills + "/tamper_msg.lua") +
+                                   ": NavigatorInterface.StopMessage is read-only (shared by "
+                                   "every skill): cannot set NavigatorInterface.StopMessage.new"));
+  std::string refused;
+  for (const std::string& line : log) {
+    if (line.rfind("refused", 0) == 0) refused = line;
+  }
+  CHECK(refused == "refused 4, getmetatable false");
+  REQUIRE(engine.exec("send_msgs{}"));
+  CHECK(test::run_cycles(engine, robot, 1) == SkillStatus::kFinal);
+  CHECK(engine.error() == "");
+}
+
 TEST_CASE("skills: module_dirs, cfg_dirs and fawkes_config in a scenario's skills map") {
   const core::ConfigNode node = core::ConfigNode::parse(
       "skills:\n  module_dirs: [modules]\n  cfg_dirs: [cfg]\n"
