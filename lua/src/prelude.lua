@@ -1226,7 +1226,8 @@ function E.begin_module(name, path)
 end
 
 -- Checks a loaded module's declarations; errors name the file (and line where one is known).
-function E.finish_module(name)
+-- `returned`: what the file returned (a helper module's value for require, as require gives it).
+function E.finish_module(name, returned)
   local h = handles[name]
   loading = nil
   local env = h.env
@@ -1243,7 +1244,8 @@ function E.finish_module(name)
   end
   if not declared then
     h.is_module = true
-    modules[h.name] = env
+    if returned == nil then returned = env end
+    modules[h.name] = returned
     return
   end
   if rawget(env, "name") == nil then

@@ -700,11 +700,13 @@ void SkillEngine::Impl::build() {
         } else {
           lua_insert(L, -2);                      // chunk, env
           LLSF_DEMAND(lua_setupvalue(L, -2, 1));  // _ENV = env
-          if (protected_call(0, 0) != LUA_OK) {
+          if (protected_call(0, 1) != LUA_OK) {
             load_error = explain(pop_message(L));
           } else {
+            // finish_module(name, what the file returned): a helper module's value for require
             lua_pushstring(L, f.name.c_str());
-            if (call_entry("finish_module", 1, 0) != LUA_OK) load_error = explain(pop_message(L));
+            lua_insert(L, -2);
+            if (call_entry("finish_module", 2, 0) != LUA_OK) load_error = explain(pop_message(L));
           }
         }
       }

@@ -98,6 +98,27 @@ TEST_CASE("a skill directory whose init.lua names its skills (a Fawkes skill spa
   CHECK(engine.result() == "forty-two");
 }
 
+TEST_CASE("a helper module in a skill directory that returns a table: require gives that table") {
+  // The engine loads every file of a skill directory, in name order: aa_helper.lua before the
+  // skill that requires it, zz_helper.lua after (then require loads it first). Either way
+  // require gives what the file returned, as the docs say, not the file's globals.
+  test::TempDir dir;
+  const std::string helper = "local M = {}\nM.answer = 'forty-two'\nreturn M\n";
+  dir.write("aa_helper.lua", helper);
+  dir.write("zz_helper.lua", helper);
+  dir.write("mid_user.lua", skill_running("mid_user",
+                                          "self.fsm.result = require('aa_helper').answer .. ' ' .. "
+                                          "require('zz_helper').answer"));
+  lua::SkillEngineConfig cfg = fawkes_config();
+  cfg.skill_dirs = {LLSF_SOURCE_DIR "/lua/skills/fawkes", dir.path.string()};
+  FakeRobot robot;
+  lua::SkillEngine engine(cfg, robot);
+  CHECK(engine.load_errors().empty());
+  REQUIRE(engine.exec("mid_user{}"));
+  CHECK(test::run_cycles(engine, robot, 1) == SkillStatus::kFinal);
+  CHECK(engine.result() == "forty-two forty-two");
+}
+
 TEST_CASE("require finds only Lua files of the skill and module directories") {
   test::TempDir dir;
   const std::string skills = dir.path.string() + "/skills";
