@@ -650,6 +650,9 @@ local data_of = {}    -- object -> its data (fields; refreshed from the writer)
 local meta_of = {}    -- object -> {type=, id=, t=, write=, stamp=, msgid=}
 local message_classes = {}  -- type -> message name -> class
 local message_of = setmetatable({}, {__mode = "k"})  -- message -> its class
+-- message -> its field values: kept beside it, so that msg:x() is the getter (Fawkes' API) and
+-- not hidden by the value
+local values_of = setmetatable({}, {__mode = "k"})
 
 local function default_value(kind, len)
   local v = (kind == "string" and "") or (kind == "bool" and false) or
@@ -691,23 +694,25 @@ local function message_class(type_name, name, fields)
   mmt.__index = function(msg, k)
     if type(k) ~= "string" then return nil end
     local f = k:match("^set_(.+)$")
-    if f then return function(self, v) rawset(self, f, v) end end
+    if f then return function(self, v) values_of[self][f] = v end end
     for _, fname in ipairs(fields) do
-      if fname == k then return function(self) return rawget(self, k) end end
+      if fname == k then return function(self) return values_of[self][k] end end
     end
     return nil
   end
+  -- (msg.field = v, as the messages' plain tables once took it: the value, as set_field(v))
+  mmt.__newindex = function(msg, k, v) values_of[msg][k] = v end
   -- Class:new(field values in the definition's order).
   class.new = function(cls, ...)
     if cls ~= shown then fail(2, "%s.%s:new(...): call it with a colon", type_name, name) end
-    local msg = setmetatable({}, mmt)
+    local msg, values = setmetatable({}, mmt), {}
     for i = 1, select("#", ...) do
       local f = fields[i]
       if not f then fail(2, "%s:new: too many arguments (fields: %s)", name,
                          table.concat(fields, ", ")) end
-      rawset(msg, f, (select(i, ...)))
+      values[f] = (select(i, ...))
     end
-    message_of[msg] = class
+    message_of[msg], values_of[msg] = class, values
     return msg
   end
   shown = F.readonly and F.readonly(class, type_name .. "." .. name) or class
@@ -754,7 +759,7 @@ function common.msgq_enqueue_copy(obj, msg)
   m.msgid = m.msgid + 1
   epoch = epoch + 1
   local handle = m.t.handle
-  local id = handle and handle(data_of[obj], class.name, msg, m.id, 3) or nil
+  local id = handle and handle(data_of[obj], class.name, values_of[msg], m.id, 3) or nil
   if m.store then  -- a message changed the data it holds
     m.written_ns = now_ns()
     state.version = state.version + 1
@@ -994,8 +999,9 @@ function F.send(type_name, id, name, values)
   local class = message_class(type_name, name, fields)
   local msg = class.new(class)
   -- (a field not given is false: the writers take their default for it)
-  for _, f in ipairs(fields) do rawset(msg, f, false) end
-  for k, v in pairs(values) do rawset(msg, k, v) end
+  local given = values_of[msg]
+  for _, f in ipairs(fields) do given[f] = false end
+  for k, v in pairs(values) do given[k] = v end
   return common.msgq_enqueue_copy(obj, msg)
 end
 

@@ -405,6 +405,33 @@ TEST_CASE("message classes are read-only: one skill cannot break another's nav.S
   CHECK(engine.error() == "");
 }
 
+TEST_CASE("a message's getters and setters, as Fawkes' msg:x() and msg:set_x(v)") {
+  test::TempDir dir;
+  const std::string skills = dir.path.string() + "/skills";
+  std::filesystem::create_directories(skills);
+  write(skills + "/getters.lua",
+        skill_running("getters",
+                      "local g = nav.CartesianGotoMessage:new(1.5, 2.5, 0.25)\n"
+                      "g:set_y(3.5)\n"
+                      "g.orientation = 0.75  -- (a plain assignment, as the value)\n"
+                      "self.fsm.result = g:x() .. ' ' .. g:y() .. ' ' .. g:orientation()\n"
+                      "nav:msgq_enqueue_copy(g)",
+                      "{v='nav', type='NavigatorInterface', id='Pathplan'}"));
+  lua::SkillEngineConfig cfg = fawkes_config();
+  cfg.skill_dirs = {skills};
+  FakeRobot robot;
+  lua::SkillEngine engine(cfg, robot);
+  REQUIRE(engine.exec("getters{}"));
+  CHECK(test::run_cycles(engine, robot, 1) == SkillStatus::kFinal);
+  CHECK(engine.error() == "");
+  CHECK(engine.result() == "1.5 3.5 0.75");
+  // The goal sent is what the getters read.
+  CHECK(robot.nav_goal == "pose");
+  CHECK(robot.pose_estimate.pose.x == doctest::Approx(1.5));
+  CHECK(robot.pose_estimate.pose.y == doctest::Approx(3.5));
+  CHECK(robot.pose_estimate.pose.theta == doctest::Approx(0.75));
+}
+
 TEST_CASE("skills: module_dirs, cfg_dirs and fawkes_config in a scenario's skills map") {
   const core::ConfigNode node = core::ConfigNode::parse(
       "skills:\n  module_dirs: [modules]\n  cfg_dirs: [cfg]\n"
