@@ -180,14 +180,21 @@ F.tf_transformer = transformer
 local Node = {}
 Node.__index = Node
 Node.__metatable = false
+-- Graphs and their nodes are read-only for skills (F.readonly, the prelude's: below, when a graph
+-- is loaded): every graph loaded goes into the one list ppgoto's places come from, so one skill
+-- could otherwise move another's place.
 local invalid_node = setmetatable({name_ = "", x_ = 0, y_ = 0, props = {}, reach = {}}, Node)
+local invalid_shown  -- invalid_node as skills get it (made with the first graph)
 function Node:name() return self.name_ end
 function Node:x() return self.x_ end
 function Node:y() return self.y_ end
 function Node:is_valid() return self.name_ ~= "" end
 function Node:is_unconnected() return self.unconnected == true end
 function Node:has_property(p) return self.props[p] ~= nil end
-function Node:has_properties() return next(self.props) ~= nil end
+function Node:has_properties()
+  local step, t = pairs(self.props)  -- (a read-only proxy: next() would see it empty)
+  return step(t) ~= nil
+end
 function Node:property(p) return self.props[p] or "" end
 function Node:property_as_float(p) return tonumber(self.props[p]) or 0.0 end
 function Node:property_as_int(p) return floor(tonumber(self.props[p]) or 0) end
@@ -213,8 +220,8 @@ function Graph:nodes()
   return t
 end
 -- The node of that name, or an invalid node (name "", is_valid() false), as Fawkes returned.
-function Graph:node(name) return self.by_name[name] or invalid_node end
-function Graph:root_node() return self.by_name[self.root] or invalid_node end
+function Graph:node(name) return self.by_name[name] or invalid_shown end
+function Graph:root_node() return self.by_name[self.root] or invalid_shown end
 function Graph:node_exists(name) return self.by_name[name] ~= nil end
 function Graph:search_nodes(property)
   local t = {}
@@ -235,7 +242,7 @@ local function closest(g, x, y, property, unconnected, except)
       if d < best_d then best, best_d = n, d end
     end
   end
-  return best or invalid_node
+  return best or invalid_shown
 end
 function Graph:closest_node(x, y, property) return closest(self, x, y, property, false) end
 function Graph:closest_node_with_unconnected(x, y, property)
@@ -255,18 +262,30 @@ local function load_yaml_navgraph(file)
   if type(file) ~= "string" then fail(2, "fawkes.load_yaml_navgraph: expected a file name") end
   local data, err = native.navgraph(file)
   if not data then fail(2, "fawkes.load_yaml_navgraph: %s", err) end
-  local g = setmetatable({name_ = data.name, root = data.root, list = {}, by_name = {}}, Graph)
+  local readonly = F.readonly
+  local what = "navgraph " .. tostring(data.name)
+  if not invalid_shown then invalid_shown = readonly(invalid_node, "navgraph node") end
+  local nodes, reach = {}, {}
   for i, d in ipairs(data.nodes) do
-    local n = setmetatable({name_ = d.name, x_ = d.x, y_ = d.y, props = d.properties,
-                            unconnected = d.unconnected, reach = {}}, Node)
-    g.list[i] = n
-    g.by_name[d.name] = n
+    reach[d.name] = {}
+    nodes[i] = setmetatable({name_ = d.name, x_ = d.x, y_ = d.y,
+                             props = readonly(d.properties, what .. " node " .. d.name),
+                             unconnected = d.unconnected,
+                             reach = readonly(reach[d.name], what .. " node " .. d.name)}, Node)
   end
   for _, e in ipairs(data.edges) do
-    local a, b = g.by_name[e[1]], g.by_name[e[2]]
-    a.reach[#a.reach + 1] = b.name_
-    if not e[3] then b.reach[#b.reach + 1] = a.name_ end
+    local a, b = reach[e[1]], reach[e[2]]
+    a[#a + 1] = e[2]
+    if not e[3] then b[#b + 1] = e[1] end
   end
+  local list, by_name = {}, {}
+  for i, n in ipairs(nodes) do
+    list[i] = readonly(n, what .. " node " .. n.name_)
+    by_name[n.name_] = list[i]
+  end
+  local g = readonly(setmetatable({name_ = data.name, root = data.root,
+                                   list = readonly(list, what), by_name = readonly(by_name, what)},
+                                  Graph), what)
   graphs[#graphs + 1] = g
   return g
 end

@@ -405,6 +405,46 @@ TEST_CASE("message classes are read-only: one skill cannot break another's nav.S
   CHECK(engine.error() == "");
 }
 
+TEST_CASE("navgraphs are read-only: one skill cannot move another's place") {
+  test::TempDir dir;
+  const std::string skills = dir.path.string() + "/skills";
+  std::filesystem::create_directories(skills);
+  // The first graph loaded is where ppgoto's places come from (F.navgraph_node).
+  write(skills + "/aa_mover.lua",
+        skill_running(
+            "aa_mover",
+            "local graph = fawkes.load_yaml_navgraph('navgraph-test.yaml')\n"
+            "local n = graph:node('M1')\n"
+            "local tries = {\n"
+            "  function() n.x_ = 9 end,\n"
+            "  function() rawset(n, 'x_', 9) end,\n"
+            "  function() n.props.orientation = '0' end,\n"
+            "  function() graph:nodes()[1].y_ = 9 end,\n"
+            "  function() graph.by_name.M1 = graph:node('FAR') end,\n"
+            "  function() graph:node('NOWHERE').name_ = 'M1' end,\n"
+            "}\n"
+            "local refused = 0\n"
+            "for _, f in ipairs(tries) do if not pcall(f) then refused = refused + 1 end end\n"
+            "self.fsm.result = refused .. ' ' .. tostring(n:has_properties()) .. ' ' .. "
+            "n:x() .. ' ' .. #n:reachable_nodes() .. ' ' .. #graph:nodes()"));
+  write(skills + "/goer.lua",
+        skill_running("goer", "nav:msgq_enqueue_copy(nav.PlaceGotoMessage:new('M1'))",
+                      "{v='nav', type='NavigatorInterface', id='Pathplan'}"));
+  lua::SkillEngineConfig cfg = fawkes_config();
+  cfg.skill_dirs = {skills};
+  FakeRobot robot;
+  lua::SkillEngine engine(cfg, robot);
+  CHECK(engine.load_errors().empty());
+  REQUIRE(engine.exec("aa_mover{}"));
+  CHECK(test::run_cycles(engine, robot, 1) == SkillStatus::kFinal);
+  CHECK(engine.result() == "6 true 2.0 0 5");
+  REQUIRE(engine.exec("goer{}"));
+  CHECK(test::run_cycles(engine, robot, 1) == SkillStatus::kFinal);
+  CHECK(robot.pose_estimate.pose.x == doctest::Approx(2.0));
+  CHECK(robot.pose_estimate.pose.y == doctest::Approx(1.0));
+  CHECK(robot.pose_estimate.pose.theta == doctest::Approx(1.57));
+}
+
 TEST_CASE("a message's getters and setters, as Fawkes' msg:x() and msg:set_x(v)") {
   test::TempDir dir;
   const std::string skills = dir.path.string() + "/skills";
