@@ -329,15 +329,28 @@ std::string line_starting(const std::vector<std::string>& log, const std::string
   return "";
 }
 
+// An engine with meddler and worker loaded, its log kept.
+struct Meddling {
+  TempDir dir{"llsf_budget"};
+  FakeRobot robot;
+  std::vector<std::string> log;
+  lua::SkillEngine engine{config(dir), robot};
+  Meddling() {
+    engine.set_log_sink([this](lua::LogLevel, std::string_view text) { log.emplace_back(text); });
+  }
+  static lua::SkillEngineConfig config(TempDir& dir) {
+    write_meddler_and_worker(dir);
+    return budget_config(dir);
+  }
+};
+
 }  // namespace
 
 TEST_CASE("a SkillJumpState's state holds no real handle: a skill cannot end its sub-skill") {
-  TempDir dir("llsf_budget");
-  write_meddler_and_worker(dir);
-  FakeRobot robot;
-  lua::SkillEngine engine(budget_config(dir), robot);
-  std::vector<std::string> log;
-  engine.set_log_sink([&](lua::LogLevel, std::string_view text) { log.emplace_back(text); });
+  Meddling m;
+  lua::SkillEngine& engine = m.engine;
+  FakeRobot& robot = m.robot;
+  const std::vector<std::string>& log = m.log;
   REQUIRE(engine.exec("meddler{tamper='down'}"));
   CHECK(test::run_cycles(engine, robot, 2) == SkillStatus::kRunning);
   CHECK(engine.skill_state("worker") == "WORK");
@@ -347,12 +360,10 @@ TEST_CASE("a SkillJumpState's state holds no real handle: a skill cannot end its
 }
 
 TEST_CASE("a sub-skill's state machine holds no real handle: it cannot fail its caller") {
-  TempDir dir("llsf_budget");
-  write_meddler_and_worker(dir);
-  FakeRobot robot;
-  lua::SkillEngine engine(budget_config(dir), robot);
-  std::vector<std::string> log;
-  engine.set_log_sink([&](lua::LogLevel, std::string_view text) { log.emplace_back(text); });
+  Meddling m;
+  lua::SkillEngine& engine = m.engine;
+  FakeRobot& robot = m.robot;
+  const std::vector<std::string>& log = m.log;
   REQUIRE(engine.exec("meddler{tamper='up'}"));
   CHECK(test::run_cycles(engine, robot, 2) == SkillStatus::kRunning);
   CHECK(test::run_cycles(engine, robot, 1) == SkillStatus::kFinal);
