@@ -279,11 +279,11 @@ void Costmap::beams_near(const Vec2& origin, std::size_t hits, const Beams& beam
       --beam_marks_[static_cast<std::size_t>(last) + 1];
     }
   }
-  beam_wanted_.resize(static_cast<std::size_t>(count));
+  // The marks summed in place: beam k is wanted when beam_marks_[k] is 1.
   int open = 0;
-  for (int k = 0; k < count; ++k) {
-    open += beam_marks_[static_cast<std::size_t>(k)];
-    beam_wanted_[static_cast<std::size_t>(k)] = open > 0 ? 1 : 0;
+  for (int& mark : beam_marks_) {
+    open += mark;
+    mark = open > 0 ? 1 : 0;
   }
   beam_todo_.resize(hits);
   std::size_t todo = 0;
@@ -291,7 +291,7 @@ void Costmap::beams_near(const Vec2& origin, std::size_t hits, const Beams& beam
     const int beam = beams.of_hit[k];
     LLSF_ASSERT(beam >= 0 && beam < count);
     beam_todo_[todo] = static_cast<int>(k);
-    todo += beam_wanted_[static_cast<std::size_t>(beam)];
+    todo += static_cast<std::size_t>(beam_marks_[static_cast<std::size_t>(beam)]);
   }
   beam_todo_.resize(todo);
 }

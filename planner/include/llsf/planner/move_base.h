@@ -138,7 +138,7 @@ class Costmap {
   static constexpr std::uint8_t kInscribed = 253;
   static constexpr std::uint8_t kLethal = 254;
 
-  /// Where a scan's beams point: hit k came from beam of_hit[k] (increasing), in the direction
+  /// Where a scan's beams point: hit k came from beam of_hit[k], in the direction
   /// first_rad + of_hit[k] * increment_rad (field frame), of `count` beams in all. Empty
   /// of_hit: not known.
   struct Beams {
@@ -282,8 +282,7 @@ class Costmap {
   std::vector<BeamLine> beam_lines_;
   std::vector<OffsetCell> reach_cells_;  // the obstacle cells within reach of a scan
   std::vector<int> beam_marks_;          // beams_near(): +1 where a window starts, -1 after it
-  std::vector<std::uint8_t> beam_wanted_;
-  std::vector<int> beam_todo_;  // the beams to look at
+  std::vector<int> beam_todo_;           // the beams to look at
   std::size_t beams_tested_ = 0;
   struct KernelRow {  // the inflation kernel by rows: costs of cells di0, di0 + 1, ... of row dj
     int dj;
